@@ -1,0 +1,11 @@
+//! Bit-accurate models of ray-tracing hardware datapaths: number formats ([`format`]), the
+//! latency-reordered Möller–Trumbore ray–triangle pipeline ([`rti`]) with per-stage probes
+//! ([`probe`]), and its error bounds ([`bound`]).
+#![warn(missing_docs)]
+
+pub mod bound;
+pub mod format;
+pub mod probe;
+pub mod rti;
+
+pub use format::{AnyFormat, Format};

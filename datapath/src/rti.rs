@@ -1,0 +1,551 @@
+//! The latency-reordered Möller–Trumbore ray–triangle intersection (RTI) pipeline.
+//!
+//! The classic test is 51 operations (9 sub, 2 cross products, 4 dot products, 1 divide, 3
+//! multiplies by 1/det). This datapath keeps those operations and fixes their order and
+//! grouping so that the longest path is short and the divide comes last:
+//! subtracts in parallel, both cross products in parallel, the four dot products in parallel,
+//! a division-free validity test (which clears the valid bit), then the divide. The stage
+//! table [`stage_table`] is the contract; [`Rti::trace`] implements it and a test checks every
+//! recorded signal against the table.
+//!
+//! Every operation is the format's rounded op; nothing is fused; dot products add as
+//! `(x + y) + z`; comparisons are the format's IEEE ordered compares (NaN → false, −0 == +0).
+
+use crate::format::{DivMode, Format};
+use crate::probe::{NoProbe, Probe};
+use crate::{record, record_flags};
+
+/// A ray in the datapath's format: origin, direction and the accepted t interval.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Ray<V> {
+    /// Origin.
+    pub o: [V; 3],
+    /// Direction (need not be normalised).
+    pub d: [V; 3],
+    /// Smallest accepted t (inclusive).
+    pub tmin: V,
+    /// Largest accepted t (inclusive).
+    pub tmax: V,
+}
+
+/// A triangle in the datapath's format.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Tri<V> {
+    /// Vertices v0, v1, v2.
+    pub v: [[V; 3]; 3],
+}
+
+/// Output of one RTI test.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RtiOut<V> {
+    /// Validity-stage result: det, barycentric and t-sign tests passed.
+    pub valid: bool,
+    /// `valid` and `tmin <= t <= tmax`.
+    pub hit: bool,
+    /// Distance along the ray (meaningful when `valid`).
+    pub t: V,
+    /// Barycentric weight of v1.
+    pub u: V,
+    /// Barycentric weight of v2.
+    pub v: V,
+}
+
+/// Face culling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Cull {
+    /// Both faces: valid needs `|det| > threshold`.
+    TwoSided,
+    /// Back faces culled: valid needs `det > threshold` (front face: ray against the normal e1 × e2).
+    Backface,
+}
+
+/// Which of two equal-t hits the min-capture unit keeps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TieRule {
+    /// Keep the earlier one in the stream (replace only when `t < best`).
+    First,
+    /// Keep the later one (replace when `t <= best`).
+    Last,
+}
+
+/// Datapath options of an RTI unit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RtiConfig {
+    /// Face culling.
+    pub cull: Cull,
+    /// det threshold (>= 0), converted into the format.
+    pub det_threshold: f64,
+    /// Min-capture tie rule.
+    pub tie: TieRule,
+}
+
+impl Default for RtiConfig {
+    fn default() -> Self {
+        Self { cull: Cull::TwoSided, det_threshold: 0.0, tie: TieRule::First }
+    }
+}
+
+/// Operation of one signal in the stage table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Op {
+    /// a - b.
+    Sub,
+    /// a + b.
+    Add,
+    /// a × b.
+    Mul,
+    /// a ÷ b (per the format's division mode).
+    Div,
+    /// A comparison or logic bit; the formula is in the note.
+    Logic,
+}
+
+/// One row of the stage table: `name = a op b` at `stage`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SigDef {
+    /// Pipeline stage (1-based).
+    pub stage: u8,
+    /// Signal name (as recorded by the probe).
+    pub name: &'static str,
+    /// Operation.
+    pub op: Op,
+    /// First operand (input or earlier signal).
+    pub a: &'static str,
+    /// Second operand.
+    pub b: &'static str,
+    /// Formula for logic bits.
+    pub note: &'static str,
+}
+
+const fn s(stage: u8, name: &'static str, op: Op, a: &'static str, b: &'static str) -> SigDef {
+    SigDef { stage, name, op, a, b, note: "" }
+}
+const fn l(stage: u8, name: &'static str, note: &'static str) -> SigDef {
+    SigDef { stage, name, op: Op::Logic, a: "", b: "", note }
+}
+
+/// Input signal names: ray origin, direction, t interval, triangle vertices, and the constant one.
+pub const RTI_INPUTS: [&str; 17] = [
+    "ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax", "v0x", "v0y", "v0z", "v1x", "v1y", "v1z", "v2x", "v2y", "v2z",
+];
+
+const STAGES_1_TO_7: [SigDef; 53] = [
+    // stage 1: the nine subtracts, in parallel
+    s(1, "e1x", Op::Sub, "v1x", "v0x"),
+    s(1, "e1y", Op::Sub, "v1y", "v0y"),
+    s(1, "e1z", Op::Sub, "v1z", "v0z"),
+    s(1, "e2x", Op::Sub, "v2x", "v0x"),
+    s(1, "e2y", Op::Sub, "v2y", "v0y"),
+    s(1, "e2z", Op::Sub, "v2z", "v0z"),
+    s(1, "sx", Op::Sub, "ox", "v0x"),
+    s(1, "sy", Op::Sub, "oy", "v0y"),
+    s(1, "sz", Op::Sub, "oz", "v0z"),
+    // stage 2: the twelve products of p = d × e2 and q = s × e1
+    s(2, "pxa", Op::Mul, "dy", "e2z"),
+    s(2, "pxb", Op::Mul, "dz", "e2y"),
+    s(2, "pya", Op::Mul, "dz", "e2x"),
+    s(2, "pyb", Op::Mul, "dx", "e2z"),
+    s(2, "pza", Op::Mul, "dx", "e2y"),
+    s(2, "pzb", Op::Mul, "dy", "e2x"),
+    s(2, "qxa", Op::Mul, "sy", "e1z"),
+    s(2, "qxb", Op::Mul, "sz", "e1y"),
+    s(2, "qya", Op::Mul, "sz", "e1x"),
+    s(2, "qyb", Op::Mul, "sx", "e1z"),
+    s(2, "qza", Op::Mul, "sx", "e1y"),
+    s(2, "qzb", Op::Mul, "sy", "e1x"),
+    // stage 3: the six cross-product subtracts
+    s(3, "px", Op::Sub, "pxa", "pxb"),
+    s(3, "py", Op::Sub, "pya", "pyb"),
+    s(3, "pz", Op::Sub, "pza", "pzb"),
+    s(3, "qx", Op::Sub, "qxa", "qxb"),
+    s(3, "qy", Op::Sub, "qya", "qyb"),
+    s(3, "qz", Op::Sub, "qza", "qzb"),
+    // stage 4: the twelve dot-product multiplies: det = e1·p, u' = s·p, v' = d·q, t' = e2·q
+    s(4, "detx", Op::Mul, "e1x", "px"),
+    s(4, "dety", Op::Mul, "e1y", "py"),
+    s(4, "detz", Op::Mul, "e1z", "pz"),
+    s(4, "upx", Op::Mul, "sx", "px"),
+    s(4, "upy", Op::Mul, "sy", "py"),
+    s(4, "upz", Op::Mul, "sz", "pz"),
+    s(4, "vpx", Op::Mul, "dx", "qx"),
+    s(4, "vpy", Op::Mul, "dy", "qy"),
+    s(4, "vpz", Op::Mul, "dz", "qz"),
+    s(4, "tpx", Op::Mul, "e2x", "qx"),
+    s(4, "tpy", Op::Mul, "e2y", "qy"),
+    s(4, "tpz", Op::Mul, "e2z", "qz"),
+    // stage 5: first adds (x + y)
+    s(5, "det_xy", Op::Add, "detx", "dety"),
+    s(5, "up_xy", Op::Add, "upx", "upy"),
+    s(5, "vp_xy", Op::Add, "vpx", "vpy"),
+    s(5, "tp_xy", Op::Add, "tpx", "tpy"),
+    // stage 6: second adds (+ z)
+    s(6, "det", Op::Add, "det_xy", "detz"),
+    s(6, "up", Op::Add, "up_xy", "upz"),
+    s(6, "vp", Op::Add, "vp_xy", "vpz"),
+    s(6, "tp", Op::Add, "tp_xy", "tpz"),
+    // stage 7: u' + v' and the division-free validity test; the valid bit may be cleared here
+    s(7, "uv", Op::Add, "up", "vp"),
+    l(7, "det_ok", "two-sided: threshold < |det|; backface culling: threshold < det"),
+    l(7, "u_ok", "det > 0 ? 0 <= u' : u' <= 0"),
+    l(7, "v_ok", "det > 0 ? 0 <= v' : v' <= 0"),
+    l(7, "uv_ok", "det > 0 ? u'+v' <= det : det <= u'+v'"),
+    l(7, "t_ok", "det > 0 ? 0 <= t' : t' <= 0"),
+];
+
+const VALID: SigDef = l(7, "valid", "det_ok & u_ok & v_ok & uv_ok & t_ok");
+
+const RECIP_TAIL: [SigDef; 7] = [
+    s(8, "inv_det", Op::Div, "one", "det"),
+    s(9, "t", Op::Mul, "tp", "inv_det"),
+    s(9, "u", Op::Mul, "up", "inv_det"),
+    s(9, "v", Op::Mul, "vp", "inv_det"),
+    l(10, "tmin_ok", "tmin <= t"),
+    l(10, "tmax_ok", "t <= tmax"),
+    l(10, "hit", "valid & tmin_ok & tmax_ok"),
+];
+
+const DIVIDE_TAIL: [SigDef; 6] = [
+    s(8, "t", Op::Div, "tp", "det"),
+    s(8, "u", Op::Div, "up", "det"),
+    s(8, "v", Op::Div, "vp", "det"),
+    l(9, "tmin_ok", "tmin <= t"),
+    l(9, "tmax_ok", "t <= tmax"),
+    l(9, "hit", "valid & tmin_ok & tmax_ok"),
+];
+
+/// The stage table of the RTI datapath for a division mode, in the order signals are produced.
+pub fn stage_table(div: DivMode) -> Vec<SigDef> {
+    let mut t: Vec<SigDef> = STAGES_1_TO_7.to_vec();
+    t.push(VALID);
+    match div {
+        DivMode::RecipMul => t.extend_from_slice(&RECIP_TAIL),
+        DivMode::Divide => t.extend_from_slice(&DIVIDE_TAIL),
+    }
+    t
+}
+
+/// Number of pipeline stages (latency in cycles at one stage per cycle) for a division mode.
+pub fn stage_count(div: DivMode) -> u8 {
+    match div {
+        DivMode::RecipMul => 10,
+        DivMode::Divide => 9,
+    }
+}
+
+/// The best hit a min-capture unit holds for one ray.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Capture<V> {
+    /// True once any hit was captured.
+    pub hit: bool,
+    /// Nearest t.
+    pub t: V,
+    /// Its u.
+    pub u: V,
+    /// Its v.
+    pub v: V,
+    /// Its triangle id.
+    pub id: u32,
+}
+
+/// An RTI unit in format `F`.
+#[derive(Clone, Debug)]
+pub struct Rti<F: Format> {
+    /// Number format and its options.
+    pub fmt: F,
+    /// Face culling.
+    pub cull: Cull,
+    /// det threshold in the format.
+    pub det_thr: F::V,
+    /// Min-capture tie rule.
+    pub tie: TieRule,
+}
+
+impl<F: Format> Rti<F> {
+    /// An RTI unit with the given options.
+    pub fn new(fmt: F, cfg: RtiConfig) -> Self {
+        let det_thr = fmt.from_f64(cfg.det_threshold.max(0.0));
+        Self { fmt, cull: cfg.cull, det_thr, tie: cfg.tie }
+    }
+
+    /// Converts an f64 ray into the format.
+    pub fn ray(&self, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64) -> Ray<F::V> {
+        let f = &self.fmt;
+        Ray { o: o.map(|x| f.from_f64(x)), d: d.map(|x| f.from_f64(x)), tmin: f.from_f64(tmin), tmax: f.from_f64(tmax) }
+    }
+
+    /// Converts an f64 triangle into the format.
+    pub fn tri(&self, v: [[f64; 3]; 3]) -> Tri<F::V> {
+        Tri { v: v.map(|p| p.map(|x| self.fmt.from_f64(x))) }
+    }
+
+    /// Runs one ray–triangle test through every stage, reporting each signal to the probe.
+    #[inline(always)]
+    pub fn trace<P: Probe<F::V>>(&self, ray: &Ray<F::V>, tri: &Tri<F::V>, p: &mut P) -> RtiOut<F::V> {
+        let f = &self.fmt;
+        let [ox, oy, oz] = ray.o;
+        let [dx, dy, dz] = ray.d;
+        let [[v0x, v0y, v0z], [v1x, v1y, v1z], [v2x, v2y, v2z]] = tri.v;
+        // stage 1
+        let e1x = f.sub(v1x, v0x);
+        let e1y = f.sub(v1y, v0y);
+        let e1z = f.sub(v1z, v0z);
+        let e2x = f.sub(v2x, v0x);
+        let e2y = f.sub(v2y, v0y);
+        let e2z = f.sub(v2z, v0z);
+        let sx = f.sub(ox, v0x);
+        let sy = f.sub(oy, v0y);
+        let sz = f.sub(oz, v0z);
+        record!(p; e1x, e1y, e1z, e2x, e2y, e2z, sx, sy, sz);
+        // stage 2
+        let pxa = f.mul(dy, e2z);
+        let pxb = f.mul(dz, e2y);
+        let pya = f.mul(dz, e2x);
+        let pyb = f.mul(dx, e2z);
+        let pza = f.mul(dx, e2y);
+        let pzb = f.mul(dy, e2x);
+        let qxa = f.mul(sy, e1z);
+        let qxb = f.mul(sz, e1y);
+        let qya = f.mul(sz, e1x);
+        let qyb = f.mul(sx, e1z);
+        let qza = f.mul(sx, e1y);
+        let qzb = f.mul(sy, e1x);
+        record!(p; pxa, pxb, pya, pyb, pza, pzb, qxa, qxb, qya, qyb, qza, qzb);
+        // stage 3
+        let px = f.sub(pxa, pxb);
+        let py = f.sub(pya, pyb);
+        let pz = f.sub(pza, pzb);
+        let qx = f.sub(qxa, qxb);
+        let qy = f.sub(qya, qyb);
+        let qz = f.sub(qza, qzb);
+        record!(p; px, py, pz, qx, qy, qz);
+        // stage 4
+        let detx = f.mul(e1x, px);
+        let dety = f.mul(e1y, py);
+        let detz = f.mul(e1z, pz);
+        let upx = f.mul(sx, px);
+        let upy = f.mul(sy, py);
+        let upz = f.mul(sz, pz);
+        let vpx = f.mul(dx, qx);
+        let vpy = f.mul(dy, qy);
+        let vpz = f.mul(dz, qz);
+        let tpx = f.mul(e2x, qx);
+        let tpy = f.mul(e2y, qy);
+        let tpz = f.mul(e2z, qz);
+        record!(p; detx, dety, detz, upx, upy, upz, vpx, vpy, vpz, tpx, tpy, tpz);
+        // stage 5
+        let det_xy = f.add(detx, dety);
+        let up_xy = f.add(upx, upy);
+        let vp_xy = f.add(vpx, vpy);
+        let tp_xy = f.add(tpx, tpy);
+        record!(p; det_xy, up_xy, vp_xy, tp_xy);
+        // stage 6
+        let det = f.add(det_xy, detz);
+        let up = f.add(up_xy, upz);
+        let vp = f.add(vp_xy, vpz);
+        let tp = f.add(tp_xy, tpz);
+        record!(p; det, up, vp, tp);
+        // stage 7: validity without division
+        let uv = f.add(up, vp);
+        record!(p; uv);
+        let zero = f.zero();
+        let det_ok = match self.cull {
+            Cull::TwoSided => f.lt(self.det_thr, f.abs(det)),
+            Cull::Backface => f.lt(self.det_thr, det),
+        };
+        let pos = f.lt(zero, det);
+        let u_ok = if pos { f.le(zero, up) } else { f.le(up, zero) };
+        let v_ok = if pos { f.le(zero, vp) } else { f.le(vp, zero) };
+        let uv_ok = if pos { f.le(uv, det) } else { f.le(det, uv) };
+        let t_ok = if pos { f.le(zero, tp) } else { f.le(tp, zero) };
+        let valid = det_ok & u_ok & v_ok & uv_ok & t_ok;
+        record_flags!(p; det_ok, u_ok, v_ok, uv_ok, t_ok, valid);
+        // stages 8-9 (8-10): the divide last
+        let (t, u, v) = match f.div_mode() {
+            DivMode::RecipMul => {
+                let inv_det = f.div(f.one(), det);
+                record!(p; inv_det);
+                (f.mul(tp, inv_det), f.mul(up, inv_det), f.mul(vp, inv_det))
+            }
+            DivMode::Divide => (f.div(tp, det), f.div(up, det), f.div(vp, det)),
+        };
+        record!(p; t, u, v);
+        let tmin_ok = f.le(ray.tmin, t);
+        let tmax_ok = f.le(t, ray.tmax);
+        let hit = valid & tmin_ok & tmax_ok;
+        record_flags!(p; tmin_ok, tmax_ok, hit);
+        RtiOut { valid, hit, t, u, v }
+    }
+
+    /// One ray–triangle test without probing.
+    #[inline(always)]
+    pub fn test(&self, ray: &Ray<F::V>, tri: &Tri<F::V>) -> RtiOut<F::V> {
+        self.trace(ray, tri, &mut NoProbe)
+    }
+
+    /// The min-capture unit: takes `out` for triangle `id` if it hits and is nearer than the
+    /// held hit (`t < best` under [`TieRule::First`], `t <= best` under [`TieRule::Last`]).
+    #[inline(always)]
+    pub fn capture(&self, c: &mut Capture<F::V>, out: &RtiOut<F::V>, id: u32) {
+        if !out.hit {
+            return;
+        }
+        let take = !c.hit
+            || match self.tie {
+                TieRule::First => self.fmt.lt(out.t, c.t),
+                TieRule::Last => self.fmt.le(out.t, c.t),
+            };
+        if take {
+            *c = Capture { hit: true, t: out.t, u: out.u, v: out.v, id };
+        }
+    }
+
+    /// One ray against a stream of triangles (a leaf), ids `first_id..`: the nearest hit.
+    pub fn leaf(&self, ray: &Ray<F::V>, tris: &TrisSoa<F::V>, first_id: u32) -> Capture<F::V> {
+        let mut c = Capture::default();
+        for i in 0..tris.len() {
+            let o = self.test(ray, &tris.get(i));
+            self.capture(&mut c, &o, first_id + i as u32);
+        }
+        c
+    }
+
+    /// The broadcast architecture: each triangle of the stream goes to every ray of the packet
+    /// in turn; `out[r]` is ray r's min-capture unit (reset here). Same result as [`Rti::leaf`] per ray.
+    ///
+    /// # Panics
+    /// If `out` is shorter than the packet.
+    pub fn packet(&self, rays: &RaysSoa<F::V>, tris: &TrisSoa<F::V>, first_id: u32, out: &mut [Capture<F::V>]) {
+        let n = rays.len();
+        assert!(out.len() >= n, "min-capture buffer shorter than the ray packet");
+        out[..n].fill(Capture::default());
+        for i in 0..tris.len() {
+            let tri = tris.get(i);
+            for (r, c) in out[..n].iter_mut().enumerate() {
+                let o = self.test(&rays.get(r), &tri);
+                self.capture(c, &o, first_id + i as u32);
+            }
+        }
+    }
+
+    /// Pairwise batch over structure-of-arrays: ray i against triangle i into `out` slot i.
+    /// Bit-identical to [`Rti::test`]; allocation-free.
+    ///
+    /// # Panics
+    /// If the three batches differ in length.
+    pub fn batch(&self, rays: &RaysSoa<F::V>, tris: &TrisSoa<F::V>, out: &mut HitsSoa<F::V>) {
+        let n = rays.len();
+        assert!(tris.len() == n && out.len() == n, "batch lengths differ");
+        for i in 0..n {
+            let o = self.test(&rays.get(i), &tris.get(i));
+            out.hit[i] = o.hit;
+            out.valid[i] = o.valid;
+            out.t[i] = o.t;
+            out.u[i] = o.u;
+            out.v[i] = o.v;
+        }
+    }
+}
+
+/// Rays as structure-of-arrays columns.
+#[derive(Clone, Debug, Default)]
+pub struct RaysSoa<V> {
+    /// Origin columns.
+    pub o: [Vec<V>; 3],
+    /// Direction columns.
+    pub d: [Vec<V>; 3],
+    /// tmin column.
+    pub tmin: Vec<V>,
+    /// tmax column.
+    pub tmax: Vec<V>,
+}
+
+impl<V: Copy> RaysSoa<V> {
+    /// Number of rays.
+    pub fn len(&self) -> usize {
+        self.tmin.len()
+    }
+    /// True when empty.
+    pub fn is_empty(&self) -> bool {
+        self.tmin.is_empty()
+    }
+    /// Appends a ray.
+    pub fn push(&mut self, r: &Ray<V>) {
+        for k in 0..3 {
+            self.o[k].push(r.o[k]);
+            self.d[k].push(r.d[k]);
+        }
+        self.tmin.push(r.tmin);
+        self.tmax.push(r.tmax);
+    }
+    /// Ray i.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Ray<V> {
+        Ray {
+            o: [self.o[0][i], self.o[1][i], self.o[2][i]],
+            d: [self.d[0][i], self.d[1][i], self.d[2][i]],
+            tmin: self.tmin[i],
+            tmax: self.tmax[i],
+        }
+    }
+}
+
+/// Triangles as structure-of-arrays columns: `v[vertex][axis]`.
+#[derive(Clone, Debug, Default)]
+pub struct TrisSoa<V> {
+    /// Vertex coordinate columns.
+    pub v: [[Vec<V>; 3]; 3],
+}
+
+impl<V: Copy> TrisSoa<V> {
+    /// Number of triangles.
+    pub fn len(&self) -> usize {
+        self.v[0][0].len()
+    }
+    /// True when empty.
+    pub fn is_empty(&self) -> bool {
+        self.v[0][0].is_empty()
+    }
+    /// Appends a triangle.
+    pub fn push(&mut self, t: &Tri<V>) {
+        for j in 0..3 {
+            for k in 0..3 {
+                self.v[j][k].push(t.v[j][k]);
+            }
+        }
+    }
+    /// Triangle i.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Tri<V> {
+        Tri { v: [0, 1, 2].map(|j| [self.v[j][0][i], self.v[j][1][i], self.v[j][2][i]]) }
+    }
+}
+
+/// Batch outputs as structure-of-arrays columns.
+#[derive(Clone, Debug, Default)]
+pub struct HitsSoa<V> {
+    /// Hit bits.
+    pub hit: Vec<bool>,
+    /// Valid bits.
+    pub valid: Vec<bool>,
+    /// t column.
+    pub t: Vec<V>,
+    /// u column.
+    pub u: Vec<V>,
+    /// v column.
+    pub v: Vec<V>,
+}
+
+impl<V: Copy + Default> HitsSoa<V> {
+    /// Output columns for `n` results.
+    pub fn with_len(n: usize) -> Self {
+        Self { hit: vec![false; n], valid: vec![false; n], t: vec![V::default(); n], u: vec![V::default(); n], v: vec![V::default(); n] }
+    }
+    /// Number of results.
+    pub fn len(&self) -> usize {
+        self.hit.len()
+    }
+    /// True when empty.
+    pub fn is_empty(&self) -> bool {
+        self.hit.is_empty()
+    }
+}

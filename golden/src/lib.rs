@@ -1,0 +1,7 @@
+//! Golden reference: plain f64 intersection code, written independently of the `datapath`
+//! models it judges (it shares no code with them).
+#![warn(missing_docs)]
+
+pub mod mt;
+
+pub use mt::{closest_hit, intersect, MtResult, Ray64, Tri64};

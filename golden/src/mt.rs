@@ -1,0 +1,139 @@
+//! Classic Möller–Trumbore in f64, in the textbook operation order (divide first, then the
+//! barycentric tests), with the hit point's barycentric margin and the determinant's size.
+
+/// A ray in f64.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray64 {
+    /// Origin.
+    pub o: [f64; 3],
+    /// Direction.
+    pub d: [f64; 3],
+    /// Smallest accepted t (inclusive).
+    pub tmin: f64,
+    /// Largest accepted t (inclusive).
+    pub tmax: f64,
+}
+
+/// A triangle in f64.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tri64 {
+    /// Vertices.
+    pub v: [[f64; 3]; 3],
+}
+
+/// Result of the reference test.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MtResult {
+    /// The ray meets the triangle within [tmin, tmax].
+    pub hit: bool,
+    /// Distance along the ray to the triangle's plane (NaN if det is 0).
+    pub t: f64,
+    /// Barycentric weight of v1.
+    pub u: f64,
+    /// Barycentric weight of v2.
+    pub v: f64,
+    /// The determinant e1·(d × e2).
+    pub det: f64,
+    /// |det| / (|d|·|e1|·|e2|): the sine-like conditioning of the test (0 = ray in the plane).
+    pub det_rel: f64,
+    /// min(u, v, 1 − u − v): positive inside, negative outside; the distance to the nearest
+    /// edge in barycentric units.
+    pub bary_margin: f64,
+    /// Distance in scene units from the plane point to the nearest edge line (signed like the margin).
+    pub edge_dist: f64,
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Intersects `ray` with `tri`; `cull` rejects back faces (det <= 0).
+pub fn intersect(ray: &Ray64, tri: &Tri64, cull: bool) -> MtResult {
+    let [v0, v1, v2] = tri.v;
+    let e1 = sub(v1, v0);
+    let e2 = sub(v2, v0);
+    let p = cross(ray.d, e2);
+    let det = dot(e1, p);
+    let inv = 1.0 / det;
+    let s = sub(ray.o, v0);
+    let u = dot(s, p) * inv;
+    let q = cross(s, e1);
+    let v = dot(ray.d, q) * inv;
+    let t = dot(e2, q) * inv;
+    let w = 1.0 - u - v;
+    let face_ok = if cull { det > 0.0 } else { det != 0.0 };
+    let hit = face_ok && det.is_finite() && u >= 0.0 && v >= 0.0 && w >= 0.0 && t >= ray.tmin && t <= ray.tmax;
+    let bary_margin = u.min(v).min(w);
+    // heights of the triangle over each edge: 2·area / |edge|
+    let area2 = norm(cross(e1, e2));
+    let e3 = sub(v2, v1);
+    let edge_dist = [(u, norm(e2)), (v, norm(e1)), (w, norm(e3))]
+        .iter()
+        .map(|&(b, len)| if len > 0.0 { b * area2 / len } else { 0.0 })
+        .fold(f64::INFINITY, f64::min);
+    let scale = norm(ray.d) * norm(e1) * norm(e2);
+    let det_rel = if scale > 0.0 { det.abs() / scale } else { 0.0 };
+    MtResult { hit, t, u, v, det, det_rel, bary_margin, edge_dist }
+}
+
+/// Nearest hit of `ray` over `tris`: (index, t); on equal t the lower index wins.
+pub fn closest_hit(ray: &Ray64, tris: &[Tri64], cull: bool) -> Option<(usize, f64)> {
+    let mut best: Option<(usize, f64)> = None;
+    for (i, t) in tris.iter().enumerate() {
+        let r = intersect(ray, t, cull);
+        if r.hit && best.is_none_or(|(_, bt)| r.t < bt) {
+            best = Some((i, r.t));
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_tri() -> Tri64 {
+        Tri64 { v: [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] }
+    }
+
+    #[test]
+    fn hits_the_plane_at_the_expected_point() {
+        let ray = Ray64 { o: [0.25, 0.25, 2.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY };
+        let r = intersect(&ray, &unit_tri(), false);
+        assert!(r.hit);
+        assert_eq!((r.t, r.u, r.v), (2.0, 0.25, 0.25));
+        assert_eq!(r.bary_margin, 0.25);
+        assert_eq!(r.edge_dist, 0.25);
+        assert_eq!(r.det_rel, 1.0);
+    }
+
+    #[test]
+    fn misses_outside_and_behind_and_culls_back_faces() {
+        let t = unit_tri();
+        let outside = Ray64 { o: [0.75, 0.75, 2.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY };
+        let r = intersect(&outside, &t, false);
+        assert!(!r.hit && r.bary_margin < 0.0);
+        let behind = Ray64 { o: [0.25, 0.25, 2.0], d: [0.0, 0.0, 1.0], tmin: 0.0, tmax: f64::INFINITY };
+        assert!(!intersect(&behind, &t, false).hit);
+        // from below the ray sees the back face (normal +z)
+        let below = Ray64 { o: [0.25, 0.25, -2.0], d: [0.0, 0.0, 1.0], tmin: 0.0, tmax: f64::INFINITY };
+        assert!(intersect(&below, &t, false).hit);
+        assert!(!intersect(&below, &t, true).hit);
+    }
+
+    #[test]
+    fn closest_hit_takes_the_nearest_and_the_first_on_ties() {
+        let near = Tri64 { v: [[-1.0, -1.0, 1.0], [3.0, -1.0, 1.0], [-1.0, 3.0, 1.0]] };
+        let ray = Ray64 { o: [0.25, 0.25, 2.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY };
+        assert_eq!(closest_hit(&ray, &[unit_tri(), near, near], false), Some((1, 1.0)));
+    }
+}
