@@ -6,6 +6,7 @@
 pub mod bound;
 pub mod format;
 pub mod probe;
+pub mod rng;
 pub mod rti;
 
 pub use format::{AnyFormat, Format};
