@@ -1,1 +1,266 @@
-fn main() {}
+//! The `raypipe` command line.
+
+use clap::{Parser, Subcommand, ValueEnum};
+use datapath::format::DivMode;
+use datapath::rti::{stage_table, Cull, Op, Rti, RtiConfig, TieRule};
+use datapath::{with_format, AnyFormat};
+use golden::{Ray64, Tri64};
+use raypipe::scene::Scene;
+use raypipe::verify::{render, verify, VerifyConfig};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Default formats of `raypipe verify`.
+const DEFAULT_FORMATS: [&str; 5] = ["f32", "fp16", "bf16", "e8m16", "q8.24:divide"];
+
+#[derive(Parser)]
+#[command(
+    name = "raypipe",
+    version,
+    about = "Bit-accurate ray-tracing datapath models judged against a golden f64 reference"
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Option<Cmd>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Tie {
+    First,
+    Last,
+}
+
+#[derive(clap::Args, Clone)]
+struct RtiArgs {
+    /// Cull back faces (hit needs det > threshold) instead of two-sided (|det| > threshold).
+    #[arg(long)]
+    cull: bool,
+    /// det threshold (>= 0).
+    #[arg(long, default_value_t = 0.0)]
+    det_threshold: f64,
+    /// Min-capture tie rule on equal t.
+    #[arg(long, value_enum, default_value_t = Tie::First)]
+    tie: Tie,
+}
+
+impl RtiArgs {
+    fn config(&self) -> Result<RtiConfig, String> {
+        if !(self.det_threshold >= 0.0 && self.det_threshold.is_finite()) {
+            return Err(format!(
+                "--det-threshold must be a finite number >= 0, got {}",
+                self.det_threshold
+            ));
+        }
+        Ok(RtiConfig {
+            cull: if self.cull {
+                Cull::Backface
+            } else {
+                Cull::TwoSided
+            },
+            det_threshold: self.det_threshold,
+            tie: match self.tie {
+                Tie::First => TieRule::First,
+                Tie::Last => TieRule::Last,
+            },
+        })
+    }
+}
+
+#[derive(clap::Args, Clone)]
+struct VerifyArgs {
+    /// OBJ scene (default: the built-in Cornell box + icosphere + needles).
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Format(s) to verify, comma-separated or repeated (default: f32,fp16,bf16,e8m16,q8.24:divide).
+    #[arg(long, value_delimiter = ',', value_parser = parse_format)]
+    format: Vec<AnyFormat>,
+    /// Number of rays.
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u64).range(1..))]
+    rays: u64,
+    /// Ray generator seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Scenes up to this many triangles are tested exhaustively per ray; larger ones per ray
+    /// against its target triangle and this many minus one random others.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u64).range(1..))]
+    sample: u64,
+    /// Print the results as JSON.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    rti: RtiArgs,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Run every format's RTI model against the golden reference (the default command).
+    Verify(VerifyArgs),
+    /// Print every stage signal of one ray–triangle test beside the binary64 twin and the golden.
+    Explain {
+        /// Format name.
+        #[arg(long, value_parser = parse_format)]
+        format: AnyFormat,
+        /// Ray: ox,oy,oz,dx,dy,dz.
+        #[arg(long, allow_hyphen_values = true)]
+        ray: String,
+        /// Triangle: x0,y0,z0,x1,y1,z1,x2,y2,z2.
+        #[arg(long, allow_hyphen_values = true)]
+        tri: String,
+        /// Smallest accepted t.
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+        tmin: f64,
+        /// Largest accepted t.
+        #[arg(long, default_value_t = f64::INFINITY)]
+        tmax: f64,
+        #[command(flatten)]
+        rti: RtiArgs,
+    },
+    /// Print the RTI stage table (markdown).
+    Stages {
+        /// Division mode: recip (1/det then multiplies) or divide.
+        #[arg(long, default_value = "recip")]
+        div: String,
+    },
+}
+
+fn parse_format(s: &str) -> Result<AnyFormat, String> {
+    s.parse()
+}
+
+fn parse_list(what: &str, s: &str, n: usize) -> Result<Vec<f64>, String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|t| {
+            t.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("{what}: '{t}' is not a number"))
+        })
+        .collect::<Result<_, _>>()?;
+    if v.len() != n {
+        return Err(format!(
+            "{what}: expected {n} comma-separated numbers, got {}",
+            v.len()
+        ));
+    }
+    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+        return Err(format!("{what}: coordinates must be finite, got {x}"));
+    }
+    Ok(v)
+}
+
+fn run_verify(a: VerifyArgs) -> Result<bool, String> {
+    let rti = a.rti.config()?;
+    let scene = match &a.scene {
+        Some(p) => Scene::load_obj(p).map_err(|e| e.to_string())?,
+        None => Scene::builtin(),
+    };
+    let formats = if a.format.is_empty() {
+        DEFAULT_FORMATS
+            .iter()
+            .map(|f| f.parse().expect("built-in format name"))
+            .collect()
+    } else {
+        a.format
+    };
+    let cfg = VerifyConfig {
+        formats,
+        rays: a.rays as usize,
+        seed: a.seed,
+        rti,
+        sample: a.sample as usize,
+    };
+    let rep = verify(&cfg, &scene);
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&rep).map_err(|e| e.to_string())?
+        );
+    } else {
+        print!("{}", render(&rep));
+    }
+    Ok(rep.passed)
+}
+
+fn stages_markdown(div: DivMode) -> String {
+    let mut s = String::from("| stage | signal | op | operands |\n|---|---|---|---|\n");
+    for d in stage_table(div) {
+        let (op, operands) = match d.op {
+            Op::Sub => ("sub", format!("{} − {}", d.a, d.b)),
+            Op::Add => ("add", format!("{} + {}", d.a, d.b)),
+            Op::Mul => ("mul", format!("{} × {}", d.a, d.b)),
+            Op::Div => ("div", format!("{} ÷ {}", d.a, d.b)),
+            Op::Logic => ("cmp/logic", d.note.to_string()),
+        };
+        s += &format!("| {} | `{}` | {} | {} |\n", d.stage, d.name, op, operands);
+    }
+    s
+}
+
+fn run() -> Result<bool, String> {
+    let cli = Cli::parse();
+    match cli.cmd {
+        None => run_verify(VerifyArgs {
+            scene: None,
+            format: Vec::new(),
+            rays: 1024,
+            seed: 1,
+            sample: 512,
+            json: false,
+            rti: RtiArgs {
+                cull: false,
+                det_threshold: 0.0,
+                tie: Tie::First,
+            },
+        }),
+        Some(Cmd::Verify(a)) => run_verify(a),
+        Some(Cmd::Explain {
+            format,
+            ray,
+            tri,
+            tmin,
+            tmax,
+            rti,
+        }) => {
+            let cfg = rti.config()?;
+            let r = parse_list("--ray", &ray, 6)?;
+            let t = parse_list("--tri", &tri, 9)?;
+            if tmin.is_nan() || tmax.is_nan() {
+                return Err("--tmin/--tmax must not be NaN".into());
+            }
+            let ray = Ray64 {
+                o: [r[0], r[1], r[2]],
+                d: [r[3], r[4], r[5]],
+                tmin,
+                tmax,
+            };
+            let tri = Tri64 {
+                v: [[t[0], t[1], t[2]], [t[3], t[4], t[5]], [t[6], t[7], t[8]]],
+            };
+            with_format!(format, |f| print!(
+                "{}",
+                raypipe::explain::explain(&Rti::new(f, cfg), &ray, &tri)
+            ));
+            Ok(true)
+        }
+        Some(Cmd::Stages { div }) => {
+            let d = match div.as_str() {
+                "recip" => DivMode::RecipMul,
+                "divide" => DivMode::Divide,
+                other => return Err(format!("--div must be recip or divide, got '{other}'")),
+            };
+            print!("{}", stages_markdown(d));
+            Ok(true)
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(1),
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

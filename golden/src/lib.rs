@@ -4,4 +4,4 @@
 
 pub mod mt;
 
-pub use mt::{closest_hit, intersect, MtResult, Ray64, Tri64};
+pub use mt::{closest_hit, intersect, Faces, MtResult, Ray64, Tri64};

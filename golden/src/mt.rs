@@ -47,7 +47,11 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -56,8 +60,17 @@ fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// Intersects `ray` with `tri`; `cull` rejects back faces (det <= 0).
-pub fn intersect(ray: &Ray64, tri: &Tri64, cull: bool) -> MtResult {
+/// Face test options of the reference.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Faces {
+    /// Reject back faces: a hit needs det > threshold (otherwise |det| > threshold).
+    pub cull: bool,
+    /// det threshold (>= 0).
+    pub det_threshold: f64,
+}
+
+/// Intersects `ray` with `tri` under the face options.
+pub fn intersect(ray: &Ray64, tri: &Tri64, faces: Faces) -> MtResult {
     let [v0, v1, v2] = tri.v;
     let e1 = sub(v1, v0);
     let e2 = sub(v2, v0);
@@ -70,8 +83,18 @@ pub fn intersect(ray: &Ray64, tri: &Tri64, cull: bool) -> MtResult {
     let v = dot(ray.d, q) * inv;
     let t = dot(e2, q) * inv;
     let w = 1.0 - u - v;
-    let face_ok = if cull { det > 0.0 } else { det != 0.0 };
-    let hit = face_ok && det.is_finite() && u >= 0.0 && v >= 0.0 && w >= 0.0 && t >= ray.tmin && t <= ray.tmax;
+    let face_ok = if faces.cull {
+        det > faces.det_threshold
+    } else {
+        det.abs() > faces.det_threshold
+    };
+    let hit = face_ok
+        && det.is_finite()
+        && u >= 0.0
+        && v >= 0.0
+        && w >= 0.0
+        && t >= ray.tmin
+        && t <= ray.tmax;
     let bary_margin = u.min(v).min(w);
     // heights of the triangle over each edge: 2·area / |edge|
     let area2 = norm(cross(e1, e2));
@@ -82,14 +105,23 @@ pub fn intersect(ray: &Ray64, tri: &Tri64, cull: bool) -> MtResult {
         .fold(f64::INFINITY, f64::min);
     let scale = norm(ray.d) * norm(e1) * norm(e2);
     let det_rel = if scale > 0.0 { det.abs() / scale } else { 0.0 };
-    MtResult { hit, t, u, v, det, det_rel, bary_margin, edge_dist }
+    MtResult {
+        hit,
+        t,
+        u,
+        v,
+        det,
+        det_rel,
+        bary_margin,
+        edge_dist,
+    }
 }
 
 /// Nearest hit of `ray` over `tris`: (index, t); on equal t the lower index wins.
-pub fn closest_hit(ray: &Ray64, tris: &[Tri64], cull: bool) -> Option<(usize, f64)> {
+pub fn closest_hit(ray: &Ray64, tris: &[Tri64], faces: Faces) -> Option<(usize, f64)> {
     let mut best: Option<(usize, f64)> = None;
     for (i, t) in tris.iter().enumerate() {
-        let r = intersect(ray, t, cull);
+        let r = intersect(ray, t, faces);
         if r.hit && best.is_none_or(|(_, bt)| r.t < bt) {
             best = Some((i, r.t));
         }
@@ -102,13 +134,20 @@ mod tests {
     use super::*;
 
     fn unit_tri() -> Tri64 {
-        Tri64 { v: [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] }
+        Tri64 {
+            v: [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        }
     }
 
     #[test]
     fn hits_the_plane_at_the_expected_point() {
-        let ray = Ray64 { o: [0.25, 0.25, 2.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY };
-        let r = intersect(&ray, &unit_tri(), false);
+        let ray = Ray64 {
+            o: [0.25, 0.25, 2.0],
+            d: [0.0, 0.0, -1.0],
+            tmin: 0.0,
+            tmax: f64::INFINITY,
+        };
+        let r = intersect(&ray, &unit_tri(), Faces::default());
         assert!(r.hit);
         assert_eq!((r.t, r.u, r.v), (2.0, 0.25, 0.25));
         assert_eq!(r.bary_margin, 0.25);
@@ -119,21 +158,56 @@ mod tests {
     #[test]
     fn misses_outside_and_behind_and_culls_back_faces() {
         let t = unit_tri();
-        let outside = Ray64 { o: [0.75, 0.75, 2.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY };
-        let r = intersect(&outside, &t, false);
+        let outside = Ray64 {
+            o: [0.75, 0.75, 2.0],
+            d: [0.0, 0.0, -1.0],
+            tmin: 0.0,
+            tmax: f64::INFINITY,
+        };
+        let r = intersect(&outside, &t, Faces::default());
         assert!(!r.hit && r.bary_margin < 0.0);
-        let behind = Ray64 { o: [0.25, 0.25, 2.0], d: [0.0, 0.0, 1.0], tmin: 0.0, tmax: f64::INFINITY };
-        assert!(!intersect(&behind, &t, false).hit);
+        let behind = Ray64 {
+            o: [0.25, 0.25, 2.0],
+            d: [0.0, 0.0, 1.0],
+            tmin: 0.0,
+            tmax: f64::INFINITY,
+        };
+        assert!(!intersect(&behind, &t, Faces::default()).hit);
         // from below the ray sees the back face (normal +z)
-        let below = Ray64 { o: [0.25, 0.25, -2.0], d: [0.0, 0.0, 1.0], tmin: 0.0, tmax: f64::INFINITY };
-        assert!(intersect(&below, &t, false).hit);
-        assert!(!intersect(&below, &t, true).hit);
+        let below = Ray64 {
+            o: [0.25, 0.25, -2.0],
+            d: [0.0, 0.0, 1.0],
+            tmin: 0.0,
+            tmax: f64::INFINITY,
+        };
+        assert!(intersect(&below, &t, Faces::default()).hit);
+        assert!(
+            !intersect(
+                &below,
+                &t,
+                Faces {
+                    cull: true,
+                    det_threshold: 0.0
+                }
+            )
+            .hit
+        );
     }
 
     #[test]
     fn closest_hit_takes_the_nearest_and_the_first_on_ties() {
-        let near = Tri64 { v: [[-1.0, -1.0, 1.0], [3.0, -1.0, 1.0], [-1.0, 3.0, 1.0]] };
-        let ray = Ray64 { o: [0.25, 0.25, 2.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY };
-        assert_eq!(closest_hit(&ray, &[unit_tri(), near, near], false), Some((1, 1.0)));
+        let near = Tri64 {
+            v: [[-1.0, -1.0, 1.0], [3.0, -1.0, 1.0], [-1.0, 3.0, 1.0]],
+        };
+        let ray = Ray64 {
+            o: [0.25, 0.25, 2.0],
+            d: [0.0, 0.0, -1.0],
+            tmin: 0.0,
+            tmax: f64::INFINITY,
+        };
+        assert_eq!(
+            closest_hit(&ray, &[unit_tri(), near, near], Faces::default()),
+            Some((1, 1.0))
+        );
     }
 }

@@ -2,8 +2,8 @@
 //! bits, total width 2..=64. Values are raw integers scaled by 2^-F; products and quotients are
 //! formed exactly in i128 and then rounded and overflowed per the datapath's stated modes.
 
-use super::{Contract, DivMode, ErrorModel, Format, FormatKind};
 use super::layout::pow2;
+use super::{Contract, DivMode, ErrorModel, Format, FormatKind};
 
 /// Rounding of products, quotients and input conversion.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -44,12 +44,24 @@ pub struct Fixed {
 
 impl Fixed {
     /// A `qI.F` format; checks 1 <= I and 2 <= I + F <= 64.
-    pub fn new(int_bits: u32, frac_bits: u32, round: FxRound, overflow: FxOverflow, div: DivMode) -> Result<Self, String> {
+    pub fn new(
+        int_bits: u32,
+        frac_bits: u32,
+        round: FxRound,
+        overflow: FxOverflow,
+        div: DivMode,
+    ) -> Result<Self, String> {
         let w = int_bits + frac_bits;
         if int_bits == 0 || !(2..=64).contains(&w) {
             return Err(format!("q{int_bits}.{frac_bits}: need at least 1 integer (sign) bit and a total width of 2..=64"));
         }
-        Ok(Self { int_bits, frac_bits, round, overflow, div })
+        Ok(Self {
+            int_bits,
+            frac_bits,
+            round,
+            overflow,
+            div,
+        })
     }
     fn w(&self) -> u32 {
         self.int_bits + self.frac_bits
@@ -120,22 +132,27 @@ impl Format for Fixed {
     type V = i64;
 
     fn name(&self) -> String {
-        let mut opts = vec![self.round_name()];
+        let mut opts = Vec::new();
+        if self.round != FxRound::Floor {
+            opts.push(self.round_name());
+        }
         if self.overflow == FxOverflow::Wrap {
             opts.push("wrap");
         }
         if self.div == DivMode::Divide {
             opts.push("divide");
         }
-        let default = self.round == FxRound::Floor && self.overflow == FxOverflow::Saturate && self.div == DivMode::RecipMul;
-        if default {
+        if opts.is_empty() {
             format!("q{}.{}", self.int_bits, self.frac_bits)
         } else {
-            format!("q{}.{}:{}", self.int_bits, self.frac_bits, opts.join(","))
+            format!("q{}.{}:{}", self.int_bits, self.frac_bits, opts.join("+"))
         }
     }
     fn kind(&self) -> FormatKind {
-        FormatKind::Fixed { int_bits: self.int_bits, frac_bits: self.frac_bits }
+        FormatKind::Fixed {
+            int_bits: self.int_bits,
+            frac_bits: self.frac_bits,
+        }
     }
     fn width(&self) -> u32 {
         self.w()
@@ -176,8 +193,17 @@ impl Format for Fixed {
     }
     fn error_model(&self) -> ErrorModel {
         let step = pow2(-(self.frac_bits as i32));
-        let eta = if self.round == FxRound::NearestEven { step / 2.0 } else { step };
-        ErrorModel { u: 0.0, eta, add_eta: 0.0, max: self.max_raw() as f64 * step }
+        let eta = if self.round == FxRound::NearestEven {
+            step / 2.0
+        } else {
+            step
+        };
+        ErrorModel {
+            u: 0.0,
+            eta,
+            add_eta: 0.0,
+            max: self.max_raw() as f64 * step,
+        }
     }
     fn div_mode(&self) -> DivMode {
         self.div
@@ -188,7 +214,11 @@ impl Format for Fixed {
             return 0;
         }
         if x.is_infinite() {
-            return if x > 0.0 { self.max_raw() } else { self.min_raw() };
+            return if x > 0.0 {
+                self.max_raw()
+            } else {
+                self.min_raw()
+            };
         }
         // scaling by 2^F is exact in f64 for every finite x of interest (no overflow below 2^960)
         let y = x * pow2(self.frac_bits as i32);

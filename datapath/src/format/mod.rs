@@ -57,7 +57,11 @@ pub struct FpOpts {
 
 impl Default for FpOpts {
     fn default() -> Self {
-        Self { subnormals: Subnormals::Ieee, nan: NanMode::Canonical, div: DivMode::RecipMul }
+        Self {
+            subnormals: Subnormals::Ieee,
+            nan: NanMode::Canonical,
+            div: DivMode::RecipMul,
+        }
     }
 }
 
@@ -161,7 +165,11 @@ pub trait Format: Clone + Debug + Send + Sync + 'static {
     fn ulp(&self, x: f64) -> f64;
     /// Hex digits of one encoding: `ceil(width / 4)`.
     fn hex(&self, v: Self::V) -> String {
-        format!("{:0w$x}", self.to_bits(v), w = self.width().div_ceil(4) as usize)
+        format!(
+            "{:0w$x}",
+            self.to_bits(v),
+            w = self.width().div_ceil(4) as usize
+        )
     }
 }
 
@@ -238,7 +246,7 @@ impl<B: IeeeBackend> Format for Ieee<B> {
         if opts.is_empty() {
             base
         } else {
-            format!("{base}:{}", opts.join(","))
+            format!("{base}:{}", opts.join("+"))
         }
     }
     fn kind(&self) -> FormatKind {
@@ -284,7 +292,12 @@ impl<B: IeeeBackend> Format for Ieee<B> {
             Subnormals::Ieee => 0.0, // a sum on the subnormal grid is exact
             Subnormals::Ftz => l.min_normal(),
         };
-        ErrorModel { u: l.unit_roundoff(), eta, add_eta, max: l.max_finite() }
+        ErrorModel {
+            u: l.unit_roundoff(),
+            eta,
+            add_eta,
+            max: l.max_finite(),
+        }
     }
     fn div_mode(&self) -> DivMode {
         self.opts.div

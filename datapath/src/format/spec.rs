@@ -1,12 +1,15 @@
-//! Format names: parsing `f32`, `fp16`, `bf16`, `eEmM`, `qI.F` with `:option,...` suffixes into
+//! Format names: parsing `f32`, `fp16`, `bf16`, `eEmM`, `qI.F` with `:option+...` suffixes into
 //! [`AnyFormat`], the run-time choice that dispatches to the generic models.
 
-use super::{Bf16, DivMode, F16Half, F32Native, Fixed, FloatLayout, FpOpts, FxOverflow, FxRound, Ieee, NanMode, Soft, Subnormals};
+use super::{
+    Bf16, DivMode, F16Half, F32Native, Fixed, FloatLayout, FpOpts, FxOverflow, FxRound, Ieee,
+    NanMode, Soft, Subnormals,
+};
 use std::fmt;
 use std::str::FromStr;
 
 /// The grammar of format names, for error messages and `--help`.
-pub const FORMAT_HELP: &str = "format names: f32 | fp16 | bf16 | eEmM (custom IEEE-like, E=2..11 exponent, M=1..52 fraction bits, e.g. e8m16) | qI.F (signed fixed point, I integer bits incl. sign, F fraction bits, I+F <= 64, e.g. q8.24); options after ':' comma-separated: floats ftz|ieee, canonical|propagate, recip|divide; fixed floor|ceil|trunc|nearest, saturate|wrap, recip|divide (e.g. fp16:ftz,divide or q8.24:nearest,wrap)";
+pub const FORMAT_HELP: &str = "format names: f32 | fp16 | bf16 | eEmM (custom IEEE-like, E=2..11 exponent, M=1..52 fraction bits, e.g. e8m16) | qI.F (signed fixed point, I integer bits incl. sign, F fraction bits, I+F <= 64, e.g. q8.24); options after ':' joined by '+': floats ftz|ieee, canonical|propagate, recip|divide; fixed floor|ceil|trunc|nearest, saturate|wrap, recip|divide (e.g. fp16:ftz+divide or q8.24:nearest+wrap)";
 
 /// A format chosen at run time.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -69,10 +72,14 @@ impl FromStr for AnyFormat {
     fn from_str(s: &str) -> Result<Self, String> {
         let lower = s.trim().to_ascii_lowercase();
         let (base, opts) = match lower.split_once(':') {
-            Some((b, o)) => (b, o.split(',').filter(|t| !t.is_empty()).collect::<Vec<_>>()),
+            Some((b, o)) => (
+                b,
+                o.split('+').filter(|t| !t.is_empty()).collect::<Vec<_>>(),
+            ),
             None => (lower.as_str(), Vec::new()),
         };
-        let unknown = |what: &str| format!("unknown format option '{what}' in '{s}'; {FORMAT_HELP}");
+        let unknown =
+            |what: &str| format!("unknown format option '{what}' in '{s}'; {FORMAT_HELP}");
         if let Some((i, f)) = parse_q(base) {
             let mut round = FxRound::Floor;
             let mut overflow = FxOverflow::Saturate;
@@ -90,7 +97,9 @@ impl FromStr for AnyFormat {
                     other => return Err(unknown(other)),
                 }
             }
-            return Fixed::new(i, f, round, overflow, div).map(AnyFormat::Fixed).map_err(|e| format!("{e}; {FORMAT_HELP}"));
+            return Fixed::new(i, f, round, overflow, div)
+                .map(AnyFormat::Fixed)
+                .map_err(|e| format!("{e}; {FORMAT_HELP}"));
         }
         let mut o = FpOpts::default();
         for t in opts {
@@ -124,7 +133,17 @@ mod tests {
 
     #[test]
     fn names_round_trip() {
-        for n in ["f32", "fp16", "bf16", "e8m16", "e5m2", "q8.24", "fp16:ftz", "f32:ftz,propagate,divide", "q16.16:nearest,wrap"] {
+        for n in [
+            "f32",
+            "fp16",
+            "bf16",
+            "e8m16",
+            "e5m2",
+            "q8.24",
+            "fp16:ftz",
+            "f32:ftz+propagate+divide",
+            "q16.16:nearest+wrap",
+        ] {
             let f: AnyFormat = n.parse().unwrap();
             assert_eq!(f.name(), n);
             assert_eq!(f.name().parse::<AnyFormat>().unwrap(), f);
@@ -133,7 +152,18 @@ mod tests {
 
     #[test]
     fn bad_names_are_clear_errors() {
-        for n in ["f31", "e12m3", "e8m0", "q0.8", "q40.40", "fp16:fast", "q8.8:ftz", "", "e8", "q8"] {
+        for n in [
+            "f31",
+            "e12m3",
+            "e8m0",
+            "q0.8",
+            "q40.40",
+            "fp16:fast",
+            "q8.8:ftz",
+            "",
+            "e8",
+            "q8",
+        ] {
             let e = n.parse::<AnyFormat>().unwrap_err();
             assert!(e.contains("format"), "{n}: {e}");
         }

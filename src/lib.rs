@@ -1,0 +1,10 @@
+//! raypipe: bit-accurate ray-tracing datapath models judged against a golden reference.
+//!
+//! Data flow: scene ([`scene`]) → rays → model stages (`datapath`) → compare with the golden
+//! (`golden`) and the error bounds ([`judge`]) → report ([`verify`], [`explain`]).
+#![warn(missing_docs)]
+
+pub mod explain;
+pub mod judge;
+pub mod scene;
+pub mod verify;

@@ -1,0 +1,333 @@
+//! `raypipe verify`: every chosen format's RTI model against the golden reference on a scene's
+//! rays, with the property check (decisive cases must agree; t within its bound), error
+//! statistics and model throughput.
+
+use crate::judge::{judge, Judged};
+use crate::scene::Scene;
+use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiConfig, TrisSoa};
+use datapath::{with_format, AnyFormat, Format};
+use golden::{Ray64, Tri64};
+use serde::Serialize;
+use std::time::Instant;
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct VerifyConfig {
+    /// Formats to verify.
+    pub formats: Vec<AnyFormat>,
+    /// Number of rays.
+    pub rays: usize,
+    /// Seed of the ray generator.
+    pub seed: u64,
+    /// RTI options.
+    pub rti: RtiConfig,
+    /// Scenes with at most this many triangles are tested exhaustively per ray; larger ones
+    /// test each ray against its target triangle and `sample - 1` seeded random others.
+    pub sample: usize,
+}
+
+/// Results for one format.
+#[derive(Clone, Debug, Serialize)]
+pub struct FormatReport {
+    /// Format name.
+    pub format: String,
+    /// Bits per value.
+    pub width: u32,
+    /// Ray–triangle tests run.
+    pub tests: u64,
+    /// Tests whose error bound makes the decision certain.
+    pub decisive: u64,
+    /// Golden hits.
+    pub golden_hits: u64,
+    /// Model hits.
+    pub model_hits: u64,
+    /// Model miss where the golden hits.
+    pub false_misses: u64,
+    /// Model hit where the golden misses.
+    pub false_hits: u64,
+    /// Property failures (must be 0).
+    pub violations: u64,
+    /// Tests where both hit.
+    pub shared_hits: u64,
+    /// Median |t − t_golden| in units of the format's ulp at t_golden.
+    pub t_err_ulps_median: f64,
+    /// Largest |t − t_golden| in ulps.
+    pub t_err_ulps_max: f64,
+    /// Median |t − t_golden| / |t_golden|.
+    pub t_err_rel_median: f64,
+    /// Largest relative t error.
+    pub t_err_rel_max: f64,
+    /// Rays whose min-capture result names a different triangle (or hit/miss) than the golden closest hit.
+    pub closest_disagreements: u64,
+    /// Model throughput of the pairwise batch path, million tests per second (one thread).
+    pub mtests_per_s: f64,
+    /// The first property failure, as an `explain` command line.
+    pub first_violation: Option<String>,
+}
+
+/// The whole run.
+#[derive(Clone, Debug, Serialize)]
+pub struct VerifyReport {
+    /// Scene name.
+    pub scene: String,
+    /// Triangles in the scene.
+    pub triangles: usize,
+    /// The power of two applied to the scene's coordinates.
+    pub scale: f64,
+    /// Rays cast.
+    pub rays: usize,
+    /// Ray seed.
+    pub seed: u64,
+    /// Triangles tested per ray.
+    pub tests_per_ray: usize,
+    /// Per-format results.
+    pub formats: Vec<FormatReport>,
+    /// No property failed.
+    pub passed: bool,
+}
+
+/// The (ray, triangle) test list: per ray, the triangles it is tested against.
+fn test_lists(scene: &Scene, rays: &[(Ray64, usize)], sample: usize, seed: u64) -> Vec<Vec<usize>> {
+    let n = scene.tris.len();
+    if n <= sample {
+        return rays.iter().map(|_| (0..n).collect()).collect();
+    }
+    let mut r = datapath::rng::SplitMix64::new(seed ^ 0x7e57);
+    rays.iter()
+        .map(|&(_, target)| {
+            let mut v = vec![target];
+            v.extend((1..sample).map(|_| r.below(n as u64) as usize));
+            v
+        })
+        .collect()
+}
+
+fn explain_cmd(fmt: &str, ray: &Ray64, tri: &Tri64, scale: f64) -> String {
+    let j = |xs: &[f64]| {
+        xs.iter()
+            .map(|x| format!("{x:?}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    let tv: Vec<f64> = tri.v.iter().flatten().copied().collect();
+    format!(
+        "raypipe explain --format {fmt} --ray {},{} --tri {}  # scene coordinates x {scale:?}",
+        j(&ray.o),
+        j(&ray.d),
+        j(&tv)
+    )
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn run_format<F: Format>(
+    fmt: F,
+    cfg: &VerifyConfig,
+    scene: &Scene,
+    rays: &[(Ray64, usize)],
+    lists: &[Vec<usize>],
+) -> FormatReport {
+    let rti = Rti::new(fmt, cfg.rti);
+    let name = rti.fmt.name();
+    let mut rep = FormatReport {
+        format: name.clone(),
+        width: rti.fmt.width(),
+        tests: 0,
+        decisive: 0,
+        golden_hits: 0,
+        model_hits: 0,
+        false_misses: 0,
+        false_hits: 0,
+        violations: 0,
+        shared_hits: 0,
+        t_err_ulps_median: 0.0,
+        t_err_ulps_max: 0.0,
+        t_err_rel_median: 0.0,
+        t_err_rel_max: 0.0,
+        closest_disagreements: 0,
+        mtests_per_s: 0.0,
+        first_violation: None,
+    };
+    let (mut ulps, mut rels) = (Vec::new(), Vec::new());
+    let faces = crate::judge::faces(&rti);
+    for ((ray, _), list) in rays.iter().zip(lists) {
+        let mray = rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
+        let mut cap = Capture::default();
+        let (rq, _) = crate::judge::quantise(&rti, ray, &scene.tris[0]);
+        let mut qtris = Vec::with_capacity(list.len());
+        for (k, &ti) in list.iter().enumerate() {
+            let tri = &scene.tris[ti];
+            let j: Judged = judge(&rti, ray, tri);
+            rep.tests += 1;
+            rep.decisive += j.decisive as u64;
+            rep.golden_hits += j.golden.hit as u64;
+            rep.model_hits += j.hit as u64;
+            rep.false_misses += (j.golden.hit && !j.hit) as u64;
+            rep.false_hits += (!j.golden.hit && j.hit) as u64;
+            if let Some(why) = j.violation() {
+                rep.violations += 1;
+                if rep.first_violation.is_none() {
+                    rep.first_violation = Some(format!(
+                        "{why}: {}",
+                        explain_cmd(&name, ray, tri, scene.scale)
+                    ));
+                }
+            }
+            if j.hit && j.golden.hit {
+                rep.shared_hits += 1;
+                ulps.push(j.t_error() / j.ulp);
+                rels.push(j.t_error() / j.golden.t.abs().max(f64::MIN_POSITIVE));
+            }
+            let out = rti.test(&mray, &rti.tri(tri.v));
+            rti.capture(&mut cap, &out, k as u32);
+            qtris.push(crate::judge::quantise(&rti, ray, tri).1);
+        }
+        let g = golden::closest_hit(&rq, &qtris, faces);
+        let same = match (g, cap.hit) {
+            (None, false) => true,
+            (Some((gi, _)), true) => list[gi] == list[cap.id as usize],
+            _ => false,
+        };
+        rep.closest_disagreements += !same as u64;
+    }
+    rep.t_err_ulps_max = ulps.iter().copied().fold(0.0, f64::max);
+    rep.t_err_rel_max = rels.iter().copied().fold(0.0, f64::max);
+    rep.t_err_ulps_median = median(&mut ulps);
+    rep.t_err_rel_median = median(&mut rels);
+    rep.mtests_per_s = throughput(&rti, scene, rays, lists);
+    rep
+}
+
+/// Times the pairwise batch path over every test of the run (model only), in chunks.
+fn throughput<F: Format>(
+    rti: &Rti<F>,
+    scene: &Scene,
+    rays: &[(Ray64, usize)],
+    lists: &[Vec<usize>],
+) -> f64 {
+    const CHUNK: usize = 1 << 14;
+    let mut rs = RaysSoa::default();
+    let mut ts = TrisSoa::default();
+    let mut out = HitsSoa::with_len(CHUNK);
+    let mut secs = 0.0;
+    let mut n = 0usize;
+    let mut sink = 0usize;
+    let mut flush = |rs: &mut RaysSoa<F::V>, ts: &mut TrisSoa<F::V>, out: &mut HitsSoa<F::V>| {
+        if rs.is_empty() {
+            return;
+        }
+        if out.len() != rs.len() {
+            *out = HitsSoa::with_len(rs.len());
+        }
+        let t0 = Instant::now();
+        rti.batch(rs, ts, out);
+        secs += t0.elapsed().as_secs_f64();
+        n += rs.len();
+        sink += out.hit.iter().filter(|&&h| h).count();
+        *rs = RaysSoa::default();
+        *ts = TrisSoa::default();
+    };
+    for ((ray, _), list) in rays.iter().zip(lists) {
+        let mray = rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
+        for &ti in list {
+            rs.push(&mray);
+            ts.push(&rti.tri(scene.tris[ti].v));
+            if rs.len() == CHUNK {
+                flush(&mut rs, &mut ts, &mut out);
+            }
+        }
+    }
+    flush(&mut rs, &mut ts, &mut out);
+    std::hint::black_box(sink);
+    if secs > 0.0 {
+        n as f64 / secs / 1e6
+    } else {
+        0.0
+    }
+}
+
+/// Runs every format on the scene.
+pub fn verify(cfg: &VerifyConfig, scene: &Scene) -> VerifyReport {
+    let rays = scene.rays(cfg.rays, cfg.seed);
+    let lists = test_lists(scene, &rays, cfg.sample, cfg.seed);
+    let formats: Vec<FormatReport> = cfg
+        .formats
+        .iter()
+        .map(|f| with_format!(*f, |f| run_format(f, cfg, scene, &rays, &lists)))
+        .collect();
+    VerifyReport {
+        scene: scene.name.clone(),
+        triangles: scene.tris.len(),
+        scale: scene.scale,
+        rays: rays.len(),
+        seed: cfg.seed,
+        tests_per_ray: lists.first().map_or(0, Vec::len),
+        passed: formats.iter().all(|f| f.violations == 0),
+        formats,
+    }
+}
+
+/// The report as a text table.
+pub fn render(r: &VerifyReport) -> String {
+    let mut s = format!(
+        "raypipe verify: scene {} ({} triangles, coordinates x {:?}), {} rays, seed {}, {} tests per ray\n\n",
+        r.scene, r.triangles, r.scale, r.rays, r.seed, r.tests_per_ray
+    );
+    s += &format!(
+        "{:<16} {:>9} {:>9} {:>8} {:>8} {:>7} {:>7} {:>6} {:>10} {:>10} {:>9} {:>9} {:>8} {:>9}\n",
+        "format",
+        "tests",
+        "decisive",
+        "g-hits",
+        "m-hits",
+        "f-miss",
+        "f-hit",
+        "viol",
+        "t ulp med",
+        "t ulp max",
+        "t rel med",
+        "t rel max",
+        "closest≠",
+        "Mtests/s"
+    );
+    for f in &r.formats {
+        s += &format!(
+            "{:<16} {:>9} {:>9} {:>8} {:>8} {:>7} {:>7} {:>6} {:>10.3} {:>10.3} {:>9.2e} {:>9.2e} {:>8} {:>9.2}\n",
+            f.format,
+            f.tests,
+            f.decisive,
+            f.golden_hits,
+            f.model_hits,
+            f.false_misses,
+            f.false_hits,
+            f.violations,
+            f.t_err_ulps_median,
+            f.t_err_ulps_max,
+            f.t_err_rel_median,
+            f.t_err_rel_max,
+            f.closest_disagreements,
+            f.mtests_per_s
+        );
+    }
+    s += "\nf-miss/f-hit: model vs golden f64 on the same quantised inputs; viol: decisive tests (error bound clear of every threshold) where hit/miss differs or the t error exceeds its bound.\n";
+    if r.passed {
+        s += "property: PASS (no violations)\n";
+    } else {
+        s += "property: FAIL\n";
+        for f in r.formats.iter().filter(|f| f.violations > 0) {
+            s += &format!(
+                "  {}: {} violations; first: {}\n",
+                f.format,
+                f.violations,
+                f.first_violation.as_deref().unwrap_or("")
+            );
+        }
+    }
+    s
+}
