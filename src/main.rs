@@ -36,7 +36,7 @@ struct RtiArgs {
     #[arg(long)]
     cull: bool,
     /// det threshold (>= 0).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     det_threshold: f64,
     /// Min-capture tie rule on equal t.
     #[arg(long, value_enum, default_value_t = Tie::First)]

@@ -1,0 +1,264 @@
+//! The command line: the main job passes, JSON is well formed, and every bad input gives a
+//! clear error and exit code 2 (never a panic).
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn raypipe(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .args(args)
+        .output()
+        .expect("run raypipe")
+}
+
+fn text(o: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// A file in a fresh temporary directory.
+fn temp_file(name: &str, contents: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("raypipe-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, contents).unwrap();
+    p
+}
+
+fn assert_clear_error(o: &Output, needle: &str) {
+    let (out, err) = text(o);
+    assert_eq!(o.status.code(), Some(2), "stdout: {out}\nstderr: {err}");
+    assert!(err.contains(needle), "stderr lacks '{needle}': {err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn verify_prints_a_table_per_format_and_passes() {
+    let o = raypipe(&["verify", "--rays", "48"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    for f in ["f32", "fp16", "bf16", "e8m16", "q8.24:divide"] {
+        assert!(
+            out.lines().any(|l| l.starts_with(f)),
+            "no row for {f}:\n{out}"
+        );
+    }
+    assert!(out.contains("property: PASS"));
+    assert!(out.contains("seed 1"));
+}
+
+#[test]
+fn verify_json_has_every_format() {
+    let o = raypipe(&[
+        "verify",
+        "--rays",
+        "32",
+        "--seed",
+        "9",
+        "--format",
+        "f32,e5m10:ftz",
+        "--json",
+    ]);
+    assert!(o.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("valid JSON");
+    assert_eq!(v["seed"], 9);
+    assert_eq!(v["passed"], true);
+    let names: Vec<&str> = v["formats"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["format"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["f32", "e5m10:ftz"]);
+    let f32 = &v["formats"][0];
+    assert_eq!(f32["tests"], 32 * 368);
+    assert!(f32["decisive"].as_u64().unwrap() > 32 * 368 * 9 / 10);
+}
+
+#[test]
+fn verify_loads_an_obj_scene() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n";
+    let p = temp_file("tetra.obj", obj);
+    let o = raypipe(&[
+        "verify",
+        "--scene",
+        p.to_str().unwrap(),
+        "--rays",
+        "64",
+        "--format",
+        "f32",
+    ]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{out}\n{err}");
+    assert!(out.contains("tetra.obj (4 triangles"), "{out}");
+}
+
+#[test]
+fn missing_obj_is_a_clear_error() {
+    assert_clear_error(
+        &raypipe(&["verify", "--scene", "/nonexistent/scene.obj"]),
+        "no such file",
+    );
+}
+
+#[test]
+fn malformed_obj_is_a_clear_error() {
+    let p = temp_file("bad.obj", "v 0 0 0\nv 1 0 zero\nv 0 1 0\nf 1 2 3\n");
+    assert_clear_error(
+        &raypipe(&["verify", "--scene", p.to_str().unwrap()]),
+        "malformed OBJ",
+    );
+    let p = temp_file("badindex.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n");
+    assert_clear_error(&raypipe(&["verify", "--scene", p.to_str().unwrap()]), "OBJ");
+}
+
+#[test]
+fn nan_and_inf_coordinates_are_clear_errors() {
+    let p = temp_file("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+    assert_clear_error(
+        &raypipe(&["verify", "--scene", p.to_str().unwrap()]),
+        "non-finite",
+    );
+    let p = temp_file("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n");
+    assert_clear_error(
+        &raypipe(&["verify", "--scene", p.to_str().unwrap()]),
+        "non-finite",
+    );
+    let tri = "0,0,0,1,0,0,0,1,0";
+    assert_clear_error(
+        &raypipe(&[
+            "explain",
+            "--format",
+            "f32",
+            "--ray",
+            "0,0,1,0,0,NaN",
+            "--tri",
+            tri,
+        ]),
+        "finite",
+    );
+    assert_clear_error(
+        &raypipe(&[
+            "explain",
+            "--format",
+            "f32",
+            "--ray",
+            "0,0,1,0,0,-1",
+            "--tri",
+            "0,0,0,1,0,0,0,inf,0",
+        ]),
+        "finite",
+    );
+}
+
+#[test]
+fn obj_without_triangles_is_a_clear_error() {
+    let p = temp_file("empty.obj", "# only vertices\nv 0 0 0\nv 1 0 0\n");
+    assert_clear_error(
+        &raypipe(&["verify", "--scene", p.to_str().unwrap()]),
+        "no triangles",
+    );
+}
+
+#[test]
+fn unknown_format_is_a_clear_error() {
+    let o = raypipe(&["verify", "--format", "f24"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("unknown format 'f24'"));
+    let o = raypipe(&[
+        "explain",
+        "--format",
+        "fp16:fast",
+        "--ray",
+        "0,0,1,0,0,-1",
+        "--tri",
+        "0,0,0,1,0,0,0,1,0",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("unknown format option 'fast'"));
+}
+
+#[test]
+fn explain_wrong_arity_and_bad_options_are_clear_errors() {
+    assert_clear_error(
+        &raypipe(&[
+            "explain",
+            "--format",
+            "f32",
+            "--ray",
+            "0,0,1",
+            "--tri",
+            "0,0,0,1,0,0,0,1,0",
+        ]),
+        "expected 6",
+    );
+    assert_clear_error(
+        &raypipe(&[
+            "explain",
+            "--format",
+            "f32",
+            "--ray",
+            "0,0,1,0,0,-1",
+            "--tri",
+            "0,0,0,1,0,0,0,1",
+        ]),
+        "expected 9",
+    );
+    assert_clear_error(
+        &raypipe(&[
+            "explain",
+            "--format",
+            "f32",
+            "--ray",
+            "0,0,1,0,0,-1",
+            "--tri",
+            "0,0,0,1,0,0,0,1,0",
+            "--det-threshold",
+            "-1",
+        ]),
+        "det-threshold",
+    );
+    assert_eq!(raypipe(&["verify", "--rays", "0"]).status.code(), Some(2));
+}
+
+#[test]
+fn explain_prints_every_stage_signal_with_bits() {
+    let o = raypipe(&[
+        "explain",
+        "--format",
+        "fp16",
+        "--ray",
+        "0.25,0.25,1,0,0,-1",
+        "--tri",
+        "0,0,0,1,0,0,0,1,0",
+    ]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    for sig in [
+        "e1x", "pxa", "qzb", "det_xy", "uv", "valid", "inv_det", "hit",
+    ] {
+        assert!(
+            out.lines()
+                .any(|l| l.split_whitespace().nth(1) == Some(sig)),
+            "no {sig} row:\n{out}"
+        );
+    }
+    // fp16 1.0 is 0x3c00; t = 1 here
+    assert!(
+        out.lines()
+            .any(|l| l.split_whitespace().nth(1) == Some("t") && l.contains("3c00")),
+        "{out}"
+    );
+    assert!(out.contains("golden: hit true t 1e0"), "{out}");
+}
+
+#[test]
+fn stages_prints_the_stage_table() {
+    let o = raypipe(&["stages"]);
+    let out = text(&o).0;
+    assert!(o.status.success());
+    assert!(out.contains("| 8 | `inv_det` | div | one ÷ det |"), "{out}");
+    assert_eq!(raypipe(&["stages", "--div", "fast"]).status.code(), Some(2));
+}
