@@ -1,1 +1,135 @@
-fn main() {}
+//! criterion benchmarks of the RTI models (pairwise batch path) against baselines: the golden
+//! f64 reference, a plain scalar f32 Möller–Trumbore and a `half`-crate scalar fp16 one.
+//! Run: `cargo bench --bench rti`.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use datapath::rng::SplitMix64;
+use datapath::rti::{HitsSoa, RaysSoa, Rti, RtiConfig, TrisSoa};
+use datapath::{with_format, AnyFormat, Format};
+use golden::{Faces, Ray64, Tri64};
+use half::f16;
+use std::hint::black_box;
+
+const N: usize = 4096;
+
+fn cases() -> Vec<(Ray64, Tri64)> {
+    let scene = raypipe::scene::Scene::builtin();
+    let mut r = SplitMix64::new(42);
+    scene
+        .rays(N, 42)
+        .into_iter()
+        .map(|(ray, target)| {
+            let i = if r.below(2) == 0 {
+                target
+            } else {
+                r.below(scene.tris.len() as u64) as usize
+            };
+            (ray, scene.tris[i])
+        })
+        .collect()
+}
+
+fn bench_models(c: &mut Criterion) {
+    let cases = cases();
+    let mut g = c.benchmark_group("rti_batch");
+    g.throughput(Throughput::Elements(N as u64));
+    for name in ["f32", "fp16", "bf16", "e8m16", "q8.24:divide"] {
+        let any: AnyFormat = name.parse().unwrap();
+        with_format!(any, |f| {
+            let rti = Rti::new(f, RtiConfig::default());
+            let (mut rays, mut tris) = (RaysSoa::default(), TrisSoa::default());
+            for (ray, tri) in &cases {
+                rays.push(&rti.ray(ray.o, ray.d, ray.tmin, ray.tmax));
+                tris.push(&rti.tri(tri.v));
+            }
+            let mut out = HitsSoa::with_len(N);
+            g.bench_with_input(BenchmarkId::new("model", rti.fmt.name()), &(), |b, _| {
+                b.iter(|| rti.batch(black_box(&rays), black_box(&tris), &mut out))
+            });
+        });
+    }
+    g.bench_function("golden_f64", |b| {
+        b.iter(|| {
+            cases
+                .iter()
+                .filter(|(ray, tri)| {
+                    golden::intersect(black_box(ray), black_box(tri), Faces::default()).hit
+                })
+                .count()
+        })
+    });
+    let c32: Vec<([f32; 6], [f32; 9])> = cases
+        .iter()
+        .map(|(r, t)| {
+            let ray = [r.o[0], r.o[1], r.o[2], r.d[0], r.d[1], r.d[2]].map(|x| x as f32);
+            let v: Vec<f32> = t.v.iter().flatten().map(|&x| x as f32).collect();
+            (ray, v.try_into().unwrap())
+        })
+        .collect();
+    g.bench_function("plain_scalar_f32_mt", |b| {
+        b.iter(|| {
+            c32.iter()
+                .filter(|(r, t)| plain_mt(black_box(r), black_box(t)).is_some())
+                .count()
+        })
+    });
+    let c16: Vec<([f16; 6], [f16; 9])> = c32
+        .iter()
+        .map(|(r, t)| (r.map(f16::from_f32), t.map(f16::from_f32)))
+        .collect();
+    g.bench_function("half_scalar_fp16_mt", |b| {
+        b.iter(|| {
+            c16.iter()
+                .filter(|(r, t)| plain_mt(black_box(r), black_box(t)).is_some())
+                .count()
+        })
+    });
+    g.finish();
+}
+
+/// Textbook Möller–Trumbore in any `Copy` arithmetic type (the baselines).
+fn plain_mt<T>(r: &[T; 6], v: &[T; 9]) -> Option<T>
+where
+    T: Copy
+        + PartialOrd
+        + std::ops::Add<Output = T>
+        + std::ops::Sub<Output = T>
+        + std::ops::Mul<Output = T>
+        + std::ops::Div<Output = T>
+        + From<u8>,
+{
+    let zero = T::from(0u8);
+    let one = T::from(1u8);
+    let sub = |a: [T; 3], b: [T; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross = |a: [T; 3], b: [T; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let dot = |a: [T; 3], b: [T; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (o, d) = ([r[0], r[1], r[2]], [r[3], r[4], r[5]]);
+    let (v0, v1, v2) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]);
+    let e1 = sub(v1, v0);
+    let e2 = sub(v2, v0);
+    let p = cross(d, e2);
+    let det = dot(e1, p);
+    if det == zero {
+        return None;
+    }
+    let inv = one / det;
+    let s = sub(o, v0);
+    let u = dot(s, p) * inv;
+    let q = cross(s, e1);
+    let w = dot(d, q) * inv;
+    let t = dot(e2, q) * inv;
+    (u >= zero && w >= zero && u + w <= one && t >= zero).then_some(t)
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(2)).warm_up_time(std::time::Duration::from_millis(500));
+    targets = bench_models
+}
+criterion_main!(benches);

@@ -4,7 +4,7 @@
 //! must equal the golden's, and where both hit the t error must be within its bound. A failing
 //! case prints every stage signal (`raypipe explain`'s output).
 //!
-//! Seeded; the case count comes from PROPTEST_CASES (default 256 per format).
+//! Seeded (fixed RNG seed); the case count comes from PROPTEST_CASES (default 2000).
 
 mod common;
 

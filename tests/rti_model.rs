@@ -332,9 +332,9 @@ fn culling_and_det_threshold() {
         with_format!(any, |f| {
             // counter-clockwise seen from +z: normal +z; a ray going -z sees the front face
             let v = [[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.0, 0.5, 0.0]];
-            let two = Rti::new(f.clone(), RtiConfig::default());
+            let two = Rti::new(f, RtiConfig::default());
             let cull = Rti::new(
-                f.clone(),
+                f,
                 RtiConfig {
                     cull: Cull::Backface,
                     ..RtiConfig::default()
@@ -355,14 +355,14 @@ fn culling_and_det_threshold() {
             );
             // det = e1·(d × e2) = 1 here; a threshold of 2 rejects it, 0.5 keeps it
             let hi = Rti::new(
-                f.clone(),
+                f,
                 RtiConfig {
                     det_threshold: 2.0,
                     ..RtiConfig::default()
                 },
             );
             let lo = Rti::new(
-                f.clone(),
+                f,
                 RtiConfig {
                     det_threshold: 0.5,
                     ..RtiConfig::default()
@@ -395,7 +395,7 @@ fn nan_in_any_input_never_hits() {
             let good = rti.ray([0.1, 0.1, 1.0], [0.0, 0.0, -1.0], 0.0, f64::INFINITY);
             let tri = rti.tri([[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.0, 0.5, 0.0]]);
             assert!(rti.test(&good, &tri).hit);
-            for i in 0..17 {
+            for (i, input) in RTI_INPUTS.iter().enumerate() {
                 let (mut ray, mut t) = (good, tri);
                 match i {
                     0..=2 => ray.o[i] = nan,
@@ -408,7 +408,7 @@ fn nan_in_any_input_never_hits() {
                     !rti.test(&ray, &t).hit,
                     "{}: NaN in input {} hits",
                     rti.fmt.name(),
-                    RTI_INPUTS[i]
+                    input
                 );
             }
         });

@@ -51,7 +51,8 @@ struct Ctx {
 
 impl Ctx {
     fn check(&mut self, b: Bnd) -> Bnd {
-        if !(b.v.abs() + b.e <= self.em.max) {
+        let m = b.v.abs() + b.e;
+        if m.is_nan() || m > self.em.max {
             self.overflow = true;
         }
         b

@@ -27,6 +27,7 @@ pub trait IeeeBackend: Clone + Copy + Debug + Send + Sync + 'static {
     fn div(&self, a: Self::V, b: Self::V) -> Self::V;
     /// Correctly rounded conversion from f64.
     #[inline]
+    #[allow(clippy::wrong_self_convention)] // a format carries run-time parameters
     fn from_f64(&self, x: f64) -> Self::V {
         Self::from_bits(self.layout().from_f64(x))
     }
@@ -84,6 +85,7 @@ impl IeeeBackend for F32Native {
         a / b
     }
     #[inline(always)]
+    #[allow(clippy::wrong_self_convention)] // a format carries run-time parameters
     fn from_f64(&self, x: f64) -> f32 {
         x as f32 // Rust's f64 -> f32 cast rounds to nearest-even
     }

@@ -113,7 +113,7 @@ pub struct Contract {
 }
 
 /// A number format with its datapath options; all model arithmetic goes through it.
-pub trait Format: Clone + Debug + Send + Sync + 'static {
+pub trait Format: Copy + Debug + Send + Sync + 'static {
     /// The value type (one register of the datapath).
     type V: Copy + Debug + Default + Send + Sync + 'static;
 
@@ -131,12 +131,14 @@ pub trait Format: Clone + Debug + Send + Sync + 'static {
     fn div_mode(&self) -> DivMode;
 
     /// Input conversion from f64 (correctly rounded; flushed under FTZ).
+    #[allow(clippy::wrong_self_convention)] // a format carries run-time parameters
     fn from_f64(&self, x: f64) -> Self::V;
     /// Value as f64 (exact for every float format and for fixed values below 2^53 steps).
     fn to_f64(&self, v: Self::V) -> f64;
     /// Encoding, right-aligned in a u64.
     fn to_bits(&self, v: Self::V) -> u64;
     /// Value from its encoding (low `width` bits).
+    #[allow(clippy::wrong_self_convention)] // a format carries run-time parameters
     fn from_bits(&self, b: u64) -> Self::V;
 
     /// a + b.
@@ -303,6 +305,7 @@ impl<B: IeeeBackend> Format for Ieee<B> {
         self.opts.div
     }
 
+    #[allow(clippy::wrong_self_convention)] // a format carries run-time parameters
     fn from_f64(&self, x: f64) -> B::V {
         let v = self.backend.from_f64(x);
         let z = self.zero();
@@ -314,6 +317,7 @@ impl<B: IeeeBackend> Format for Ieee<B> {
     fn to_bits(&self, v: B::V) -> u64 {
         B::bits(v)
     }
+    #[allow(clippy::wrong_self_convention)] // a format carries run-time parameters
     fn from_bits(&self, b: u64) -> B::V {
         B::from_bits(b & (self.lay().sign_mask() << 1).wrapping_sub(1))
     }
