@@ -54,6 +54,7 @@ pub struct F32Native;
 
 impl IeeeBackend for F32Native {
     type V = f32;
+    #[inline(always)]
     fn layout(&self) -> FloatLayout {
         FloatLayout::BINARY32
     }
@@ -110,6 +111,7 @@ pub struct F16Half;
 
 impl IeeeBackend for F16Half {
     type V = f16;
+    #[inline(always)]
     fn layout(&self) -> FloatLayout {
         FloatLayout::BINARY16
     }
@@ -177,6 +179,7 @@ impl Bf16 {
 
 impl IeeeBackend for Bf16 {
     type V = u16;
+    #[inline(always)]
     fn layout(&self) -> FloatLayout {
         FloatLayout::BFLOAT16
     }
@@ -227,6 +230,7 @@ pub struct Soft(pub FloatLayout);
 
 impl IeeeBackend for Soft {
     type V = u64;
+    #[inline(always)]
     fn layout(&self) -> FloatLayout {
         self.0
     }

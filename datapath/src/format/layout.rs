@@ -26,6 +26,7 @@ pub struct Decoded {
 }
 
 /// Builds 2^e as an f64 exactly, for -1074 <= e <= 1023.
+#[inline]
 pub(crate) fn pow2(e: i32) -> f64 {
     debug_assert!((-1074..=1023).contains(&e));
     if e >= -1022 {
@@ -46,6 +47,7 @@ impl FloatLayout {
     pub const BINARY64: Self = Self::new(11, 52);
 
     /// A layout with `e` exponent and `m` fraction bits.
+    #[inline]
     pub const fn new(exp_bits: u32, man_bits: u32) -> Self {
         Self { exp_bits, man_bits }
     }
@@ -62,42 +64,52 @@ impl FloatLayout {
     }
 
     /// Total width in bits.
+    #[inline]
     pub const fn width(&self) -> u32 {
         1 + self.exp_bits + self.man_bits
     }
     /// Exponent bias.
+    #[inline]
     pub const fn bias(&self) -> i32 {
         (1 << (self.exp_bits - 1)) - 1
     }
     /// Smallest normal exponent.
+    #[inline]
     pub const fn emin(&self) -> i32 {
         1 - self.bias()
     }
     /// Largest finite exponent.
+    #[inline]
     pub const fn emax(&self) -> i32 {
         self.bias()
     }
     /// Sign bit mask.
+    #[inline]
     pub const fn sign_mask(&self) -> u64 {
         1 << (self.exp_bits + self.man_bits)
     }
     /// Exponent field mask.
+    #[inline]
     pub const fn exp_mask(&self) -> u64 {
         ((1 << self.exp_bits) - 1) << self.man_bits
     }
     /// Fraction field mask.
+    #[inline]
     pub const fn man_mask(&self) -> u64 {
         (1 << self.man_bits) - 1
     }
     /// The canonical quiet NaN: sign 0, exponent all ones, fraction MSB set, rest 0.
+    #[inline]
     pub const fn canonical_nan(&self) -> u64 {
         self.exp_mask() | (1 << (self.man_bits - 1))
     }
     /// Infinity with the given sign.
+    #[inline]
     pub const fn inf(&self, neg: bool) -> u64 {
         self.exp_mask() | if neg { self.sign_mask() } else { 0 }
     }
     /// Zero with the given sign.
+    #[inline]
     pub const fn zero(&self, neg: bool) -> u64 {
         if neg {
             self.sign_mask()
@@ -121,31 +133,38 @@ impl FloatLayout {
     }
 
     /// True for NaN encodings.
+    #[inline]
     pub const fn is_nan(&self, b: u64) -> bool {
         b & self.exp_mask() == self.exp_mask() && b & self.man_mask() != 0
     }
     /// True for ±infinity.
+    #[inline]
     pub const fn is_inf(&self, b: u64) -> bool {
         b & (self.exp_mask() | self.man_mask()) == self.exp_mask()
     }
     /// True for ±0.
+    #[inline]
     pub const fn is_zero(&self, b: u64) -> bool {
         b & (self.exp_mask() | self.man_mask()) == 0
     }
     /// True for nonzero subnormals.
+    #[inline]
     pub const fn is_subnormal(&self, b: u64) -> bool {
         b & self.exp_mask() == 0 && b & self.man_mask() != 0
     }
     /// True when the sign bit is set.
+    #[inline]
     pub const fn is_neg(&self, b: u64) -> bool {
         b & self.sign_mask() != 0
     }
     /// Sets the quiet bit (fraction MSB).
+    #[inline]
     pub const fn quiet(&self, b: u64) -> u64 {
         b | (1 << (self.man_bits - 1))
     }
 
     /// Decodes a finite encoding (callers exclude NaN and infinity).
+    #[inline]
     pub fn decode(&self, b: u64) -> Decoded {
         let neg = self.is_neg(b);
         let biased = ((b & self.exp_mask()) >> self.man_bits) as i32;
@@ -168,6 +187,7 @@ impl FloatLayout {
 
     /// Rounds `(-1)^neg × sig × 2^exp` (exact) to this format, nearest-even, with gradual
     /// underflow and overflow to infinity. `sig` must be below 2^126.
+    #[inline]
     pub fn round(&self, neg: bool, sig: u128, exp: i32) -> u64 {
         let sign = self.zero(neg);
         if sig == 0 {
@@ -214,6 +234,7 @@ impl FloatLayout {
     }
 
     /// Correctly rounded (nearest-even) conversion from f64. NaN becomes the canonical NaN.
+    #[inline]
     pub fn from_f64(&self, x: f64) -> u64 {
         if x.is_nan() {
             return self.canonical_nan();
@@ -226,6 +247,7 @@ impl FloatLayout {
     }
 
     /// Exact conversion to f64 (every supported format is a subset of binary64).
+    #[inline]
     pub fn to_f64(&self, b: u64) -> f64 {
         if self.is_nan(b) {
             return f64::NAN;
@@ -253,6 +275,7 @@ impl FloatLayout {
     }
 
     /// IEEE addition, nearest-even. Any NaN result is the canonical NaN.
+    #[inline]
     pub fn add(&self, a: u64, b: u64) -> u64 {
         if self.is_nan(a) || self.is_nan(b) {
             return self.canonical_nan();
@@ -295,6 +318,7 @@ impl FloatLayout {
     }
 
     /// IEEE subtraction, nearest-even.
+    #[inline]
     pub fn sub(&self, a: u64, b: u64) -> u64 {
         if self.is_nan(b) {
             return self.canonical_nan();
@@ -303,6 +327,7 @@ impl FloatLayout {
     }
 
     /// IEEE multiplication, nearest-even.
+    #[inline]
     pub fn mul(&self, a: u64, b: u64) -> u64 {
         if self.is_nan(a) || self.is_nan(b) {
             return self.canonical_nan();
@@ -320,6 +345,7 @@ impl FloatLayout {
     }
 
     /// IEEE division, nearest-even.
+    #[inline]
     pub fn div(&self, a: u64, b: u64) -> u64 {
         if self.is_nan(a) || self.is_nan(b) {
             return self.canonical_nan();
@@ -349,10 +375,12 @@ impl FloatLayout {
     }
 
     /// IEEE ordered comparison a < b (false if either is NaN; -0 == +0).
+    #[inline]
     pub fn lt(&self, a: u64, b: u64) -> bool {
         self.to_f64(a) < self.to_f64(b)
     }
     /// IEEE ordered comparison a <= b (false if either is NaN; -0 == +0).
+    #[inline]
     pub fn le(&self, a: u64, b: u64) -> bool {
         self.to_f64(a) <= self.to_f64(b)
     }
