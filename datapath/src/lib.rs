@@ -8,5 +8,6 @@ pub mod format;
 pub mod probe;
 pub mod rng;
 pub mod rti;
+pub mod slab;
 
 pub use format::{AnyFormat, Format};

@@ -3,5 +3,7 @@
 #![warn(missing_docs)]
 
 pub mod mt;
+pub mod slab;
 
 pub use mt::{closest_hit, intersect, Faces, MtResult, Ray64, Tri64};
+pub use slab::{slab_exact, slab_f64, SlabResult};

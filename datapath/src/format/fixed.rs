@@ -298,6 +298,23 @@ impl Format for Fixed {
     fn ulp(&self, _x: f64) -> f64 {
         pow2(-(self.frac_bits as i32))
     }
+    fn sign_bit(&self, v: i64) -> bool {
+        v < 0
+    }
+    fn next_up(&self, v: i64) -> i64 {
+        if v == self.max_raw() {
+            v
+        } else {
+            v + 1
+        }
+    }
+    fn next_down(&self, v: i64) -> i64 {
+        if v == self.min_raw() {
+            v
+        } else {
+            v - 1
+        }
+    }
 }
 
 impl Fixed {

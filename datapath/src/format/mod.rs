@@ -165,6 +165,30 @@ pub trait Format: Copy + Debug + Send + Sync + 'static {
     }
     /// Spacing of the format's grid near |x|.
     fn ulp(&self, x: f64) -> f64;
+    /// The sign bit (fixed point: negative).
+    fn sign_bit(&self, v: Self::V) -> bool;
+    /// The next value toward +∞ (NaN and +∞ unchanged; under FTZ it skips the subnormals).
+    fn next_up(&self, v: Self::V) -> Self::V;
+    /// The next value toward −∞ (NaN and −∞ unchanged; under FTZ it skips the subnormals).
+    fn next_down(&self, v: Self::V) -> Self::V;
+    /// The largest value <= x (x not NaN): a directed, conservative input conversion.
+    fn round_down(&self, x: f64) -> Self::V {
+        let v = self.from_f64(x);
+        if self.to_f64(v) > x {
+            self.next_down(v)
+        } else {
+            v
+        }
+    }
+    /// The smallest value >= x (x not NaN).
+    fn round_up(&self, x: f64) -> Self::V {
+        let v = self.from_f64(x);
+        if self.to_f64(v) < x {
+            self.next_up(v)
+        } else {
+            v
+        }
+    }
     /// Hex digits of one encoding: `ceil(width / 4)`.
     fn hex(&self, v: Self::V) -> String {
         format!(
@@ -372,5 +396,41 @@ impl<B: IeeeBackend> Format for Ieee<B> {
     }
     fn ulp(&self, x: f64) -> f64 {
         self.lay().ulp(x)
+    }
+    #[inline(always)]
+    fn sign_bit(&self, v: B::V) -> bool {
+        self.lay().is_neg(B::bits(v))
+    }
+    fn next_up(&self, v: B::V) -> B::V {
+        let l = self.lay();
+        let b = B::bits(v);
+        if l.is_nan(b) || b == l.inf(false) {
+            return v;
+        }
+        let ftz = self.opts.subnormals == Subnormals::Ftz;
+        let r = if l.is_zero(b) {
+            if ftz {
+                1 << l.man_bits // smallest normal
+            } else {
+                1
+            }
+        } else if l.is_neg(b) {
+            b - 1
+        } else {
+            b + 1
+        };
+        if ftz && l.is_subnormal(r) {
+            // only reachable stepping up from the negative smallest normal
+            return B::from_bits(l.sign_mask());
+        }
+        B::from_bits(r)
+    }
+    fn next_down(&self, v: B::V) -> B::V {
+        let m = self.lay().sign_mask();
+        let flip = |x: B::V| B::from_bits(B::bits(x) ^ m);
+        if self.is_nan(v) {
+            return v;
+        }
+        flip(self.next_up(flip(v)))
     }
 }

@@ -1,0 +1,452 @@
+//! The bounding-volume intersection (BVI) pipeline: the slab test in 6 subtracts and 6
+//! multiplies per ray–box test, then the compare unit.
+//!
+//! Per ray, once (stage 0): `inv_d = 1 ⊘ d` (the format's division), after the direction
+//! preparation of the variant ([`DirPrep`]). Per box: stage 1 subtracts the origin from both
+//! planes of each axis, stage 2 multiplies by `inv_d`, stage 3 picks near/far per axis by the
+//! sign bit of `inv_d`, stage 4 (compare unit) accumulates `t_near` from `tmin` and `t_far` from
+//! `tmax` with the variant's comparator ([`SlabNan`]), stage 5 optionally widens the interval by
+//! `widen_ulps` grid steps (the conservative variants), stage 6 decides `hit = t_near <= t_far`.
+//! `t_near` (widened) is the entry distance that orders children.
+//!
+//! Comparators are written out: no `min`/`max` (which treat NaN and ±0 in ways hardware does
+//! not). NaN arises only from `0 × ∞`: the origin exactly on a slab plane of an axis whose
+//! direction component is ±0 (`inv_d = ±∞`).
+
+use crate::format::Format;
+use crate::probe::{NoProbe, Probe};
+use crate::{record, record_flags};
+
+/// What the compare unit does with a NaN slab distance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SlabNan {
+    /// pbrt-v4's form `t = (x > t) ? x : t` (near) and `t = (x < t) ? x : t` (far): a NaN axis
+    /// value loses every compare and is ignored. With a ±0 direction component and the origin
+    /// on that slab's plane, the axis imposes no constraint — exactly right for a closed box.
+    Ignore,
+    /// The form `t = (t >= x) ? t : x` (near) and `t = (t <= x) ? t : x` (far): a NaN axis value
+    /// wins, poisons the interval and the box is missed (rays grazing a face in its plane miss).
+    Poison,
+}
+
+/// How the per-ray reciprocal direction is formed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DirPrep {
+    /// `inv_d = 1 ⊘ d`; a ±0 component gives ±∞.
+    Plain,
+    /// Embree's robust form: a component with |d| < δ is replaced by ±δ (sign of d kept, +δ for
+    /// +0, −δ for −0) before `1 ⊘ d`, δ = 2 ⊘ max-finite rounded up (so 1/δ stays finite);
+    /// no ∞ and no NaN reach the datapath.
+    Embree,
+}
+
+/// Options of a slab unit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SlabConfig {
+    /// NaN comparator convention.
+    pub nan: SlabNan,
+    /// Direction preparation.
+    pub prep: DirPrep,
+    /// Steps of the format's grid `t_near` is moved down and `t_far` up before the decision
+    /// (0 = plain). 4 makes a float datapath with IEEE subnormals conservative (see [`CONSERVATIVE_ULPS`]).
+    pub widen_ulps: u32,
+}
+
+/// Widening that makes the float slab test conservative: the exact t = (b − o)/d and the
+/// computed ((b ⊖ o) ⊗ (1 ⊘ d)) differ by at most γ₃·|t| (three roundings, IEEE subnormals
+/// add at most half a subnormal step each) and γ₃|t| < 4 ulp(t_c) for every computed t_c —
+/// including just below a power of two and across a binade step-down (steps there are halved
+/// but 4 of them still cover 3u·2^e·(1+γ₃)). Overflow to ∞ only widens the interval.
+pub const CONSERVATIVE_ULPS: u32 = 4;
+
+impl Default for SlabConfig {
+    fn default() -> Self {
+        Self {
+            nan: SlabNan::Ignore,
+            prep: DirPrep::Plain,
+            widen_ulps: 0,
+        }
+    }
+}
+
+/// A ray prepared for the slab unit: origin, reciprocal direction, t interval.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SlabRay<V> {
+    /// Origin.
+    pub o: [V; 3],
+    /// 1 ⊘ d per axis (after the direction preparation).
+    pub inv_d: [V; 3],
+    /// Smallest accepted t.
+    pub tmin: V,
+    /// Largest accepted t.
+    pub tmax: V,
+}
+
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Aabb<V> {
+    /// Lower corner.
+    pub min: [V; 3],
+    /// Upper corner.
+    pub max: [V; 3],
+}
+
+/// Output of one ray–box test.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SlabOut<V> {
+    /// The interval is non-empty.
+    pub hit: bool,
+    /// Entry distance (after widening): orders children.
+    pub t_near: V,
+    /// Exit distance (after widening).
+    pub t_far: V,
+}
+
+/// Why a box cannot be stored in a format.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BoxError {
+    /// A coordinate is NaN.
+    Nan,
+    /// min > max on an axis (use [`Slab::empty_box`] for empty slots).
+    Inverted,
+    /// A fixed-point format cannot hold the outward-rounded coordinate.
+    OutOfRange(f64),
+}
+
+impl std::fmt::Display for BoxError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BoxError::Nan => write!(f, "box coordinate is NaN"),
+            BoxError::Inverted => write!(f, "box min exceeds max"),
+            BoxError::OutOfRange(x) => {
+                write!(f, "box coordinate {x} is outside the fixed-point range")
+            }
+        }
+    }
+}
+
+impl std::error::Error for BoxError {}
+
+/// A slab unit in format `F`.
+#[derive(Clone, Copy, Debug)]
+pub struct Slab<F: Format> {
+    /// Compute format (also the box format inside the datapath).
+    pub fmt: F,
+    /// Variant.
+    pub cfg: SlabConfig,
+}
+
+impl<F: Format> Slab<F> {
+    /// A slab unit.
+    pub fn new(fmt: F, cfg: SlabConfig) -> Self {
+        Self { fmt, cfg }
+    }
+
+    /// Stage 0 (once per ray): quantises the ray and forms `inv_d`, reporting its signals.
+    pub fn prepare_trace<P: Probe<F::V>>(
+        &self,
+        o: [f64; 3],
+        d: [f64; 3],
+        tmin: f64,
+        tmax: f64,
+        p: &mut P,
+    ) -> SlabRay<F::V> {
+        let f = &self.fmt;
+        let one = f.one();
+        let [dx, dy, dz] = d.map(|x| f.from_f64(x));
+        let prep = |v: F::V| match self.cfg.prep {
+            DirPrep::Plain => v,
+            DirPrep::Embree => {
+                let delta = self.delta();
+                if f.lt(f.abs(v), delta) {
+                    if f.sign_bit(v) {
+                        f.sub(f.zero(), delta)
+                    } else {
+                        delta
+                    }
+                } else {
+                    v
+                }
+            }
+        };
+        let (pdx, pdy, pdz) = (prep(dx), prep(dy), prep(dz));
+        let inv_dx = f.div(one, pdx);
+        let inv_dy = f.div(one, pdy);
+        let inv_dz = f.div(one, pdz);
+        record!(p; dx, dy, dz, pdx, pdy, pdz, inv_dx, inv_dy, inv_dz);
+        SlabRay {
+            o: o.map(|x| f.from_f64(x)),
+            inv_d: [inv_dx, inv_dy, inv_dz],
+            tmin: f.from_f64(tmin),
+            tmax: f.from_f64(tmax),
+        }
+    }
+
+    /// Stage 0 without probing.
+    pub fn prepare(&self, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64) -> SlabRay<F::V> {
+        self.prepare_trace(o, d, tmin, tmax, &mut NoProbe)
+    }
+
+    /// Embree's δ for this format: 2 ⊘ max-finite, rounded up (1/δ = max/2 stays finite).
+    pub fn delta(&self) -> F::V {
+        let f = &self.fmt;
+        f.round_up(2.0 / f.error_model().max)
+    }
+
+    /// The compare-select of the near chain: `acc` replaced by `x` when x is farther in.
+    #[inline(always)]
+    fn near_sel(&self, acc: F::V, x: F::V) -> F::V {
+        let f = &self.fmt;
+        match self.cfg.nan {
+            SlabNan::Ignore => {
+                if f.lt(acc, x) {
+                    x
+                } else {
+                    acc
+                }
+            }
+            SlabNan::Poison => {
+                if f.le(x, acc) {
+                    acc
+                } else {
+                    x
+                }
+            }
+        }
+    }
+
+    /// The compare-select of the far chain.
+    #[inline(always)]
+    fn far_sel(&self, acc: F::V, x: F::V) -> F::V {
+        let f = &self.fmt;
+        match self.cfg.nan {
+            SlabNan::Ignore => {
+                if f.lt(x, acc) {
+                    x
+                } else {
+                    acc
+                }
+            }
+            SlabNan::Poison => {
+                if f.le(acc, x) {
+                    acc
+                } else {
+                    x
+                }
+            }
+        }
+    }
+
+    /// One ray–box test through every stage, reporting each signal to the probe.
+    #[inline(always)]
+    pub fn trace<P: Probe<F::V>>(
+        &self,
+        r: &SlabRay<F::V>,
+        b: &Aabb<F::V>,
+        p: &mut P,
+    ) -> SlabOut<F::V> {
+        let f = &self.fmt;
+        let [ox, oy, oz] = r.o;
+        let [ix, iy, iz] = r.inv_d;
+        // stage 1: six subtracts
+        let lox = f.sub(b.min[0], ox);
+        let hix = f.sub(b.max[0], ox);
+        let loy = f.sub(b.min[1], oy);
+        let hiy = f.sub(b.max[1], oy);
+        let loz = f.sub(b.min[2], oz);
+        let hiz = f.sub(b.max[2], oz);
+        record!(p; lox, hix, loy, hiy, loz, hiz);
+        // stage 2: six multiplies
+        let tlox = f.mul(lox, ix);
+        let thix = f.mul(hix, ix);
+        let tloy = f.mul(loy, iy);
+        let thiy = f.mul(hiy, iy);
+        let tloz = f.mul(loz, iz);
+        let thiz = f.mul(hiz, iz);
+        record!(p; tlox, thix, tloy, thiy, tloz, thiz);
+        // stage 3: near/far by the sign bit of inv_d
+        let (negx, negy, negz) = (f.sign_bit(ix), f.sign_bit(iy), f.sign_bit(iz));
+        let (nearx, farx) = if negx { (thix, tlox) } else { (tlox, thix) };
+        let (neary, fary) = if negy { (thiy, tloy) } else { (tloy, thiy) };
+        let (nearz, farz) = if negz { (thiz, tloz) } else { (tloz, thiz) };
+        record_flags!(p; negx, negy, negz);
+        record!(p; nearx, farx, neary, fary, nearz, farz);
+        // stage 4: the compare unit, accumulating from tmin / tmax in axis order x, y, z
+        let tn_x = self.near_sel(r.tmin, nearx);
+        let tn_xy = self.near_sel(tn_x, neary);
+        let t_near = self.near_sel(tn_xy, nearz);
+        let tf_x = self.far_sel(r.tmax, farx);
+        let tf_xy = self.far_sel(tf_x, fary);
+        let t_far = self.far_sel(tf_xy, farz);
+        record!(p; tn_x, tn_xy, t_near, tf_x, tf_xy, t_far);
+        // stage 5: widening (conservative variants)
+        let (mut near_w, mut far_w) = (t_near, t_far);
+        for _ in 0..self.cfg.widen_ulps {
+            near_w = f.next_down(near_w);
+            far_w = f.next_up(far_w);
+        }
+        record!(p; near_w, far_w);
+        // stage 6: decision
+        let hit = f.le(near_w, far_w);
+        record_flags!(p; hit);
+        SlabOut {
+            hit,
+            t_near: near_w,
+            t_far: far_w,
+        }
+    }
+
+    /// One ray–box test without probing.
+    #[inline(always)]
+    pub fn test(&self, r: &SlabRay<F::V>, b: &Aabb<F::V>) -> SlabOut<F::V> {
+        self.trace(r, b, &mut NoProbe)
+    }
+
+    /// Stores an f64 box conservatively: min rounded down, max rounded up, so the stored box
+    /// contains the original. Float formats clamp beyond their range to ±∞ (still containing);
+    /// fixed point reports [`BoxError::OutOfRange`].
+    pub fn store_box(&self, min: [f64; 3], max: [f64; 3]) -> Result<Aabb<F::V>, BoxError> {
+        let f = &self.fmt;
+        if min.iter().chain(max.iter()).any(|x| x.is_nan()) {
+            return Err(BoxError::Nan);
+        }
+        if (0..3).any(|a| min[a] > max[a]) {
+            return Err(BoxError::Inverted);
+        }
+        let mut b = Aabb {
+            min: [f.zero(); 3],
+            max: [f.zero(); 3],
+        };
+        for a in 0..3 {
+            b.min[a] = f.round_down(min[a]);
+            b.max[a] = f.round_up(max[a]);
+            if f.to_f64(b.min[a]) > min[a] {
+                return Err(BoxError::OutOfRange(min[a]));
+            }
+            if f.to_f64(b.max[a]) < max[a] {
+                return Err(BoxError::OutOfRange(max[a]));
+            }
+        }
+        Ok(b)
+    }
+
+    /// The empty-slot encoding: min = +largest, max = −largest on every axis (+∞/−∞ in float
+    /// formats); no ray hits it.
+    pub fn empty_box(&self) -> Aabb<F::V> {
+        let f = &self.fmt;
+        let hi = f.from_f64(f64::INFINITY);
+        let lo = f.from_f64(f64::NEG_INFINITY);
+        Aabb {
+            min: [hi; 3],
+            max: [lo; 3],
+        }
+    }
+
+    /// Pairwise batch over structure-of-arrays: ray i against box i. Bit-identical to
+    /// [`Slab::test`]; allocation-free.
+    ///
+    /// # Panics
+    /// If the columns differ in length.
+    pub fn batch(
+        &self,
+        rays: &SlabRaysSoa<F::V>,
+        boxes: &BoxesSoa<F::V>,
+        out: &mut SlabOutSoa<F::V>,
+    ) {
+        let n = rays.tmin.len();
+        assert!(
+            boxes.min[0].len() == n && out.hit.len() == n,
+            "batch lengths differ"
+        );
+        for i in 0..n {
+            let o = self.test(&rays.get(i), &boxes.get(i));
+            out.hit[i] = o.hit;
+            out.t_near[i] = o.t_near;
+            out.t_far[i] = o.t_far;
+        }
+    }
+}
+
+/// Prepared slab rays as structure-of-arrays columns.
+#[derive(Clone, Debug, Default)]
+pub struct SlabRaysSoa<V> {
+    /// Origin columns.
+    pub o: [Vec<V>; 3],
+    /// Reciprocal direction columns.
+    pub inv_d: [Vec<V>; 3],
+    /// tmin column.
+    pub tmin: Vec<V>,
+    /// tmax column.
+    pub tmax: Vec<V>,
+}
+
+impl<V: Copy> SlabRaysSoa<V> {
+    /// Appends a ray.
+    pub fn push(&mut self, r: &SlabRay<V>) {
+        for a in 0..3 {
+            self.o[a].push(r.o[a]);
+            self.inv_d[a].push(r.inv_d[a]);
+        }
+        self.tmin.push(r.tmin);
+        self.tmax.push(r.tmax);
+    }
+    /// Ray i.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> SlabRay<V> {
+        SlabRay {
+            o: [self.o[0][i], self.o[1][i], self.o[2][i]],
+            inv_d: [self.inv_d[0][i], self.inv_d[1][i], self.inv_d[2][i]],
+            tmin: self.tmin[i],
+            tmax: self.tmax[i],
+        }
+    }
+}
+
+/// Boxes as structure-of-arrays columns.
+#[derive(Clone, Debug, Default)]
+pub struct BoxesSoa<V> {
+    /// Lower-corner columns.
+    pub min: [Vec<V>; 3],
+    /// Upper-corner columns.
+    pub max: [Vec<V>; 3],
+}
+
+impl<V: Copy> BoxesSoa<V> {
+    /// Appends a box.
+    pub fn push(&mut self, b: &Aabb<V>) {
+        for a in 0..3 {
+            self.min[a].push(b.min[a]);
+            self.max[a].push(b.max[a]);
+        }
+    }
+    /// Box i.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Aabb<V> {
+        Aabb {
+            min: [self.min[0][i], self.min[1][i], self.min[2][i]],
+            max: [self.max[0][i], self.max[1][i], self.max[2][i]],
+        }
+    }
+}
+
+/// Slab outputs as structure-of-arrays columns.
+#[derive(Clone, Debug, Default)]
+pub struct SlabOutSoa<V> {
+    /// Hit bits.
+    pub hit: Vec<bool>,
+    /// Entry distances.
+    pub t_near: Vec<V>,
+    /// Exit distances.
+    pub t_far: Vec<V>,
+}
+
+impl<V: Copy + Default> SlabOutSoa<V> {
+    /// Output columns for `n` results.
+    pub fn with_len(n: usize) -> Self {
+        Self {
+            hit: vec![false; n],
+            t_near: vec![V::default(); n],
+            t_far: vec![V::default(); n],
+        }
+    }
+}
