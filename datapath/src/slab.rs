@@ -24,9 +24,12 @@ pub enum SlabNan {
     /// value loses every compare and is ignored. With a ±0 direction component and the origin
     /// on that slab's plane, the axis imposes no constraint — exactly right for a closed box.
     Ignore,
-    /// The form `t = (t >= x) ? t : x` (near) and `t = (t <= x) ? t : x` (far): a NaN axis value
-    /// wins, poisons the interval and the box is missed (rays grazing a face in its plane miss).
-    Poison,
+    /// The form `t = (x <= t) ? t : x` (near) and `t = (t <= x) ? t : x` (far): the compare is
+    /// false for a NaN on either side and the operand is taken. A NaN axis value replaces the
+    /// accumulator, and the next axis's value replaces a NaN accumulator: a NaN from the x or y
+    /// axis is dropped (like `Ignore`), a NaN from the z axis (last in the chain) reaches the
+    /// decision and the box is missed. The naive chain's asymmetry, modelled as hardware has it.
+    TakeOnFalse,
 }
 
 /// How the per-ray reciprocal direction is formed.
@@ -48,8 +51,9 @@ pub struct SlabConfig {
     /// Direction preparation.
     pub prep: DirPrep,
     /// Steps of the format's grid `t_near` is moved down and `t_far` up before the decision
-    /// (0 = plain). 4 makes a float datapath with IEEE subnormals conservative (see [`CONSERVATIVE_ULPS`]).
-    pub widen_ulps: u32,
+    /// (0 = plain; negative narrows). 4 makes a float datapath with IEEE subnormals conservative
+    /// (see [`CONSERVATIVE_ULPS`]); −4 makes it never report a hit the exact test misses.
+    pub widen_ulps: i32,
 }
 
 /// Widening that makes the float slab test conservative: the exact t = (b − o)/d and the
@@ -57,7 +61,7 @@ pub struct SlabConfig {
 /// add at most half a subnormal step each) and γ₃|t| < 4 ulp(t_c) for every computed t_c —
 /// including just below a power of two and across a binade step-down (steps there are halved
 /// but 4 of them still cover 3u·2^e·(1+γ₃)). Overflow to ∞ only widens the interval.
-pub const CONSERVATIVE_ULPS: u32 = 4;
+pub const CONSERVATIVE_ULPS: i32 = 4;
 
 impl Default for SlabConfig {
     fn default() -> Self {
@@ -205,7 +209,7 @@ impl<F: Format> Slab<F> {
                     acc
                 }
             }
-            SlabNan::Poison => {
+            SlabNan::TakeOnFalse => {
                 if f.le(x, acc) {
                     acc
                 } else {
@@ -227,7 +231,7 @@ impl<F: Format> Slab<F> {
                     acc
                 }
             }
-            SlabNan::Poison => {
+            SlabNan::TakeOnFalse => {
                 if f.le(acc, x) {
                     acc
                 } else {
@@ -281,9 +285,14 @@ impl<F: Format> Slab<F> {
         record!(p; tn_x, tn_xy, t_near, tf_x, tf_xy, t_far);
         // stage 5: widening (conservative variants)
         let (mut near_w, mut far_w) = (t_near, t_far);
-        for _ in 0..self.cfg.widen_ulps {
-            near_w = f.next_down(near_w);
-            far_w = f.next_up(far_w);
+        for _ in 0..self.cfg.widen_ulps.unsigned_abs() {
+            if self.cfg.widen_ulps > 0 {
+                near_w = f.next_down(near_w);
+                far_w = f.next_up(far_w);
+            } else {
+                near_w = f.next_up(near_w);
+                far_w = f.next_down(far_w);
+            }
         }
         record!(p; near_w, far_w);
         // stage 6: decision
@@ -330,8 +339,24 @@ impl<F: Format> Slab<F> {
         Ok(b)
     }
 
+    /// Stores an f64 box in a (narrower) storage format `S`, outward-rounded, then widens it into
+    /// this compute format, again outward: the datapath's box contains the original (the
+    /// thesis's fp16 bounding volumes with f32 arithmetic).
+    pub fn store_box_via<S: Format>(
+        &self,
+        s: &S,
+        min: [f64; 3],
+        max: [f64; 3],
+    ) -> Result<Aabb<F::V>, BoxError> {
+        let stored = Slab::new(*s, self.cfg).store_box(min, max)?;
+        let lo = stored.min.map(|v| s.to_f64(v));
+        let hi = stored.max.map(|v| s.to_f64(v));
+        self.store_box(lo, hi)
+    }
+
     /// The empty-slot encoding: min = +largest, max = −largest on every axis (+∞/−∞ in float
-    /// formats); no ray hits it.
+    /// formats); no ray whose origin and direction are finite in the format hits it (a ray that
+    /// overflowed the format makes ∞ − ∞ or ∞ × 0, a NaN the comparator may ignore).
     pub fn empty_box(&self) -> Aabb<F::V> {
         let f = &self.fmt;
         let hi = f.from_f64(f64::INFINITY);
