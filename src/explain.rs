@@ -145,3 +145,66 @@ pub fn explain<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> String {
     );
     s
 }
+
+/// Renders every slab signal of one ray–box test (value and hex bits), the f64 reference and
+/// the exact decision.
+pub fn explain_slab<F: Format>(
+    s: &datapath::slab::Slab<F>,
+    ray: &Ray64,
+    lo: [f64; 3],
+    hi: [f64; 3],
+) -> Result<String, String> {
+    let f = &s.fmt;
+    let b = s.store_box(lo, hi).map_err(|e| e.to_string())?;
+    let mut rec = Recorder::new();
+    let r = s.prepare_trace(ray.o, ray.d, ray.tmin, ray.tmax, &mut rec);
+    let out = s.trace(&r, &b, &mut rec);
+    let mut t = String::new();
+    let _ = writeln!(t, "format {}  variant {:?}", f.name(), s.cfg);
+    let _ = writeln!(
+        t,
+        "stored box (outward-rounded): min {:?} max {:?}",
+        b.min.map(|v| f.to_f64(v)),
+        b.max.map(|v| f.to_f64(v))
+    );
+    let _ = writeln!(
+        t,
+        "  bits min {} {} {}  max {} {} {}",
+        f.hex(b.min[0]),
+        f.hex(b.min[1]),
+        f.hex(b.min[2]),
+        f.hex(b.max[0]),
+        f.hex(b.max[1]),
+        f.hex(b.max[2])
+    );
+    let _ = writeln!(t, "\n{:<8} {:>24} {:>17}", "signal", "value", "bits");
+    for (name, sig) in &rec.signals {
+        match sig {
+            Signal::Value(v) => {
+                let _ = writeln!(
+                    t,
+                    "{:<8} {:>24} {:>17}",
+                    name,
+                    format!("{:e}", f.to_f64(*v)),
+                    f.hex(*v)
+                );
+            }
+            Signal::Flag(x) => {
+                let _ = writeln!(t, "{:<8} {:>24} {:>17}", name, x, *x as u8);
+            }
+        }
+    }
+    let q = |x: f64| f.to_f64(f.from_f64(x));
+    let (oq, dq) = (ray.o.map(q), ray.d.map(q));
+    let g = golden::slab_f64(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi);
+    let exact = golden::slab_exact(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi);
+    let _ = writeln!(
+        t,
+        "\nmodel : hit {} t_near {:e} t_far {:e}",
+        out.hit,
+        f.to_f64(out.t_near),
+        f.to_f64(out.t_far)
+    );
+    let _ = writeln!(t, "golden: hit {} t_near {:e} t_far {:e} (f64, quantised ray, original box); exact decision: hit {}", g.hit, g.t_near, g.t_far, exact);
+    Ok(t)
+}

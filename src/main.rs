@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use datapath::format::DivMode;
 use datapath::rti::{stage_table, Cull, Op, Rti, RtiConfig, TieRule};
+use datapath::slab::{Slab, SlabConfig};
 use datapath::{with_format, AnyFormat};
 use golden::{Ray64, Tri64};
 use raypipe::scene::Scene;
@@ -95,17 +96,26 @@ struct VerifyArgs {
 enum Cmd {
     /// Run every format's RTI model against the golden reference (the default command).
     Verify(VerifyArgs),
-    /// Print every stage signal of one ray–triangle test beside the binary64 twin and the golden.
+    /// Print every stage signal of one ray–triangle (or ray–box) test beside the references.
     Explain {
+        /// Unit: rti or slab.
+        #[arg(long, default_value = "rti")]
+        unit: String,
         /// Format name.
         #[arg(long, value_parser = parse_format)]
         format: AnyFormat,
         /// Ray: ox,oy,oz,dx,dy,dz.
         #[arg(long, allow_hyphen_values = true)]
         ray: String,
-        /// Triangle: x0,y0,z0,x1,y1,z1,x2,y2,z2.
+        /// Triangle (unit rti): x0,y0,z0,x1,y1,z1,x2,y2,z2.
         #[arg(long, allow_hyphen_values = true)]
-        tri: String,
+        tri: Option<String>,
+        /// Box (unit slab): minx,miny,minz,maxx,maxy,maxz.
+        #[arg(long = "box", allow_hyphen_values = true)]
+        aabb: Option<String>,
+        /// Slab variant: plain, conservative, take-on-false, embree.
+        #[arg(long, default_value = "plain")]
+        variant: String,
         /// Smallest accepted t.
         #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
         tmin: f64,
@@ -214,16 +224,18 @@ fn run() -> Result<bool, String> {
         }),
         Some(Cmd::Verify(a)) => run_verify(a),
         Some(Cmd::Explain {
+            unit,
             format,
             ray,
             tri,
+            aabb,
+            variant,
             tmin,
             tmax,
             rti,
         }) => {
             let cfg = rti.config()?;
             let r = parse_list("--ray", &ray, 6)?;
-            let t = parse_list("--tri", &tri, 9)?;
             if tmin.is_nan() || tmax.is_nan() {
                 return Err("--tmin/--tmax must not be NaN".into());
             }
@@ -233,13 +245,36 @@ fn run() -> Result<bool, String> {
                 tmin,
                 tmax,
             };
-            let tri = Tri64 {
-                v: [[t[0], t[1], t[2]], [t[3], t[4], t[5]], [t[6], t[7], t[8]]],
-            };
-            with_format!(format, |f| print!(
-                "{}",
-                raypipe::explain::explain(&Rti::new(f, cfg), &ray, &tri)
-            ));
+            match unit.as_str() {
+                "rti" => {
+                    let t =
+                        parse_list("--tri", tri.as_deref().ok_or("--unit rti needs --tri")?, 9)?;
+                    let tri = Tri64 {
+                        v: [[t[0], t[1], t[2]], [t[3], t[4], t[5]], [t[6], t[7], t[8]]],
+                    };
+                    with_format!(format, |f| print!(
+                        "{}",
+                        raypipe::explain::explain(&Rti::new(f, cfg), &ray, &tri)
+                    ));
+                }
+                "slab" => {
+                    let b = parse_list(
+                        "--box",
+                        aabb.as_deref().ok_or("--unit slab needs --box")?,
+                        6,
+                    )?;
+                    let sc = SlabConfig::named(&variant)?;
+                    let (lo, hi) = ([b[0], b[1], b[2]], [b[3], b[4], b[5]]);
+                    let text = with_format!(format, |f| raypipe::explain::explain_slab(
+                        &Slab::new(f, sc),
+                        &ray,
+                        lo,
+                        hi
+                    ))?;
+                    print!("{text}");
+                }
+                other => return Err(format!("unknown unit '{other}'; units: rti, slab")),
+            }
             Ok(true)
         }
         Some(Cmd::Stages { div }) => {

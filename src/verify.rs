@@ -82,6 +82,8 @@ pub struct VerifyReport {
     pub tests_per_ray: usize,
     /// Per-format results.
     pub formats: Vec<FormatReport>,
+    /// Slab unit results per format and variant.
+    pub slab: Vec<SlabReport>,
     /// No property failed.
     pub passed: bool,
 }
@@ -261,6 +263,8 @@ pub fn verify(cfg: &VerifyConfig, scene: &Scene) -> VerifyReport {
         .iter()
         .map(|f| with_format!(*f, |f| run_format(f, cfg, scene, &rays, &lists)))
         .collect();
+    let slab = verify_slab(cfg, scene);
+    let slab_ok = slab.iter().all(|r| !r.conservative || r.false_misses == 0);
     VerifyReport {
         scene: scene.name.clone(),
         triangles: scene.tris.len(),
@@ -268,8 +272,9 @@ pub fn verify(cfg: &VerifyConfig, scene: &Scene) -> VerifyReport {
         rays: rays.len(),
         seed: cfg.seed,
         tests_per_ray: lists.first().map_or(0, Vec::len),
-        passed: formats.iter().all(|f| f.violations == 0),
+        passed: formats.iter().all(|f| f.violations == 0) && slab_ok,
         formats,
+        slab,
     }
 }
 
@@ -316,6 +321,7 @@ pub fn render(r: &VerifyReport) -> String {
         );
     }
     s += "\nf-miss/f-hit: model vs golden f64 on the same quantised inputs; viol: decisive tests (error bound clear of every threshold) where hit/miss differs or the t error exceeds its bound.\n";
+    s += &render_slab(&r.slab);
     if r.passed {
         s += "property: PASS (no violations)\n";
     } else {
@@ -328,6 +334,151 @@ pub fn render(r: &VerifyReport) -> String {
                 f.first_violation.as_deref().unwrap_or("")
             );
         }
+    }
+    s
+}
+
+/// Slab results for one format and variant.
+#[derive(Clone, Debug, Serialize)]
+pub struct SlabReport {
+    /// Format name.
+    pub format: String,
+    /// Variant name.
+    pub variant: String,
+    /// The variant promises zero false misses.
+    pub conservative: bool,
+    /// Ray–box tests run.
+    pub tests: u64,
+    /// Exact hits (rational decision on the quantised ray and the original box).
+    pub exact_hits: u64,
+    /// Model miss where the exact test hits.
+    pub false_misses: u64,
+    /// Model hit where the exact test misses.
+    pub false_hits: u64,
+    /// Tests settled by the exact rational decision (near the boundary or disagreeing with f64).
+    pub exact_calls: u64,
+    /// Model throughput of the batch path, million tests per second (one thread).
+    pub mtests_per_s: f64,
+}
+
+/// Runs the slab unit on every (ray, box) pair: the boxes are the bounding boxes of the
+/// triangles each ray is tested against (axis-aligned walls give zero-extent boxes).
+pub fn verify_slab(cfg: &VerifyConfig, scene: &Scene) -> Vec<SlabReport> {
+    let rays = scene.rays(cfg.rays, cfg.seed);
+    let lists = test_lists(scene, &rays, cfg.sample, cfg.seed);
+    let boxes: Vec<([f64; 3], [f64; 3])> = scene
+        .tris
+        .iter()
+        .map(|t| {
+            let lo =
+                std::array::from_fn(|a| t.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min));
+            let hi =
+                std::array::from_fn(|a| t.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max));
+            (lo, hi)
+        })
+        .collect();
+    let mut out = Vec::new();
+    for f in &cfg.formats {
+        for v in datapath::slab::SLAB_VARIANTS {
+            let sc = datapath::slab::SlabConfig::named(v).expect("built-in variant");
+            out.push(with_format!(*f, |f| slab_one(
+                f, v, sc, &rays, &lists, &boxes
+            )));
+        }
+    }
+    out
+}
+
+fn slab_one<F: Format>(
+    f: F,
+    name: &str,
+    sc: datapath::slab::SlabConfig,
+    rays: &[(Ray64, usize)],
+    lists: &[Vec<usize>],
+    boxes: &[([f64; 3], [f64; 3])],
+) -> SlabReport {
+    use datapath::slab::{BoxesSoa, Slab, SlabOutSoa, SlabRaysSoa};
+    let s = Slab::new(f, sc);
+    let stored: Vec<_> = boxes
+        .iter()
+        .map(|(lo, hi)| s.store_box(*lo, *hi).unwrap_or_else(|_| s.empty_box()))
+        .collect();
+    let mut rep = SlabReport {
+        format: f.name(),
+        variant: name.to_string(),
+        conservative: sc.widen_ulps >= datapath::slab::CONSERVATIVE_ULPS
+            && matches!(f.kind(), datapath::format::FormatKind::Float(_)),
+        tests: 0,
+        exact_hits: 0,
+        false_misses: 0,
+        false_hits: 0,
+        exact_calls: 0,
+        mtests_per_s: 0.0,
+    };
+    let (mut rs, mut bs) = (SlabRaysSoa::default(), BoxesSoa::default());
+    for ((ray, _), list) in rays.iter().zip(lists) {
+        let sr = s.prepare(ray.o, ray.d, ray.tmin, ray.tmax);
+        let q = |x: f64| f.to_f64(f.from_f64(x));
+        let (oq, dq) = (ray.o.map(q), ray.d.map(q));
+        for &i in list {
+            let (lo, hi) = boxes[i];
+            let hit = s.test(&sr, &stored[i]).hit;
+            rs.push(&sr);
+            bs.push(&stored[i]);
+            let g = golden::slab_f64(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi);
+            let scale = 1.0f64.max(g.t_near.abs()).max(if g.t_far.is_finite() {
+                g.t_far.abs()
+            } else {
+                0.0
+            });
+            let close = (g.t_far - g.t_near).abs() <= 1e-9 * scale;
+            let exact = if close || g.hit != hit {
+                rep.exact_calls += 1;
+                golden::slab_exact(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi)
+            } else {
+                g.hit
+            };
+            rep.tests += 1;
+            rep.exact_hits += exact as u64;
+            rep.false_misses += (exact && !hit) as u64;
+            rep.false_hits += (!exact && hit) as u64;
+        }
+    }
+    let mut out = SlabOutSoa::with_len(rs.tmin.len());
+    let t0 = Instant::now();
+    s.batch(&rs, &bs, &mut out);
+    let secs = t0.elapsed().as_secs_f64();
+    std::hint::black_box(&out);
+    rep.mtests_per_s = if secs > 0.0 {
+        rep.tests as f64 / secs / 1e6
+    } else {
+        0.0
+    };
+    rep
+}
+
+/// The slab results as a text table.
+pub fn render_slab(rows: &[SlabReport]) -> String {
+    let mut s = format!(
+        "\nslab (BVI) unit: boxes = bounding boxes of the tested triangles; false misses / hits against the exact rational decision\n\n{:<16} {:<14} {:>9} {:>9} {:>8} {:>8} {:>9}\n",
+        "format", "variant", "tests", "exact-hit", "f-miss", "f-hit", "Mtests/s"
+    );
+    for r in rows {
+        s += &format!(
+            "{:<16} {:<14} {:>9} {:>9} {:>8} {:>8} {:>9.2}{}\n",
+            r.format,
+            r.variant,
+            r.tests,
+            r.exact_hits,
+            r.false_misses,
+            r.false_hits,
+            r.mtests_per_s,
+            if r.conservative && r.false_misses > 0 {
+                "  <- VIOLATION: conservative variant missed"
+            } else {
+                ""
+            }
+        );
     }
     s
 }

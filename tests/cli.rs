@@ -262,3 +262,80 @@ fn stages_prints_the_stage_table() {
     assert!(out.contains("| 8 | `inv_det` | div | one ÷ det |"), "{out}");
     assert_eq!(raypipe(&["stages", "--div", "fast"]).status.code(), Some(2));
 }
+
+#[test]
+fn explain_slab_prints_the_stage_signals_and_the_exact_decision() {
+    // origin on the x = -0.5 face, direction +0 in x: 0 x inf = NaN, ignored by the plain variant
+    let args = [
+        "explain",
+        "--unit",
+        "slab",
+        "--format",
+        "fp16",
+        "--ray",
+        "-0.5,0.25,0.25,0,1,1",
+        "--box",
+        "-0.5,-0.5,-0.5,0.5,0.5,0.5",
+    ];
+    let o = raypipe(&args);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        out.lines()
+            .any(|l| l.starts_with("tlox") && l.ends_with("7e00")),
+        "{out}"
+    );
+    assert!(
+        out.contains("model : hit true") && out.contains("exact decision: hit true"),
+        "{out}"
+    );
+    let mut bad = args.to_vec();
+    let last = bad.len() - 1;
+    bad[last] = "1,1,1,0,0,0";
+    assert_clear_error(&raypipe(&bad), "box min exceeds max");
+    let mut v = args.to_vec();
+    v.extend(["--variant", "sloppy"]);
+    assert_clear_error(&raypipe(&v), "unknown slab variant");
+    assert_clear_error(
+        &raypipe(&[
+            "explain",
+            "--unit",
+            "bvh",
+            "--format",
+            "f32",
+            "--ray",
+            "0,0,0,1,0,0",
+        ]),
+        "unknown unit",
+    );
+    assert_clear_error(
+        &raypipe(&[
+            "explain",
+            "--unit",
+            "slab",
+            "--format",
+            "f32",
+            "--ray",
+            "0,0,0,1,0,0",
+        ]),
+        "needs --box",
+    );
+}
+
+#[test]
+fn verify_json_has_the_slab_table() {
+    let o = raypipe(&["verify", "--rays", "16", "--format", "f32,fp16", "--json"]);
+    assert!(o.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let slab = v["slab"].as_array().unwrap();
+    assert_eq!(slab.len(), 2 * 4);
+    for r in slab {
+        assert_eq!(r["tests"], 16 * 368);
+        if r["conservative"] == true {
+            assert_eq!(r["false_misses"], 0, "{r}");
+        }
+    }
+    assert!(slab.iter().any(|r| r["variant"] == "conservative"
+        && r["format"] == "fp16"
+        && r["conservative"] == true));
+}

@@ -63,6 +63,33 @@ pub struct SlabConfig {
 /// but 4 of them still cover 3u·2^e·(1+γ₃)). Overflow to ∞ only widens the interval.
 pub const CONSERVATIVE_ULPS: i32 = 4;
 
+/// The named slab variants: `plain` (Ignore, Plain, 0), `conservative` (Ignore, Plain, +4),
+/// `take-on-false` (TakeOnFalse, Plain, 0), `embree` (Ignore, Embree, 0).
+pub const SLAB_VARIANTS: [&str; 4] = ["plain", "conservative", "take-on-false", "embree"];
+
+impl SlabConfig {
+    /// A named variant (see [`SLAB_VARIANTS`]).
+    pub fn named(name: &str) -> Result<Self, String> {
+        let c = |nan, prep, widen_ulps| {
+            Ok(SlabConfig {
+                nan,
+                prep,
+                widen_ulps,
+            })
+        };
+        match name {
+            "plain" => c(SlabNan::Ignore, DirPrep::Plain, 0),
+            "conservative" => c(SlabNan::Ignore, DirPrep::Plain, CONSERVATIVE_ULPS),
+            "take-on-false" => c(SlabNan::TakeOnFalse, DirPrep::Plain, 0),
+            "embree" => c(SlabNan::Ignore, DirPrep::Embree, 0),
+            other => Err(format!(
+                "unknown slab variant '{other}'; variants: {}",
+                SLAB_VARIANTS.join(", ")
+            )),
+        }
+    }
+}
+
 impl Default for SlabConfig {
     fn default() -> Self {
         Self {
