@@ -19,11 +19,7 @@ fn cases() -> Vec<(Ray64, Tri64)> {
         .rays(N, 42)
         .into_iter()
         .map(|(ray, target)| {
-            let i = if r.below(2) == 0 {
-                target
-            } else {
-                r.below(scene.tris.len() as u64) as usize
-            };
+            let i = if r.below(2) == 0 { target } else { r.below(scene.tris.len() as u64) as usize };
             (ray, scene.tris[i])
         })
         .collect()
@@ -52,9 +48,7 @@ fn bench_models(c: &mut Criterion) {
         b.iter(|| {
             cases
                 .iter()
-                .filter(|(ray, tri)| {
-                    golden::intersect(black_box(ray), black_box(tri), Faces::default()).hit
-                })
+                .filter(|(ray, tri)| golden::intersect(black_box(ray), black_box(tri), Faces::default()).hit)
                 .count()
         })
     });
@@ -67,22 +61,12 @@ fn bench_models(c: &mut Criterion) {
         })
         .collect();
     g.bench_function("plain_scalar_f32_mt", |b| {
-        b.iter(|| {
-            c32.iter()
-                .filter(|(r, t)| plain_mt(black_box(r), black_box(t)).is_some())
-                .count()
-        })
+        b.iter(|| c32.iter().filter(|(r, t)| plain_mt(black_box(r), black_box(t)).is_some()).count())
     });
-    let c16: Vec<([f16; 6], [f16; 9])> = c32
-        .iter()
-        .map(|(r, t)| (r.map(f16::from_f32), t.map(f16::from_f32)))
-        .collect();
+    let c16: Vec<([f16; 6], [f16; 9])> =
+        c32.iter().map(|(r, t)| (r.map(f16::from_f32), t.map(f16::from_f32))).collect();
     g.bench_function("half_scalar_fp16_mt", |b| {
-        b.iter(|| {
-            c16.iter()
-                .filter(|(r, t)| plain_mt(black_box(r), black_box(t)).is_some())
-                .count()
-        })
+        b.iter(|| c16.iter().filter(|(r, t)| plain_mt(black_box(r), black_box(t)).is_some()).count())
     });
     g.finish();
 }
@@ -101,13 +85,8 @@ where
     let zero = T::from(0u8);
     let one = T::from(1u8);
     let sub = |a: [T; 3], b: [T; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let cross = |a: [T; 3], b: [T; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
+    let cross =
+        |a: [T; 3], b: [T; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
     let dot = |a: [T; 3], b: [T; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let (o, d) = ([r[0], r[1], r[2]], [r[3], r[4], r[5]]);
     let (v0, v1, v2) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]);

@@ -15,59 +15,24 @@ pub fn explain<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> String {
     let f = &rti.fmt;
     let (rq, tq) = quantise(rti, ray, tri);
     let mut rec = Recorder::new();
-    let out = rti.trace(
-        &rti.ray(ray.o, ray.d, ray.tmin, ray.tmax),
-        &rti.tri(tri.v),
-        &mut rec,
-    );
+    let out = rti.trace(&rti.ray(ray.o, ray.d, ray.tmin, ray.tmax), &rti.tri(tri.v), &mut rec);
     // the same datapath in binary64 on the quantised inputs
-    let twin_fmt = Ieee::new(
-        Soft(FloatLayout::BINARY64),
-        FpOpts {
-            div: f.div_mode(),
-            ..FpOpts::default()
-        },
-    );
-    let twin = Rti::new(
-        twin_fmt,
-        RtiConfig {
-            cull: rti.cull,
-            det_threshold: f.to_f64(rti.det_thr),
-            tie: rti.tie,
-        },
-    );
+    let twin_fmt = Ieee::new(Soft(FloatLayout::BINARY64), FpOpts { div: f.div_mode(), ..FpOpts::default() });
+    let twin = Rti::new(twin_fmt, RtiConfig { cull: rti.cull, det_threshold: f.to_f64(rti.det_thr), tie: rti.tie });
     let mut trec = Recorder::new();
-    twin.trace(
-        &twin.ray(rq.o, rq.d, rq.tmin, rq.tmax),
-        &twin.tri(tq.v),
-        &mut trec,
-    );
+    twin.trace(&twin.ray(rq.o, rq.d, rq.tmin, rq.tmax), &twin.tri(tq.v), &mut trec);
 
     let mut s = String::new();
     let _ = writeln!(s, "format {}  ({} bits per value)", f.name(), f.width());
-    let _ = writeln!(
-        s,
-        "inputs (quantised; hex = the bits an RTL testbench drives):"
-    );
+    let _ = writeln!(s, "inputs (quantised; hex = the bits an RTL testbench drives):");
     let names = ["ox", "oy", "oz", "dx", "dy", "dz"];
     let vals: Vec<f64> = rq.o.iter().chain(rq.d.iter()).copied().collect();
     for (n, v) in names.iter().zip(vals) {
-        let _ = writeln!(
-            s,
-            "  {n:<5} {:>24} {}",
-            format!("{v:e}"),
-            f.hex(f.from_f64(v))
-        );
+        let _ = writeln!(s, "  {n:<5} {:>24} {}", format!("{v:e}"), f.hex(f.from_f64(v)));
     }
     for (k, p) in tq.v.iter().enumerate() {
         for (a, v) in p.iter().enumerate() {
-            let _ = writeln!(
-                s,
-                "  v{k}{}   {:>24} {}",
-                ["x", "y", "z"][a],
-                format!("{v:e}"),
-                f.hex(f.from_f64(*v))
-            );
+            let _ = writeln!(s, "  v{k}{}   {:>24} {}", ["x", "y", "z"][a], format!("{v:e}"), f.hex(f.from_f64(*v)));
         }
     }
     let _ = writeln!(
@@ -86,11 +51,8 @@ pub fn explain<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> String {
         match (rec.get(d.name), trec.get(d.name)) {
             (Some(Signal::Value(v)), Some(Signal::Value(w))) => {
                 let (x, y) = (f.to_f64(v), f64::from_bits(w));
-                let diff = if x.is_finite() && y.is_finite() {
-                    format!("{:.2}", (x - y) / f.ulp(y))
-                } else {
-                    "-".into()
-                };
+                let diff =
+                    if x.is_finite() && y.is_finite() { format!("{:.2}", (x - y) / f.ulp(y)) } else { "-".into() };
                 let _ = writeln!(
                     s,
                     "{:>2}  {:<8} {:<18} {:>24} {:>17} {:>24} {:>10}",
@@ -181,13 +143,7 @@ pub fn explain_slab<F: Format>(
     for (name, sig) in &rec.signals {
         match sig {
             Signal::Value(v) => {
-                let _ = writeln!(
-                    t,
-                    "{:<8} {:>24} {:>17}",
-                    name,
-                    format!("{:e}", f.to_f64(*v)),
-                    f.hex(*v)
-                );
+                let _ = writeln!(t, "{:<8} {:>24} {:>17}", name, format!("{:e}", f.to_f64(*v)), f.hex(*v));
             }
             Signal::Flag(x) => {
                 let _ = writeln!(t, "{:<8} {:>24} {:>17}", name, x, *x as u8);
@@ -198,13 +154,11 @@ pub fn explain_slab<F: Format>(
     let (oq, dq) = (ray.o.map(q), ray.d.map(q));
     let g = golden::slab_f64(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi);
     let exact = golden::slab_exact(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi);
+    let _ = writeln!(t, "\nmodel : hit {} t_near {:e} t_far {:e}", out.hit, f.to_f64(out.t_near), f.to_f64(out.t_far));
     let _ = writeln!(
         t,
-        "\nmodel : hit {} t_near {:e} t_far {:e}",
-        out.hit,
-        f.to_f64(out.t_near),
-        f.to_f64(out.t_far)
+        "golden: hit {} t_near {:e} t_far {:e} (f64, quantised ray, original box); exact decision: hit {}",
+        g.hit, g.t_near, g.t_far, exact
     );
-    let _ = writeln!(t, "golden: hit {} t_near {:e} t_far {:e} (f64, quantised ray, original box); exact decision: hit {}", g.hit, g.t_near, g.t_far, exact);
     Ok(t)
 }

@@ -33,17 +33,10 @@ impl Judged {
             return None;
         }
         if self.hit != self.golden.hit || self.golden.hit != self.exact_hit {
-            return Some(format!(
-                "hit/miss: model {} golden {} exact {}",
-                self.hit, self.golden.hit, self.exact_hit
-            ));
+            return Some(format!("hit/miss: model {} golden {} exact {}", self.hit, self.golden.hit, self.exact_hit));
         }
         if self.hit && self.t_error() > self.t_err + self.golden.t.abs() * 1e-12 {
-            return Some(format!(
-                "t error {:e} exceeds bound {:e}",
-                self.t_error(),
-                self.t_err
-            ));
+            return Some(format!("t error {:e} exceeds bound {:e}", self.t_error(), self.t_err));
         }
         None
     }
@@ -55,10 +48,7 @@ impl Judged {
 
 /// The golden's face options matching an RTI unit.
 pub fn faces<F: Format>(rti: &Rti<F>) -> Faces {
-    Faces {
-        cull: rti.cull == Cull::Backface,
-        det_threshold: rti.fmt.to_f64(rti.det_thr),
-    }
+    Faces { cull: rti.cull == Cull::Backface, det_threshold: rti.fmt.to_f64(rti.det_thr) }
 }
 
 /// Quantises the f64 ray and triangle into the format and back (what the hardware sees).
@@ -66,15 +56,8 @@ pub fn quantise<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> (Ray64, Tr
     let f = &rti.fmt;
     let q = |x: f64| f.to_f64(f.from_f64(x));
     (
-        Ray64 {
-            o: ray.o.map(q),
-            d: ray.d.map(q),
-            tmin: q(ray.tmin),
-            tmax: q(ray.tmax),
-        },
-        Tri64 {
-            v: tri.v.map(|p| p.map(q)),
-        },
+        Ray64 { o: ray.o.map(q), d: ray.d.map(q), tmin: q(ray.tmin), tmax: q(ray.tmax) },
+        Tri64 { v: tri.v.map(|p| p.map(q)) },
     )
 }
 

@@ -47,17 +47,10 @@ struct RtiArgs {
 impl RtiArgs {
     fn config(&self) -> Result<RtiConfig, String> {
         if !(self.det_threshold >= 0.0 && self.det_threshold.is_finite()) {
-            return Err(format!(
-                "--det-threshold must be a finite number >= 0, got {}",
-                self.det_threshold
-            ));
+            return Err(format!("--det-threshold must be a finite number >= 0, got {}", self.det_threshold));
         }
         Ok(RtiConfig {
-            cull: if self.cull {
-                Cull::Backface
-            } else {
-                Cull::TwoSided
-            },
+            cull: if self.cull { Cull::Backface } else { Cull::TwoSided },
             det_threshold: self.det_threshold,
             tie: match self.tie {
                 Tie::First => TieRule::First,
@@ -140,17 +133,10 @@ fn parse_format(s: &str) -> Result<AnyFormat, String> {
 fn parse_list(what: &str, s: &str, n: usize) -> Result<Vec<f64>, String> {
     let v: Vec<f64> = s
         .split(',')
-        .map(|t| {
-            t.trim()
-                .parse::<f64>()
-                .map_err(|_| format!("{what}: '{t}' is not a number"))
-        })
+        .map(|t| t.trim().parse::<f64>().map_err(|_| format!("{what}: '{t}' is not a number")))
         .collect::<Result<_, _>>()?;
     if v.len() != n {
-        return Err(format!(
-            "{what}: expected {n} comma-separated numbers, got {}",
-            v.len()
-        ));
+        return Err(format!("{what}: expected {n} comma-separated numbers, got {}", v.len()));
     }
     if let Some(x) = v.iter().find(|x| !x.is_finite()) {
         return Err(format!("{what}: coordinates must be finite, got {x}"));
@@ -165,26 +151,14 @@ fn run_verify(a: VerifyArgs) -> Result<bool, String> {
         None => Scene::builtin(),
     };
     let formats = if a.format.is_empty() {
-        DEFAULT_FORMATS
-            .iter()
-            .map(|f| f.parse().expect("built-in format name"))
-            .collect()
+        DEFAULT_FORMATS.iter().map(|f| f.parse().expect("built-in format name")).collect()
     } else {
         a.format
     };
-    let cfg = VerifyConfig {
-        formats,
-        rays: a.rays as usize,
-        seed: a.seed,
-        rti,
-        sample: a.sample as usize,
-    };
+    let cfg = VerifyConfig { formats, rays: a.rays as usize, seed: a.seed, rti, sample: a.sample as usize };
     let rep = verify(&cfg, &scene);
     if a.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&rep).map_err(|e| e.to_string())?
-        );
+        println!("{}", serde_json::to_string_pretty(&rep).map_err(|e| e.to_string())?);
     } else {
         print!("{}", render(&rep));
     }
@@ -216,61 +190,28 @@ fn run() -> Result<bool, String> {
             seed: 1,
             sample: 512,
             json: false,
-            rti: RtiArgs {
-                cull: false,
-                det_threshold: 0.0,
-                tie: Tie::First,
-            },
+            rti: RtiArgs { cull: false, det_threshold: 0.0, tie: Tie::First },
         }),
         Some(Cmd::Verify(a)) => run_verify(a),
-        Some(Cmd::Explain {
-            unit,
-            format,
-            ray,
-            tri,
-            aabb,
-            variant,
-            tmin,
-            tmax,
-            rti,
-        }) => {
+        Some(Cmd::Explain { unit, format, ray, tri, aabb, variant, tmin, tmax, rti }) => {
             let cfg = rti.config()?;
             let r = parse_list("--ray", &ray, 6)?;
             if tmin.is_nan() || tmax.is_nan() {
                 return Err("--tmin/--tmax must not be NaN".into());
             }
-            let ray = Ray64 {
-                o: [r[0], r[1], r[2]],
-                d: [r[3], r[4], r[5]],
-                tmin,
-                tmax,
-            };
+            let ray = Ray64 { o: [r[0], r[1], r[2]], d: [r[3], r[4], r[5]], tmin, tmax };
             match unit.as_str() {
                 "rti" => {
-                    let t =
-                        parse_list("--tri", tri.as_deref().ok_or("--unit rti needs --tri")?, 9)?;
-                    let tri = Tri64 {
-                        v: [[t[0], t[1], t[2]], [t[3], t[4], t[5]], [t[6], t[7], t[8]]],
-                    };
-                    with_format!(format, |f| print!(
-                        "{}",
-                        raypipe::explain::explain(&Rti::new(f, cfg), &ray, &tri)
-                    ));
+                    let t = parse_list("--tri", tri.as_deref().ok_or("--unit rti needs --tri")?, 9)?;
+                    let tri = Tri64 { v: [[t[0], t[1], t[2]], [t[3], t[4], t[5]], [t[6], t[7], t[8]]] };
+                    with_format!(format, |f| print!("{}", raypipe::explain::explain(&Rti::new(f, cfg), &ray, &tri)));
                 }
                 "slab" => {
-                    let b = parse_list(
-                        "--box",
-                        aabb.as_deref().ok_or("--unit slab needs --box")?,
-                        6,
-                    )?;
+                    let b = parse_list("--box", aabb.as_deref().ok_or("--unit slab needs --box")?, 6)?;
                     let sc = SlabConfig::named(&variant)?;
                     let (lo, hi) = ([b[0], b[1], b[2]], [b[3], b[4], b[5]]);
-                    let text = with_format!(format, |f| raypipe::explain::explain_slab(
-                        &Slab::new(f, sc),
-                        &ray,
-                        lo,
-                        hi
-                    ))?;
+                    let text =
+                        with_format!(format, |f| raypipe::explain::explain_slab(&Slab::new(f, sc), &ray, lo, hi))?;
                     print!("{text}");
                 }
                 other => return Err(format!("unknown unit '{other}'; units: rti, slab")),

@@ -49,108 +49,26 @@ type Quad = [[f64; 3]; 4];
 /// The Cornell box (Cornell Program of Computer Graphics measurements, in mm): walls, light,
 /// and the two blocks, as quads.
 const CORNELL: [Quad; 16] = [
-    [
-        [552.8, 0.0, 0.0],
-        [0.0, 0.0, 0.0],
-        [0.0, 0.0, 559.2],
-        [549.6, 0.0, 559.2],
-    ], // floor
-    [
-        [343.0, 548.0, 227.0],
-        [343.0, 548.0, 332.0],
-        [213.0, 548.0, 332.0],
-        [213.0, 548.0, 227.0],
-    ], // light
-    [
-        [556.0, 548.8, 0.0],
-        [556.0, 548.8, 559.2],
-        [0.0, 548.8, 559.2],
-        [0.0, 548.8, 0.0],
-    ], // ceiling
-    [
-        [549.6, 0.0, 559.2],
-        [0.0, 0.0, 559.2],
-        [0.0, 548.8, 559.2],
-        [556.0, 548.8, 559.2],
-    ], // back wall
-    [
-        [0.0, 0.0, 559.2],
-        [0.0, 0.0, 0.0],
-        [0.0, 548.8, 0.0],
-        [0.0, 548.8, 559.2],
-    ], // green wall
-    [
-        [552.8, 0.0, 0.0],
-        [549.6, 0.0, 559.2],
-        [556.0, 548.8, 559.2],
-        [556.0, 548.8, 0.0],
-    ], // red wall
-    [
-        [130.0, 165.0, 65.0],
-        [82.0, 165.0, 225.0],
-        [240.0, 165.0, 272.0],
-        [290.0, 165.0, 114.0],
-    ], // short block
-    [
-        [290.0, 0.0, 114.0],
-        [290.0, 165.0, 114.0],
-        [240.0, 165.0, 272.0],
-        [240.0, 0.0, 272.0],
-    ],
-    [
-        [130.0, 0.0, 65.0],
-        [130.0, 165.0, 65.0],
-        [290.0, 165.0, 114.0],
-        [290.0, 0.0, 114.0],
-    ],
-    [
-        [82.0, 0.0, 225.0],
-        [82.0, 165.0, 225.0],
-        [130.0, 165.0, 65.0],
-        [130.0, 0.0, 65.0],
-    ],
-    [
-        [240.0, 0.0, 272.0],
-        [240.0, 165.0, 272.0],
-        [82.0, 165.0, 225.0],
-        [82.0, 0.0, 225.0],
-    ],
-    [
-        [423.0, 330.0, 247.0],
-        [265.0, 330.0, 296.0],
-        [314.0, 330.0, 456.0],
-        [472.0, 330.0, 406.0],
-    ], // tall block
-    [
-        [423.0, 0.0, 247.0],
-        [423.0, 330.0, 247.0],
-        [472.0, 330.0, 406.0],
-        [472.0, 0.0, 406.0],
-    ],
-    [
-        [472.0, 0.0, 406.0],
-        [472.0, 330.0, 406.0],
-        [314.0, 330.0, 456.0],
-        [314.0, 0.0, 456.0],
-    ],
-    [
-        [314.0, 0.0, 456.0],
-        [314.0, 330.0, 456.0],
-        [265.0, 330.0, 296.0],
-        [265.0, 0.0, 296.0],
-    ],
-    [
-        [265.0, 0.0, 296.0],
-        [265.0, 330.0, 296.0],
-        [423.0, 330.0, 247.0],
-        [423.0, 0.0, 247.0],
-    ],
+    [[552.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 559.2], [549.6, 0.0, 559.2]], // floor
+    [[343.0, 548.0, 227.0], [343.0, 548.0, 332.0], [213.0, 548.0, 332.0], [213.0, 548.0, 227.0]], // light
+    [[556.0, 548.8, 0.0], [556.0, 548.8, 559.2], [0.0, 548.8, 559.2], [0.0, 548.8, 0.0]], // ceiling
+    [[549.6, 0.0, 559.2], [0.0, 0.0, 559.2], [0.0, 548.8, 559.2], [556.0, 548.8, 559.2]], // back wall
+    [[0.0, 0.0, 559.2], [0.0, 0.0, 0.0], [0.0, 548.8, 0.0], [0.0, 548.8, 559.2]], // green wall
+    [[552.8, 0.0, 0.0], [549.6, 0.0, 559.2], [556.0, 548.8, 559.2], [556.0, 548.8, 0.0]], // red wall
+    [[130.0, 165.0, 65.0], [82.0, 165.0, 225.0], [240.0, 165.0, 272.0], [290.0, 165.0, 114.0]], // short block
+    [[290.0, 0.0, 114.0], [290.0, 165.0, 114.0], [240.0, 165.0, 272.0], [240.0, 0.0, 272.0]],
+    [[130.0, 0.0, 65.0], [130.0, 165.0, 65.0], [290.0, 165.0, 114.0], [290.0, 0.0, 114.0]],
+    [[82.0, 0.0, 225.0], [82.0, 165.0, 225.0], [130.0, 165.0, 65.0], [130.0, 0.0, 65.0]],
+    [[240.0, 0.0, 272.0], [240.0, 165.0, 272.0], [82.0, 165.0, 225.0], [82.0, 0.0, 225.0]],
+    [[423.0, 330.0, 247.0], [265.0, 330.0, 296.0], [314.0, 330.0, 456.0], [472.0, 330.0, 406.0]], // tall block
+    [[423.0, 0.0, 247.0], [423.0, 330.0, 247.0], [472.0, 330.0, 406.0], [472.0, 0.0, 406.0]],
+    [[472.0, 0.0, 406.0], [472.0, 330.0, 406.0], [314.0, 330.0, 456.0], [314.0, 0.0, 456.0]],
+    [[314.0, 0.0, 456.0], [314.0, 330.0, 456.0], [265.0, 330.0, 296.0], [265.0, 0.0, 296.0]],
+    [[265.0, 0.0, 296.0], [265.0, 330.0, 296.0], [423.0, 330.0, 247.0], [423.0, 0.0, 247.0]],
 ];
 
 fn quads(q: &[Quad]) -> Vec<Tri64> {
-    q.iter()
-        .flat_map(|[a, b, c, d]| [Tri64 { v: [*a, *b, *c] }, Tri64 { v: [*a, *c, *d] }])
-        .collect()
+    q.iter().flat_map(|[a, b, c, d]| [Tri64 { v: [*a, *b, *c] }, Tri64 { v: [*a, *c, *d] }]).collect()
 }
 
 /// A closed icosphere (subdivided icosahedron, 20·4^level triangles).
@@ -202,11 +120,7 @@ pub fn icosphere(center: [f64; 3], radius: f64, level: u32) -> Vec<Tri64> {
         let mut mid = |a: usize, b: usize, verts: &mut Vec<[f64; 3]>| -> usize {
             *cache.entry((a.min(b), a.max(b))).or_insert_with(|| {
                 let (p, q) = (verts[a], verts[b]);
-                verts.push(unit([
-                    (p[0] + q[0]) / 2.0,
-                    (p[1] + q[1]) / 2.0,
-                    (p[2] + q[2]) / 2.0,
-                ]));
+                verts.push(unit([(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0, (p[2] + q[2]) / 2.0]));
                 verts.len() - 1
             })
         };
@@ -219,19 +133,8 @@ pub fn icosphere(center: [f64; 3], radius: f64, level: u32) -> Vec<Tri64> {
         }
         faces = next;
     }
-    let place = |p: [f64; 3]| {
-        [
-            center[0] + radius * p[0],
-            center[1] + radius * p[1],
-            center[2] + radius * p[2],
-        ]
-    };
-    faces
-        .iter()
-        .map(|f| Tri64 {
-            v: f.map(|i| place(verts[i])),
-        })
-        .collect()
+    let place = |p: [f64; 3]| [center[0] + radius * p[0], center[1] + radius * p[1], center[2] + radius * p[2]];
+    faces.iter().map(|f| Tri64 { v: f.map(|i| place(verts[i])) }).collect()
 }
 
 /// A fan of needle triangles (long and very thin): the ill-conditioned case.
@@ -241,9 +144,7 @@ pub fn needles(apex: [f64; 3], len: f64, count: usize) -> Vec<Tri64> {
             let a = i as f64 * std::f64::consts::PI / count as f64;
             let w = len * 1e-3 * (1.0 + i as f64);
             let tip = [apex[0] + len * a.cos(), apex[1] + len * a.sin(), apex[2]];
-            Tri64 {
-                v: [apex, tip, [tip[0], tip[1] + w, tip[2] + w]],
-            }
+            Tri64 { v: [apex, tip, [tip[0], tip[1] + w, tip[2] + w]] }
         })
         .collect()
 }
@@ -263,14 +164,10 @@ impl Scene {
         if !path.is_file() {
             return Err(SceneError::Io(format!("{}: no such file", path.display())));
         }
-        let opts = tobj::LoadOptions {
-            triangulate: true,
-            single_index: false,
-            ignore_points: true,
-            ignore_lines: true,
-        };
-        let (models, _) = tobj::load_obj(path, &opts)
-            .map_err(|e| SceneError::Malformed(format!("{}: {e}", path.display())))?;
+        let opts =
+            tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
+        let (models, _) =
+            tobj::load_obj(path, &opts).map_err(|e| SceneError::Malformed(format!("{}: {e}", path.display())))?;
         let mut tris = Vec::new();
         for m in &models {
             let p = &m.mesh.positions;
@@ -280,10 +177,7 @@ impl Scene {
                 for (k, &i) in f.iter().enumerate() {
                     let i = i as usize * 3;
                     let Some(c) = p.get(i..i + 3) else {
-                        return Err(SceneError::Malformed(format!(
-                            "{}: face index out of range",
-                            path.display()
-                        )));
+                        return Err(SceneError::Malformed(format!("{}: face index out of range", path.display())));
                     };
                     for a in 0..3 {
                         if !c[a].is_finite() {
@@ -303,24 +197,14 @@ impl Scene {
         if tris.is_empty() {
             return Err(SceneError::NoTriangles(path.display().to_string()));
         }
-        let name = path.file_name().map_or_else(
-            || path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
+        let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
         Ok(Self::normalised(name, tris))
     }
 
     /// Scales by the power of two that brings the largest |coordinate| into (1/2, 1].
     fn normalised(name: String, mut tris: Vec<Tri64>) -> Scene {
-        let m = tris
-            .iter()
-            .flat_map(|t| t.v.iter().flatten())
-            .fold(0.0f64, |m, x| m.max(x.abs()));
-        let scale = if m > 0.0 {
-            2f64.powi(-(m.log2().ceil() as i32))
-        } else {
-            1.0
-        };
+        let m = tris.iter().flat_map(|t| t.v.iter().flatten()).fold(0.0f64, |m, x| m.max(x.abs()));
+        let scale = if m > 0.0 { 2f64.powi(-(m.log2().ceil() as i32)) } else { 1.0 };
         for t in &mut tris {
             for p in &mut t.v {
                 for x in p.iter_mut() {
@@ -358,11 +242,7 @@ impl Scene {
             let d = if i % 2 == 0 {
                 let t = &self.tris[target];
                 let (b1, b2) = (r.range(-0.1, 1.1), r.range(-0.1, 1.1));
-                let (b1, b2) = if b1 + b2 > 1.2 {
-                    (1.0 - b1, 1.0 - b2)
-                } else {
-                    (b1, b2)
-                };
+                let (b1, b2) = if b1 + b2 > 1.2 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
                 let b0 = 1.0 - b1 - b2;
                 let p = [0, 1, 2].map(|a| b0 * t.v[0][a] + b1 * t.v[1][a] + b2 * t.v[2][a]);
                 [p[0] - o[0], p[1] - o[1], p[2] - o[2]]
@@ -372,15 +252,7 @@ impl Scene {
                 let s = (1.0 - z * z).sqrt();
                 [s * phi.cos(), s * phi.sin(), z]
             };
-            out.push((
-                Ray64 {
-                    o,
-                    d,
-                    tmin: 0.0,
-                    tmax: f64::INFINITY,
-                },
-                target,
-            ));
+            out.push((Ray64 { o, d, tmin: 0.0, tmax: f64::INFINITY }, target));
         }
         out
     }
@@ -407,10 +279,7 @@ mod tests {
         let a = s.rays(8, 7);
         let b = s.rays(8, 7);
         let c = s.rays(8, 8);
-        assert_eq!(
-            a.iter().map(|(r, _)| r.d).collect::<Vec<_>>(),
-            b.iter().map(|(r, _)| r.d).collect::<Vec<_>>()
-        );
+        assert_eq!(a.iter().map(|(r, _)| r.d).collect::<Vec<_>>(), b.iter().map(|(r, _)| r.d).collect::<Vec<_>>());
         assert_ne!(a[0].0.d, c[0].0.d);
     }
 
@@ -423,9 +292,7 @@ mod tests {
         for t in &tris {
             for k in 0..3 {
                 let (a, b) = (key(t.v[k]), key(t.v[(k + 1) % 3]));
-                *edges
-                    .entry(if a < b { (a, b) } else { (b, a) })
-                    .or_insert(0) += 1;
+                *edges.entry(if a < b { (a, b) } else { (b, a) }).or_insert(0) += 1;
             }
         }
         assert_eq!(tris.len(), 320);

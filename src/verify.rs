@@ -105,12 +105,7 @@ fn test_lists(scene: &Scene, rays: &[(Ray64, usize)], sample: usize, seed: u64) 
 }
 
 fn explain_cmd(fmt: &str, ray: &Ray64, tri: &Tri64, scale: f64) -> String {
-    let j = |xs: &[f64]| {
-        xs.iter()
-            .map(|x| format!("{x:?}"))
-            .collect::<Vec<_>>()
-            .join(",")
-    };
+    let j = |xs: &[f64]| xs.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(",");
     let tv: Vec<f64> = tri.v.iter().flatten().copied().collect();
     format!(
         "raypipe explain --format {fmt} --ray {},{} --tri {}  # scene coordinates x {scale:?}",
@@ -175,10 +170,7 @@ fn run_format<F: Format>(
             if let Some(why) = j.violation() {
                 rep.violations += 1;
                 if rep.first_violation.is_none() {
-                    rep.first_violation = Some(format!(
-                        "{why}: {}",
-                        explain_cmd(&name, ray, tri, scene.scale)
-                    ));
+                    rep.first_violation = Some(format!("{why}: {}", explain_cmd(&name, ray, tri, scene.scale)));
                 }
             }
             if j.hit && j.golden.hit {
@@ -207,12 +199,7 @@ fn run_format<F: Format>(
 }
 
 /// Times the pairwise batch path over every test of the run (model only), in chunks.
-fn throughput<F: Format>(
-    rti: &Rti<F>,
-    scene: &Scene,
-    rays: &[(Ray64, usize)],
-    lists: &[Vec<usize>],
-) -> f64 {
+fn throughput<F: Format>(rti: &Rti<F>, scene: &Scene, rays: &[(Ray64, usize)], lists: &[Vec<usize>]) -> f64 {
     const CHUNK: usize = 1 << 14;
     let mut rs = RaysSoa::default();
     let mut ts = TrisSoa::default();
@@ -258,11 +245,8 @@ fn throughput<F: Format>(
 pub fn verify(cfg: &VerifyConfig, scene: &Scene) -> VerifyReport {
     let rays = scene.rays(cfg.rays, cfg.seed);
     let lists = test_lists(scene, &rays, cfg.sample, cfg.seed);
-    let formats: Vec<FormatReport> = cfg
-        .formats
-        .iter()
-        .map(|f| with_format!(*f, |f| run_format(f, cfg, scene, &rays, &lists)))
-        .collect();
+    let formats: Vec<FormatReport> =
+        cfg.formats.iter().map(|f| with_format!(*f, |f| run_format(f, cfg, scene, &rays, &lists))).collect();
     let slab = verify_slab(cfg, scene);
     let slab_ok = slab.iter().all(|r| !r.conservative || r.false_misses == 0);
     VerifyReport {
@@ -370,10 +354,8 @@ pub fn verify_slab(cfg: &VerifyConfig, scene: &Scene) -> Vec<SlabReport> {
         .tris
         .iter()
         .map(|t| {
-            let lo =
-                std::array::from_fn(|a| t.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min));
-            let hi =
-                std::array::from_fn(|a| t.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max));
+            let lo = std::array::from_fn(|a| t.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min));
+            let hi = std::array::from_fn(|a| t.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max));
             (lo, hi)
         })
         .collect();
@@ -381,9 +363,7 @@ pub fn verify_slab(cfg: &VerifyConfig, scene: &Scene) -> Vec<SlabReport> {
     for f in &cfg.formats {
         for v in datapath::slab::SLAB_VARIANTS {
             let sc = datapath::slab::SlabConfig::named(v).expect("built-in variant");
-            out.push(with_format!(*f, |f| slab_one(
-                f, v, sc, &rays, &lists, &boxes
-            )));
+            out.push(with_format!(*f, |f| slab_one(f, v, sc, &rays, &lists, &boxes)));
         }
     }
     out
@@ -399,15 +379,11 @@ fn slab_one<F: Format>(
 ) -> SlabReport {
     use datapath::slab::{BoxesSoa, Slab, SlabOutSoa, SlabRaysSoa};
     let s = Slab::new(f, sc);
-    let stored: Vec<_> = boxes
-        .iter()
-        .map(|(lo, hi)| s.store_box(*lo, *hi).unwrap_or_else(|_| s.empty_box()))
-        .collect();
+    let stored: Vec<_> = boxes.iter().map(|(lo, hi)| s.store_box(*lo, *hi).unwrap_or_else(|_| s.empty_box())).collect();
     let mut rep = SlabReport {
         format: f.name(),
         variant: name.to_string(),
-        conservative: sc.widen_ulps >= datapath::slab::CONSERVATIVE_ULPS
-            && matches!(f.kind(), datapath::format::FormatKind::Float(_)),
+        conservative: sc.is_conservative(&f),
         tests: 0,
         exact_hits: 0,
         false_misses: 0,
@@ -426,11 +402,7 @@ fn slab_one<F: Format>(
             rs.push(&sr);
             bs.push(&stored[i]);
             let g = golden::slab_f64(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi);
-            let scale = 1.0f64.max(g.t_near.abs()).max(if g.t_far.is_finite() {
-                g.t_far.abs()
-            } else {
-                0.0
-            });
+            let scale = 1.0f64.max(g.t_near.abs()).max(if g.t_far.is_finite() { g.t_far.abs() } else { 0.0 });
             let close = (g.t_far - g.t_near).abs() <= 1e-9 * scale;
             let exact = if close || g.hit != hit {
                 rep.exact_calls += 1;
@@ -449,11 +421,7 @@ fn slab_one<F: Format>(
     s.batch(&rs, &bs, &mut out);
     let secs = t0.elapsed().as_secs_f64();
     std::hint::black_box(&out);
-    rep.mtests_per_s = if secs > 0.0 {
-        rep.tests as f64 / secs / 1e6
-    } else {
-        0.0
-    };
+    rep.mtests_per_s = if secs > 0.0 { rep.tests as f64 / secs / 1e6 } else { 0.0 };
     rep
 }
 
@@ -473,11 +441,7 @@ pub fn render_slab(rows: &[SlabReport]) -> String {
             r.false_misses,
             r.false_hits,
             r.mtests_per_s,
-            if r.conservative && r.false_misses > 0 {
-                "  <- VIOLATION: conservative variant missed"
-            } else {
-                ""
-            }
+            if r.conservative && r.false_misses > 0 { "  <- VIOLATION: conservative variant missed" } else { "" }
         );
     }
     s

@@ -5,17 +5,11 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn raypipe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe"))
-        .args(args)
-        .output()
-        .expect("run raypipe")
+    Command::new(env!("CARGO_BIN_EXE_raypipe")).args(args).output().expect("run raypipe")
 }
 
 fn text(o: &Output) -> (String, String) {
-    (
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+    (String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
 }
 
 /// A file in a fresh temporary directory.
@@ -40,10 +34,7 @@ fn verify_prints_a_table_per_format_and_passes() {
     let (out, err) = text(&o);
     assert!(o.status.success(), "{out}\n{err}");
     for f in ["f32", "fp16", "bf16", "e8m16", "q8.24:divide"] {
-        assert!(
-            out.lines().any(|l| l.starts_with(f)),
-            "no row for {f}:\n{out}"
-        );
+        assert!(out.lines().any(|l| l.starts_with(f)), "no row for {f}:\n{out}");
     }
     assert!(out.contains("property: PASS"));
     assert!(out.contains("seed 1"));
@@ -51,26 +42,12 @@ fn verify_prints_a_table_per_format_and_passes() {
 
 #[test]
 fn verify_json_has_every_format() {
-    let o = raypipe(&[
-        "verify",
-        "--rays",
-        "32",
-        "--seed",
-        "9",
-        "--format",
-        "f32,e5m10:ftz",
-        "--json",
-    ]);
+    let o = raypipe(&["verify", "--rays", "32", "--seed", "9", "--format", "f32,e5m10:ftz", "--json"]);
     assert!(o.status.success());
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("valid JSON");
     assert_eq!(v["seed"], 9);
     assert_eq!(v["passed"], true);
-    let names: Vec<&str> = v["formats"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| f["format"].as_str().unwrap())
-        .collect();
+    let names: Vec<&str> = v["formats"].as_array().unwrap().iter().map(|f| f["format"].as_str().unwrap()).collect();
     assert_eq!(names, ["f32", "e5m10:ftz"]);
     let f32 = &v["formats"][0];
     assert_eq!(f32["tests"], 32 * 368);
@@ -81,15 +58,7 @@ fn verify_json_has_every_format() {
 fn verify_loads_an_obj_scene() {
     let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n";
     let p = temp_file("tetra.obj", obj);
-    let o = raypipe(&[
-        "verify",
-        "--scene",
-        p.to_str().unwrap(),
-        "--rays",
-        "64",
-        "--format",
-        "f32",
-    ]);
+    let o = raypipe(&["verify", "--scene", p.to_str().unwrap(), "--rays", "64", "--format", "f32"]);
     let (out, err) = text(&o);
     assert!(o.status.success(), "{out}\n{err}");
     assert!(out.contains("tetra.obj (4 triangles"), "{out}");
@@ -97,19 +66,13 @@ fn verify_loads_an_obj_scene() {
 
 #[test]
 fn missing_obj_is_a_clear_error() {
-    assert_clear_error(
-        &raypipe(&["verify", "--scene", "/nonexistent/scene.obj"]),
-        "no such file",
-    );
+    assert_clear_error(&raypipe(&["verify", "--scene", "/nonexistent/scene.obj"]), "no such file");
 }
 
 #[test]
 fn malformed_obj_is_a_clear_error() {
     let p = temp_file("bad.obj", "v 0 0 0\nv 1 0 zero\nv 0 1 0\nf 1 2 3\n");
-    assert_clear_error(
-        &raypipe(&["verify", "--scene", p.to_str().unwrap()]),
-        "malformed OBJ",
-    );
+    assert_clear_error(&raypipe(&["verify", "--scene", p.to_str().unwrap()]), "malformed OBJ");
     let p = temp_file("badindex.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n");
     assert_clear_error(&raypipe(&["verify", "--scene", p.to_str().unwrap()]), "OBJ");
 }
@@ -117,38 +80,13 @@ fn malformed_obj_is_a_clear_error() {
 #[test]
 fn nan_and_inf_coordinates_are_clear_errors() {
     let p = temp_file("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
-    assert_clear_error(
-        &raypipe(&["verify", "--scene", p.to_str().unwrap()]),
-        "non-finite",
-    );
+    assert_clear_error(&raypipe(&["verify", "--scene", p.to_str().unwrap()]), "non-finite");
     let p = temp_file("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n");
-    assert_clear_error(
-        &raypipe(&["verify", "--scene", p.to_str().unwrap()]),
-        "non-finite",
-    );
+    assert_clear_error(&raypipe(&["verify", "--scene", p.to_str().unwrap()]), "non-finite");
     let tri = "0,0,0,1,0,0,0,1,0";
+    assert_clear_error(&raypipe(&["explain", "--format", "f32", "--ray", "0,0,1,0,0,NaN", "--tri", tri]), "finite");
     assert_clear_error(
-        &raypipe(&[
-            "explain",
-            "--format",
-            "f32",
-            "--ray",
-            "0,0,1,0,0,NaN",
-            "--tri",
-            tri,
-        ]),
-        "finite",
-    );
-    assert_clear_error(
-        &raypipe(&[
-            "explain",
-            "--format",
-            "f32",
-            "--ray",
-            "0,0,1,0,0,-1",
-            "--tri",
-            "0,0,0,1,0,0,0,inf,0",
-        ]),
+        &raypipe(&["explain", "--format", "f32", "--ray", "0,0,1,0,0,-1", "--tri", "0,0,0,1,0,0,0,inf,0"]),
         "finite",
     );
 }
@@ -156,10 +94,7 @@ fn nan_and_inf_coordinates_are_clear_errors() {
 #[test]
 fn obj_without_triangles_is_a_clear_error() {
     let p = temp_file("empty.obj", "# only vertices\nv 0 0 0\nv 1 0 0\n");
-    assert_clear_error(
-        &raypipe(&["verify", "--scene", p.to_str().unwrap()]),
-        "no triangles",
-    );
+    assert_clear_error(&raypipe(&["verify", "--scene", p.to_str().unwrap()]), "no triangles");
 }
 
 #[test]
@@ -167,15 +102,7 @@ fn unknown_format_is_a_clear_error() {
     let o = raypipe(&["verify", "--format", "f24"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o).1.contains("unknown format 'f24'"));
-    let o = raypipe(&[
-        "explain",
-        "--format",
-        "fp16:fast",
-        "--ray",
-        "0,0,1,0,0,-1",
-        "--tri",
-        "0,0,0,1,0,0,0,1,0",
-    ]);
+    let o = raypipe(&["explain", "--format", "fp16:fast", "--ray", "0,0,1,0,0,-1", "--tri", "0,0,0,1,0,0,0,1,0"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o).1.contains("unknown format option 'fast'"));
 }
@@ -183,27 +110,11 @@ fn unknown_format_is_a_clear_error() {
 #[test]
 fn explain_wrong_arity_and_bad_options_are_clear_errors() {
     assert_clear_error(
-        &raypipe(&[
-            "explain",
-            "--format",
-            "f32",
-            "--ray",
-            "0,0,1",
-            "--tri",
-            "0,0,0,1,0,0,0,1,0",
-        ]),
+        &raypipe(&["explain", "--format", "f32", "--ray", "0,0,1", "--tri", "0,0,0,1,0,0,0,1,0"]),
         "expected 6",
     );
     assert_clear_error(
-        &raypipe(&[
-            "explain",
-            "--format",
-            "f32",
-            "--ray",
-            "0,0,1,0,0,-1",
-            "--tri",
-            "0,0,0,1,0,0,0,1",
-        ]),
+        &raypipe(&["explain", "--format", "f32", "--ray", "0,0,1,0,0,-1", "--tri", "0,0,0,1,0,0,0,1"]),
         "expected 9",
     );
     assert_clear_error(
@@ -225,32 +136,14 @@ fn explain_wrong_arity_and_bad_options_are_clear_errors() {
 
 #[test]
 fn explain_prints_every_stage_signal_with_bits() {
-    let o = raypipe(&[
-        "explain",
-        "--format",
-        "fp16",
-        "--ray",
-        "0.25,0.25,1,0,0,-1",
-        "--tri",
-        "0,0,0,1,0,0,0,1,0",
-    ]);
+    let o = raypipe(&["explain", "--format", "fp16", "--ray", "0.25,0.25,1,0,0,-1", "--tri", "0,0,0,1,0,0,0,1,0"]);
     let (out, err) = text(&o);
     assert!(o.status.success(), "{err}");
-    for sig in [
-        "e1x", "pxa", "qzb", "det_xy", "uv", "valid", "inv_det", "hit",
-    ] {
-        assert!(
-            out.lines()
-                .any(|l| l.split_whitespace().nth(1) == Some(sig)),
-            "no {sig} row:\n{out}"
-        );
+    for sig in ["e1x", "pxa", "qzb", "det_xy", "uv", "valid", "inv_det", "hit"] {
+        assert!(out.lines().any(|l| l.split_whitespace().nth(1) == Some(sig)), "no {sig} row:\n{out}");
     }
     // fp16 1.0 is 0x3c00; t = 1 here
-    assert!(
-        out.lines()
-            .any(|l| l.split_whitespace().nth(1) == Some("t") && l.contains("3c00")),
-        "{out}"
-    );
+    assert!(out.lines().any(|l| l.split_whitespace().nth(1) == Some("t") && l.contains("3c00")), "{out}");
     assert!(out.contains("golden: hit true t 1e0"), "{out}");
 }
 
@@ -280,15 +173,8 @@ fn explain_slab_prints_the_stage_signals_and_the_exact_decision() {
     let o = raypipe(&args);
     let (out, err) = text(&o);
     assert!(o.status.success(), "{err}");
-    assert!(
-        out.lines()
-            .any(|l| l.starts_with("tlox") && l.ends_with("7e00")),
-        "{out}"
-    );
-    assert!(
-        out.contains("model : hit true") && out.contains("exact decision: hit true"),
-        "{out}"
-    );
+    assert!(out.lines().any(|l| l.starts_with("tlox") && l.ends_with("7e00")), "{out}");
+    assert!(out.contains("model : hit true") && out.contains("exact decision: hit true"), "{out}");
     let mut bad = args.to_vec();
     let last = bad.len() - 1;
     bad[last] = "1,1,1,0,0,0";
@@ -297,27 +183,11 @@ fn explain_slab_prints_the_stage_signals_and_the_exact_decision() {
     v.extend(["--variant", "sloppy"]);
     assert_clear_error(&raypipe(&v), "unknown slab variant");
     assert_clear_error(
-        &raypipe(&[
-            "explain",
-            "--unit",
-            "bvh",
-            "--format",
-            "f32",
-            "--ray",
-            "0,0,0,1,0,0",
-        ]),
+        &raypipe(&["explain", "--unit", "bvh", "--format", "f32", "--ray", "0,0,0,1,0,0"]),
         "unknown unit",
     );
     assert_clear_error(
-        &raypipe(&[
-            "explain",
-            "--unit",
-            "slab",
-            "--format",
-            "f32",
-            "--ray",
-            "0,0,0,1,0,0",
-        ]),
+        &raypipe(&["explain", "--unit", "slab", "--format", "f32", "--ray", "0,0,0,1,0,0"]),
         "needs --box",
     );
 }
@@ -328,14 +198,12 @@ fn verify_json_has_the_slab_table() {
     assert!(o.status.success());
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let slab = v["slab"].as_array().unwrap();
-    assert_eq!(slab.len(), 2 * 4);
+    assert_eq!(slab.len(), 2 * 5);
     for r in slab {
         assert_eq!(r["tests"], 16 * 368);
         if r["conservative"] == true {
             assert_eq!(r["false_misses"], 0, "{r}");
         }
     }
-    assert!(slab.iter().any(|r| r["variant"] == "conservative"
-        && r["format"] == "fp16"
-        && r["conservative"] == true));
+    assert!(slab.iter().any(|r| r["variant"] == "conservative" && r["format"] == "fp16" && r["conservative"] == true));
 }

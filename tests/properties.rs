@@ -17,11 +17,7 @@ use proptest::test_runner::{Config, RngSeed};
 use raypipe::judge::judge;
 
 fn config() -> Config {
-    Config {
-        rng_seed: RngSeed::Fixed(0x5eed_0003),
-        failure_persistence: None,
-        ..Config::default()
-    }
+    Config { rng_seed: RngSeed::Fixed(0x5eed_0003), failure_persistence: None, ..Config::default() }
 }
 
 fn coord() -> impl Strategy<Value = f64> {
@@ -51,28 +47,13 @@ fn case() -> impl Strategy<Value = (Ray64, Tri64)> {
             let b0 = 1.0 - b1 - b2;
             let target: [f64; 3] = std::array::from_fn(|k| b0 * a[k] + b1 * b[k] + b2 * c[k]);
             let d = [target[0] - o[0], target[1] - o[1], target[2] - o[2]];
-            (
-                Ray64 {
-                    o,
-                    d,
-                    tmin: 0.0,
-                    tmax,
-                },
-                tri,
-            )
+            (Ray64 { o, d, tmin: 0.0, tmax }, tri)
         })
 }
 
 fn check(any: &AnyFormat, cull: Cull, ray: &Ray64, tri: &Tri64) -> Result<(), TestCaseError> {
     with_format!(*any, |f| {
-        let rti = Rti::new(
-            f,
-            RtiConfig {
-                cull,
-                det_threshold: 0.0,
-                tie: TieRule::First,
-            },
-        );
+        let rti = Rti::new(f, RtiConfig { cull, det_threshold: 0.0, tie: TieRule::First });
         let j = judge(&rti, ray, tri);
         if let Some(why) = j.violation() {
             return Err(TestCaseError::fail(format!(
@@ -130,9 +111,7 @@ fn most_cases_are_decisive() {
             cases
                 .iter()
                 .map(|(ray, tri)| judge(&rti, ray, tri))
-                .fold((0, 0), |(d, h), j| {
-                    (d + j.decisive as u32, h + (j.decisive && j.hit) as u32)
-                })
+                .fold((0, 0), |(d, h), j| (d + j.decisive as u32, h + (j.decisive && j.hit) as u32))
         });
         let frac = decisive as f64 / cases.len() as f64;
         report += &format!("{name}: decisive {frac:.3}, decisive hits {hits}\n");
@@ -141,8 +120,5 @@ fn most_cases_are_decisive() {
         }
     }
     eprint!("{report}");
-    assert!(
-        low.is_empty(),
-        "too few decisive cases for {low:?}:\n{report}"
-    );
+    assert!(low.is_empty(), "too few decisive cases for {low:?}:\n{report}");
 }

@@ -8,8 +8,7 @@ use datapath::format::DivMode;
 use datapath::probe::{NoProbe, Recorder, Signal};
 use datapath::rng::SplitMix64;
 use datapath::rti::{
-    stage_table, Capture, Cull, HitsSoa, Op, Ray, RaysSoa, Rti, RtiConfig, TieRule, Tri, TrisSoa,
-    RTI_INPUTS,
+    stage_table, Capture, Cull, HitsSoa, Op, Ray, RaysSoa, Rti, RtiConfig, TieRule, Tri, TrisSoa, RTI_INPUTS,
 };
 use datapath::{with_format, Format};
 
@@ -17,19 +16,8 @@ const SEED: u64 = 0x0071_0002;
 
 fn build<F: Format>(f: &F, raw: &[u64; 17]) -> (Ray<F::V>, Tri<F::V>) {
     let v = |i: usize| f.from_bits(raw[i]);
-    let ray = Ray {
-        o: [v(0), v(1), v(2)],
-        d: [v(3), v(4), v(5)],
-        tmin: v(6),
-        tmax: v(7),
-    };
-    let tri = Tri {
-        v: [
-            [v(8), v(9), v(10)],
-            [v(11), v(12), v(13)],
-            [v(14), v(15), v(16)],
-        ],
-    };
+    let ray = Ray { o: [v(0), v(1), v(2)], d: [v(3), v(4), v(5)], tmin: v(6), tmax: v(7) };
+    let tri = Tri { v: [[v(8), v(9), v(10)], [v(11), v(12), v(13)], [v(14), v(15), v(16)]] };
     (ray, tri)
 }
 
@@ -42,9 +30,7 @@ fn check_trace<F: Format>(rti: &Rti<F>, raw: &[u64; 17]) -> Result<(), String> {
     let names: Vec<&str> = rec.signals.iter().map(|(n, _)| *n).collect();
     let want: Vec<&str> = table.iter().map(|d| d.name).collect();
     if names != want {
-        return Err(format!(
-            "recorded signals {names:?} differ from the stage table {want:?}"
-        ));
+        return Err(format!("recorded signals {names:?} differ from the stage table {want:?}"));
     }
     let lookup = |n: &str| -> F::V {
         if n == "one" {
@@ -53,8 +39,7 @@ fn check_trace<F: Format>(rti: &Rti<F>, raw: &[u64; 17]) -> Result<(), String> {
         if let Some(i) = RTI_INPUTS.iter().position(|x| *x == n) {
             return f.from_bits(raw[i]);
         }
-        rec.value(n)
-            .unwrap_or_else(|| panic!("operand {n} neither input nor earlier signal"))
+        rec.value(n).unwrap_or_else(|| panic!("operand {n} neither input nor earlier signal"))
     };
     let bits = |v: F::V| f.to_bits(v);
     let flag = |n: &str| rec.flag(n).unwrap();
@@ -84,9 +69,7 @@ fn check_trace<F: Format>(rti: &Rti<F>, raw: &[u64; 17]) -> Result<(), String> {
                         }
                     }
                     "t_ok" => sign_ok(lookup("tp")),
-                    "valid" => {
-                        flag("det_ok") & flag("u_ok") & flag("v_ok") & flag("uv_ok") & flag("t_ok")
-                    }
+                    "valid" => flag("det_ok") & flag("u_ok") & flag("v_ok") & flag("uv_ok") & flag("t_ok"),
                     "tmin_ok" => f.le(ray.tmin, lookup("t")),
                     "tmax_ok" => f.le(lookup("t"), ray.tmax),
                     "hit" => flag("valid") & flag("tmin_ok") & flag("tmax_ok"),
@@ -111,22 +94,12 @@ fn check_trace<F: Format>(rti: &Rti<F>, raw: &[u64; 17]) -> Result<(), String> {
     }
     // the outputs are the last-stage signals, and probing changed nothing
     let plain = rti.trace(&ray, &tri, &mut NoProbe);
-    for (name, v, p) in [
-        ("t", out.t, plain.t),
-        ("u", out.u, plain.u),
-        ("v", out.v, plain.v),
-    ] {
+    for (name, v, p) in [("t", out.t, plain.t), ("u", out.u, plain.u), ("v", out.v, plain.v)] {
         if bits(v) != bits(lookup(name)) || bits(v) != bits(p) {
-            return Err(format!(
-                "output {name} differs from its stage signal or from the unprobed run"
-            ));
+            return Err(format!("output {name} differs from its stage signal or from the unprobed run"));
         }
     }
-    if out.valid != flag("valid")
-        || out.hit != flag("hit")
-        || plain.hit != out.hit
-        || plain.valid != out.valid
-    {
+    if out.valid != flag("valid") || out.hit != flag("hit") || plain.hit != out.hit || plain.valid != out.valid {
         return Err("valid/hit differ from their stage signals or from the unprobed run".into());
     }
     Ok(())
@@ -136,14 +109,7 @@ fn check_trace<F: Format>(rti: &Rti<F>, raw: &[u64; 17]) -> Result<(), String> {
 fn every_stage_signal_follows_the_stage_table() {
     let mut r = SplitMix64::new(SEED);
     for any in common::formats() {
-        for cfg in [
-            RtiConfig::default(),
-            RtiConfig {
-                cull: Cull::Backface,
-                det_threshold: 1e-3,
-                tie: TieRule::Last,
-            },
-        ] {
+        for cfg in [RtiConfig::default(), RtiConfig { cull: Cull::Backface, det_threshold: 1e-3, tie: TieRule::Last }] {
             with_format!(any, |f| {
                 let rti = Rti::new(f, cfg);
                 for _ in 0..3000 {
@@ -162,35 +128,19 @@ fn stage_table_has_the_51_operations_plus_the_uv_add() {
     for div in [DivMode::RecipMul, DivMode::Divide] {
         let t = stage_table(div);
         let count = |op: Op| t.iter().filter(|d| d.op == op).count();
-        let (adds, subs, muls, divs) = (
-            count(Op::Add),
-            count(Op::Sub),
-            count(Op::Mul),
-            count(Op::Div),
-        );
-        assert_eq!(
-            subs,
-            9 + 6,
-            "9 edge/origin subtracts + 6 cross-product subtracts"
-        );
+        let (adds, subs, muls, divs) = (count(Op::Add), count(Op::Sub), count(Op::Mul), count(Op::Div));
+        assert_eq!(subs, 9 + 6, "9 edge/origin subtracts + 6 cross-product subtracts");
         assert_eq!(adds, 8 + 1, "8 dot-product adds + u'+v'");
         match div {
             DivMode::RecipMul => assert_eq!((muls, divs), (12 + 12 + 3, 1)),
             DivMode::Divide => assert_eq!((muls, divs), (12 + 12, 3)),
         }
         if div == DivMode::RecipMul {
-            assert_eq!(
-                adds + subs + muls + divs,
-                52,
-                "the classic 51 + the u'+v' add of the division-free test"
-            );
+            assert_eq!(adds + subs + muls + divs, 52, "the classic 51 + the u'+v' add of the division-free test");
         }
         // the valid bit is decided before any division
         let valid_stage = t.iter().find(|d| d.name == "valid").unwrap().stage;
-        assert!(t
-            .iter()
-            .filter(|d| d.op == Op::Div)
-            .all(|d| d.stage > valid_stage));
+        assert!(t.iter().filter(|d| d.op == Op::Div).all(|d| d.stage > valid_stage));
     }
 }
 
@@ -213,13 +163,7 @@ fn batch_equals_scalar_bit_for_bit() {
             let b = |v| rti.fmt.to_bits(v);
             for (i, s) in scalar.iter().enumerate() {
                 assert_eq!(
-                    (
-                        out.hit[i],
-                        out.valid[i],
-                        b(out.t[i]),
-                        b(out.u[i]),
-                        b(out.v[i])
-                    ),
+                    (out.hit[i], out.valid[i], b(out.t[i]), b(out.u[i]), b(out.v[i])),
                     (s.hit, s.valid, b(s.t), b(s.u), b(s.v)),
                     "{} case {i}",
                     rti.fmt.name()
@@ -235,13 +179,7 @@ fn packet_equals_leaf_equals_a_plain_min_capture_loop() {
     for any in common::formats() {
         with_format!(any, |f| {
             for tie in [TieRule::First, TieRule::Last] {
-                let rti = Rti::new(
-                    f,
-                    RtiConfig {
-                        tie,
-                        ..RtiConfig::default()
-                    },
-                );
+                let rti = Rti::new(f, RtiConfig { tie, ..RtiConfig::default() });
                 let mut tris = TrisSoa::default();
                 let mut plain_tris = Vec::new();
                 for _ in 0..40 {
@@ -284,11 +222,7 @@ fn packet_equals_leaf_equals_a_plain_min_capture_loop() {
                             best = Some((100 + i as u32, tv));
                         }
                     }
-                    assert_eq!(
-                        (cap.hit, cap.id, b(cap.t)),
-                        (leaf.hit, leaf.id, b(leaf.t)),
-                        "packet vs leaf"
-                    );
+                    assert_eq!((cap.hit, cap.id, b(cap.t)), (leaf.hit, leaf.id, b(leaf.t)), "packet vs leaf");
                     assert_eq!(cap.hit, best.is_some());
                     if let Some((id, _)) = best {
                         assert_eq!(cap.id, id, "{} {tie:?}", rti.fmt.name());
@@ -304,13 +238,7 @@ fn tie_rule_picks_the_first_or_last_of_equal_hits() {
     for any in common::formats() {
         with_format!(any, |f| {
             for (tie, want) in [(TieRule::First, 0), (TieRule::Last, 2)] {
-                let rti = Rti::new(
-                    f,
-                    RtiConfig {
-                        tie,
-                        ..RtiConfig::default()
-                    },
-                );
+                let rti = Rti::new(f, RtiConfig { tie, ..RtiConfig::default() });
                 let tri = rti.tri([[-0.5, -0.5, 0.25], [0.5, -0.5, 0.25], [0.0, 0.5, 0.25]]);
                 let mut tris = TrisSoa::default();
                 for _ in 0..3 {
@@ -333,46 +261,16 @@ fn culling_and_det_threshold() {
             // counter-clockwise seen from +z: normal +z; a ray going -z sees the front face
             let v = [[-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.0, 0.5, 0.0]];
             let two = Rti::new(f, RtiConfig::default());
-            let cull = Rti::new(
-                f,
-                RtiConfig {
-                    cull: Cull::Backface,
-                    ..RtiConfig::default()
-                },
-            );
+            let cull = Rti::new(f, RtiConfig { cull: Cull::Backface, ..RtiConfig::default() });
             let down = two.ray([0.0, 0.0, 1.0], [0.0, 0.0, -1.0], 0.0, f64::INFINITY);
             let up = two.ray([0.0, 0.0, -1.0], [0.0, 0.0, 1.0], 0.0, f64::INFINITY);
             let t = two.tri(v);
-            assert!(
-                two.test(&down, &t).hit && two.test(&up, &t).hit,
-                "{}",
-                two.fmt.name()
-            );
-            assert!(
-                cull.test(&down, &t).hit && !cull.test(&up, &t).hit,
-                "{}",
-                cull.fmt.name()
-            );
+            assert!(two.test(&down, &t).hit && two.test(&up, &t).hit, "{}", two.fmt.name());
+            assert!(cull.test(&down, &t).hit && !cull.test(&up, &t).hit, "{}", cull.fmt.name());
             // det = e1·(d × e2) = 1 here; a threshold of 2 rejects it, 0.5 keeps it
-            let hi = Rti::new(
-                f,
-                RtiConfig {
-                    det_threshold: 2.0,
-                    ..RtiConfig::default()
-                },
-            );
-            let lo = Rti::new(
-                f,
-                RtiConfig {
-                    det_threshold: 0.5,
-                    ..RtiConfig::default()
-                },
-            );
-            assert!(
-                !hi.test(&down, &t).hit && lo.test(&down, &t).hit,
-                "{}",
-                hi.fmt.name()
-            );
+            let hi = Rti::new(f, RtiConfig { det_threshold: 2.0, ..RtiConfig::default() });
+            let lo = Rti::new(f, RtiConfig { det_threshold: 0.5, ..RtiConfig::default() });
+            assert!(!hi.test(&down, &t).hit && lo.test(&down, &t).hit, "{}", hi.fmt.name());
             // behind the origin and outside the t interval
             let behind = two.ray([0.0, 0.0, -1.0], [0.0, 0.0, -1.0], 0.0, f64::INFINITY);
             assert!(!two.test(&behind, &t).hit);
@@ -385,10 +283,7 @@ fn culling_and_det_threshold() {
 
 #[test]
 fn nan_in_any_input_never_hits() {
-    for any in common::formats()
-        .into_iter()
-        .filter(|f| f.name().starts_with(['f', 'b', 'e']))
-    {
+    for any in common::formats().into_iter().filter(|f| f.name().starts_with(['f', 'b', 'e'])) {
         with_format!(any, |f| {
             let rti = Rti::new(f, RtiConfig::default());
             let nan = rti.fmt.from_f64(f64::NAN);
@@ -404,12 +299,7 @@ fn nan_in_any_input_never_hits() {
                     7 => ray.tmax = nan,
                     _ => t.v[(i - 8) / 3][(i - 8) % 3] = nan,
                 }
-                assert!(
-                    !rti.test(&ray, &t).hit,
-                    "{}: NaN in input {} hits",
-                    rti.fmt.name(),
-                    input
-                );
+                assert!(!rti.test(&ray, &t).hit, "{}: NaN in input {} hits", rti.fmt.name(), input);
             }
         });
     }

@@ -7,8 +7,7 @@ use datapath::format::{Format, Subnormals};
 use datapath::probe::{Recorder, Signal};
 use datapath::rng::SplitMix64;
 use datapath::slab::{
-    BoxError, BoxesSoa, DirPrep, Slab, SlabConfig, SlabNan, SlabOutSoa, SlabRaysSoa,
-    CONSERVATIVE_ULPS,
+    BoxError, BoxesSoa, DirPrep, Slab, SlabConfig, SlabNan, SlabOutSoa, SlabRaysSoa, CONSERVATIVE_ULPS,
 };
 use datapath::{with_format, AnyFormat};
 use golden::slab_exact;
@@ -32,11 +31,11 @@ fn fmt(name: &str) -> AnyFormat {
 }
 
 fn cfg(nan: SlabNan, prep: DirPrep, widen_ulps: i32) -> SlabConfig {
-    SlabConfig {
-        nan,
-        prep,
-        widen_ulps,
-    }
+    SlabConfig { nan, prep, widen_ulps, directed: false }
+}
+
+fn directed() -> SlabConfig {
+    SlabConfig::named("directed").unwrap()
 }
 
 /// Runs the model on f64 inputs (box stored conservatively) and returns (hit, any NaN signal).
@@ -53,10 +52,7 @@ fn run<F: Format>(
     let ray = s.prepare_trace(o, d, tmin, tmax, &mut rec);
     let b = s.store_box(lo, hi).expect("box fits");
     let out = s.trace(&ray, &b, &mut rec);
-    let nan = rec
-        .signals
-        .iter()
-        .any(|(_, v)| matches!(v, Signal::Value(x) if s.fmt.is_nan(*x)));
+    let nan = rec.signals.iter().any(|(_, v)| matches!(v, Signal::Value(x) if s.fmt.is_nan(*x)));
     (out.hit, nan)
 }
 
@@ -97,8 +93,7 @@ fn faces_times_signed_zero_directions_in_every_format_and_variant() {
     }
     assert_eq!(cases.len(), 6 * 25 * 3 * 2 * 16);
     // a NaN (0 × ∞) arises on axis a when d[a] = ±0 and o[a] lies on one of its planes
-    let nan_axis =
-        |o: [f64; 3], d: [f64; 3], a: usize| d[a] == 0.0 && (o[a] == lo[a] || o[a] == hi[a]);
+    let nan_axis = |o: [f64; 3], d: [f64; 3], a: usize| d[a] == 0.0 && (o[a] == lo[a] || o[a] == hi[a]);
     let mut report = String::new();
     for name in ALL {
         let any = fmt(name);
@@ -109,6 +104,7 @@ fn faces_times_signed_zero_directions_in_every_format_and_variant() {
                 cfg(SlabNan::Ignore, DirPrep::Plain, CONSERVATIVE_ULPS),
                 cfg(SlabNan::TakeOnFalse, DirPrep::Plain, 0),
                 cfg(SlabNan::Ignore, DirPrep::Embree, 0),
+                directed(),
             ] {
                 let s = Slab::new(f, variant);
                 let (mut false_miss, mut false_hit, mut face_plane) = (0, 0, 0);
@@ -119,9 +115,9 @@ fn faces_times_signed_zero_directions_in_every_format_and_variant() {
                     face_plane += in_plane as u32;
                     false_miss += (exact && !hit) as u32;
                     false_hit += (!exact && hit) as u32;
-                    let ctx =
-                        || format!("{name} {variant:?} o {o:?} d {d:?}: exact {exact} model {hit}");
+                    let ctx = || format!("{name} {variant:?} o {o:?} d {d:?}: exact {exact} model {hit}");
                     match (variant.nan, variant.prep) {
+                        _ if variant.directed => assert!(hit || !exact, "directed variant missed: {}", ctx()),
                         (SlabNan::Ignore, DirPrep::Plain) if float_ieee || name.contains("ftz") => {
                             if variant.widen_ulps == 0 {
                                 assert_eq!(hit, exact, "{}", ctx());
@@ -129,24 +125,13 @@ fn faces_times_signed_zero_directions_in_every_format_and_variant() {
                                 assert!(hit || !exact, "{}", ctx());
                             }
                         }
-                        (SlabNan::TakeOnFalse, DirPrep::Plain)
-                            if float_ieee || name.contains("ftz") =>
-                        {
-                            assert_eq!(
-                                hit,
-                                take_on_false_chain(o, d, 0.0, f64::INFINITY, lo, hi),
-                                "{}",
-                                ctx()
-                            );
+                        (SlabNan::TakeOnFalse, DirPrep::Plain) if float_ieee || name.contains("ftz") => {
+                            assert_eq!(hit, take_on_false_chain(o, d, 0.0, f64::INFINITY, lo, hi), "{}", ctx());
                         }
                         (SlabNan::Ignore, DirPrep::Embree) => {
                             assert!(!nan, "{}: Embree preparation let a NaN through", ctx());
                             if hit != exact {
-                                assert!(
-                                    in_plane,
-                                    "{}: disagreement outside the face-plane cases",
-                                    ctx()
-                                );
+                                assert!(in_plane, "{}: disagreement outside the face-plane cases", ctx());
                             }
                         }
                         _ => {
@@ -166,33 +151,14 @@ fn faces_times_signed_zero_directions_in_every_format_and_variant() {
 /// The take-on-false chain's semantics on exact values (every value of the face grid is exact):
 /// a NaN axis value replaces the accumulator, erasing tmin/tmax and earlier axes; a value after
 /// a NaN accumulator replaces it; otherwise the usual max (near) / min (far).
-fn take_on_false_chain(
-    o: [f64; 3],
-    d: [f64; 3],
-    tmin: f64,
-    tmax: f64,
-    lo: [f64; 3],
-    hi: [f64; 3],
-) -> bool {
+fn take_on_false_chain(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, lo: [f64; 3], hi: [f64; 3]) -> bool {
     let (mut near, mut far) = (tmin, tmax);
     for a in 0..3 {
         let inv = 1.0 / d[a];
         let (t0, t1) = ((lo[a] - o[a]) * inv, (hi[a] - o[a]) * inv);
-        let (n, f) = if inv.is_sign_negative() {
-            (t1, t0)
-        } else {
-            (t0, t1)
-        };
-        near = if n.is_nan() || near.is_nan() || n > near {
-            n
-        } else {
-            near
-        };
-        far = if f.is_nan() || far.is_nan() || f < far {
-            f
-        } else {
-            far
-        };
+        let (n, f) = if inv.is_sign_negative() { (t1, t0) } else { (t0, t1) };
+        near = if n.is_nan() || near.is_nan() || n > near { n } else { near };
+        far = if f.is_nan() || far.is_nan() || f < far { f } else { far };
     }
     near <= far
 }
@@ -205,11 +171,7 @@ fn random_case(r: &mut SplitMix64) -> ([f64; 3], [f64; 3], f64, [f64; 3], [f64; 
     let big = r.below(8) == 0;
     for a in 0..3 {
         let c = r.range(-1.0, 1.0) * if big { 1e6 } else { 1.0 };
-        let e = if r.below(10) == 0 {
-            0.0
-        } else {
-            2f64.powf(r.range(-20.0, if big { 40.0 } else { 2.0 }))
-        };
+        let e = if r.below(10) == 0 { 0.0 } else { 2f64.powf(r.range(-20.0, if big { 40.0 } else { 2.0 })) };
         lo[a] = c - e;
         hi[a] = c + e;
     }
@@ -232,11 +194,7 @@ fn random_case(r: &mut SplitMix64) -> ([f64; 3], [f64; 3], f64, [f64; 3], [f64; 
     if r.below(7) == 0 {
         d = std::array::from_fn(|_| r.range(-1.0, 1.0)); // random direction
     }
-    let tmax = if r.below(5) == 0 {
-        r.range(0.0, 3.0)
-    } else {
-        f64::INFINITY
-    };
+    let tmax = if r.below(5) == 0 { r.range(0.0, 3.0) } else { f64::INFINITY };
     (o, d, tmax, lo, hi)
 }
 
@@ -262,35 +220,59 @@ fn conservative_variant_never_misses_and_the_plain_one_errs_only_within_four_ulp
                 // which the datapath really holds, judges the narrowed and plain variants
                 let exact = slab_exact(oq, dq, 0.0, tq, lo, hi);
                 let b = wide.store_box(lo, hi).unwrap();
-                let exact_stored = slab_exact(
-                    oq,
-                    dq,
-                    0.0,
-                    tq,
-                    b.min.map(|v| f.to_f64(v)),
-                    b.max.map(|v| f.to_f64(v)),
-                );
+                let exact_stored = slab_exact(oq, dq, 0.0, tq, b.min.map(|v| f.to_f64(v)), b.max.map(|v| f.to_f64(v)));
                 let test = |s: &Slab<_>| s.test(&s.prepare(o, d, 0.0, tmax), &b).hit;
                 let (hp, hw, hn) = (test(&plain), test(&wide), test(&narrow));
                 let ctx = || {
                     format!("{name}: o {o:?} d {d:?} tmax {tmax} box {lo:?}..{hi:?}: exact {exact} (stored box {exact_stored}) plain {hp} wide {hw} narrow {hn}")
                 };
                 assert!(hw || !exact, "conservative variant missed: {}", ctx());
-                assert!(
-                    !hn || exact_stored,
-                    "narrowed variant hit a missed box: {}",
-                    ctx()
-                );
+                assert!(!hn || exact_stored, "narrowed variant hit a missed box: {}", ctx());
                 n += 1;
                 exact_hits += exact as u32;
                 plain_wrong += (hp != exact_stored) as u32;
                 wide_false_hits += (hw && !exact) as u32;
             }
-            assert!(
-                n > 15_000 && exact_hits > 3000,
-                "{name}: too few usable cases ({n}, {exact_hits} hits)"
-            );
+            assert!(n > 15_000 && exact_hits > 3000, "{name}: too few usable cases ({n}, {exact_hits} hits)");
             report += &format!("{name}: {n} cases, {exact_hits} exact hits, plain disagreements (vs the stored box) {plain_wrong}, conservative false hits {wide_false_hits}\n");
+        });
+    }
+    eprint!("{report}");
+}
+
+/// The directed (interval) variant is conservative in every format: IEEE floats, flush-to-zero
+/// floats and saturating fixed point.
+#[test]
+fn directed_variant_never_misses_in_any_format() {
+    let mut report = String::new();
+    for name in ALL {
+        with_format!(fmt(name), |f| {
+            let s = Slab::new(f, directed());
+            let mut r = SplitMix64::new(0x51ab_0005);
+            let (mut n, mut hits, mut false_hits) = (0, 0, 0);
+            for _ in 0..20_000 {
+                let (o, d, tmax, lo, hi) = random_case(&mut r);
+                let q = |x: f64| f.to_f64(f.from_f64(x));
+                let (oq, dq) = (o.map(q), d.map(q));
+                // the ray must fit the format (fixed point saturates instead of overflowing)
+                if o.iter()
+                    .chain(d.iter())
+                    .zip(oq.iter().chain(dq.iter()))
+                    .any(|(x, y)| !y.is_finite() || (x.abs() > 1.0 && (x - y).abs() > x.abs() * 0.5))
+                {
+                    continue;
+                }
+                let Ok(b) = s.store_box(lo, hi) else { continue };
+                let tq = q(tmax);
+                let exact = slab_exact(oq, dq, 0.0, tq, lo, hi);
+                let hit = s.test(&s.prepare(o, d, 0.0, tmax), &b).hit;
+                assert!(hit || !exact, "{name}: directed missed o {o:?} d {d:?} tmax {tmax} box {lo:?}..{hi:?}");
+                n += 1;
+                hits += exact as u32;
+                false_hits += (hit && !exact) as u32;
+            }
+            assert!(n > 5000 && hits > 1000, "{name}: too few usable cases ({n}, {hits} hits)");
+            report += &format!("{name}: {n} cases, {hits} exact hits, directed false hits {false_hits}\n");
         });
     }
     eprint!("{report}");
@@ -299,15 +281,7 @@ fn conservative_variant_never_misses_and_the_plain_one_errs_only_within_four_ulp
 #[test]
 fn narrow_box_storage_contains_the_original() {
     let mut r = SplitMix64::new(0x51ab_0002);
-    for storage in [
-        "fp16",
-        "bf16",
-        "e5m2",
-        "fp16:ftz",
-        "q8.8",
-        "q16.16:nearest",
-        "f32",
-    ] {
+    for storage in ["fp16", "bf16", "e5m2", "fp16:ftz", "q8.8", "q16.16:nearest", "f32"] {
         with_format!(fmt(storage), |s| {
             let compute = Slab::new(fmt_f32(), SlabConfig::default());
             for _ in 0..20_000 {
@@ -326,10 +300,7 @@ fn narrow_box_storage_contains_the_original() {
                             storage.starts_with('q'),
                             "{storage}: float storage clamps to infinity, got out-of-range {x}"
                         );
-                        assert!(
-                            x.abs() > 127.0 || storage == "q8.8" && x.abs() > 127.0,
-                            "{storage}: {x} was in range"
-                        );
+                        assert!(x.abs() > 127.0 || storage == "q8.8" && x.abs() > 127.0, "{storage}: {x} was in range");
                     }
                     Err(e) => panic!("{storage}: {e}"),
                 }
@@ -337,22 +308,13 @@ fn narrow_box_storage_contains_the_original() {
             // beyond the float format's range: clamp to infinity, still containing
             if !storage.starts_with('q') {
                 let b = compute.store_box_via(&s, [-1e300; 3], [1e300; 3]).unwrap();
-                assert!(
-                    b.min.iter().all(|x| *x == f32::NEG_INFINITY)
-                        && b.max.iter().all(|x| *x == f32::INFINITY)
-                );
+                assert!(b.min.iter().all(|x| *x == f32::NEG_INFINITY) && b.max.iter().all(|x| *x == f32::INFINITY));
             }
         });
     }
     let s = Slab::new(fmt_f32(), SlabConfig::default());
-    assert_eq!(
-        s.store_box([0.0, f64::NAN, 0.0], [1.0; 3]).unwrap_err(),
-        BoxError::Nan
-    );
-    assert_eq!(
-        s.store_box([2.0, 0.0, 0.0], [1.0; 3]).unwrap_err(),
-        BoxError::Inverted
-    );
+    assert_eq!(s.store_box([0.0, f64::NAN, 0.0], [1.0; 3]).unwrap_err(), BoxError::Nan);
+    assert_eq!(s.store_box([2.0, 0.0, 0.0], [1.0; 3]).unwrap_err(), BoxError::Inverted);
     // zero-extent boxes stay zero-extent when exactly representable, and still contain the point
     let b = s.store_box([0.5; 3], [0.5; 3]).unwrap();
     assert_eq!((b.min, b.max), ([0.5; 3], [0.5; 3]));
@@ -371,10 +333,7 @@ fn conservative_holds_with_fp16_boxes_and_f32_arithmetic() {
         AnyFormat::F16(f) => f,
         _ => unreachable!(),
     };
-    let wide = Slab::new(
-        fmt_f32(),
-        cfg(SlabNan::Ignore, DirPrep::Plain, CONSERVATIVE_ULPS),
-    );
+    let wide = Slab::new(fmt_f32(), cfg(SlabNan::Ignore, DirPrep::Plain, CONSERVATIVE_ULPS));
     let mut r = SplitMix64::new(0x51ab_0003);
     let mut hits = 0;
     for _ in 0..20_000 {
@@ -394,10 +353,7 @@ fn batch_equals_scalar_and_empty_slots_are_never_hit() {
     let mut r = SplitMix64::new(0x51ab_0004);
     for name in ALL {
         with_format!(fmt(name), |f| {
-            for variant in [
-                cfg(SlabNan::Ignore, DirPrep::Plain, 0),
-                cfg(SlabNan::TakeOnFalse, DirPrep::Embree, 4),
-            ] {
+            for variant in [cfg(SlabNan::Ignore, DirPrep::Plain, 0), cfg(SlabNan::TakeOnFalse, DirPrep::Embree, 4)] {
                 let s = Slab::new(f, variant);
                 let (mut rays, mut boxes) = (SlabRaysSoa::default(), BoxesSoa::default());
                 let mut scalar = Vec::new();
@@ -413,25 +369,15 @@ fn batch_equals_scalar_and_empty_slots_are_never_hit() {
                     boxes.push(&b);
                     scalar.push(s.test(&ray, &b));
                     // empty slots: never hit by a ray whose origin and direction fit the format
-                    if o.iter()
-                        .chain(d.iter())
-                        .all(|x| f.to_f64(f.from_f64(*x)).is_finite())
-                    {
-                        assert!(
-                            !s.test(&ray, &s.empty_box()).hit,
-                            "{name} {variant:?}: empty slot hit by d {d:?}"
-                        );
+                    if o.iter().chain(d.iter()).all(|x| f.to_f64(f.from_f64(*x)).is_finite()) {
+                        assert!(!s.test(&ray, &s.empty_box()).hit, "{name} {variant:?}: empty slot hit by d {d:?}");
                     }
                 }
                 let mut out = SlabOutSoa::with_len(scalar.len());
                 s.batch(&rays, &boxes, &mut out);
                 for (i, o) in scalar.iter().enumerate() {
                     assert_eq!(
-                        (
-                            out.hit[i],
-                            f.to_bits(out.t_near[i]),
-                            f.to_bits(out.t_far[i])
-                        ),
+                        (out.hit[i], f.to_bits(out.t_near[i]), f.to_bits(out.t_far[i])),
                         (o.hit, f.to_bits(o.t_near), f.to_bits(o.t_far)),
                         "{name} case {i}"
                     );

@@ -58,11 +58,7 @@ impl Ctx {
         b
     }
     fn input(&mut self, x: f64) -> Bnd {
-        self.check(Bnd {
-            v: x,
-            a: x.abs(),
-            e: 0.0,
-        })
+        self.check(Bnd { v: x, a: x.abs(), e: 0.0 })
     }
     fn addsub(&mut self, x: Bnd, y: Bnd, sub: bool) -> Bnd {
         let v = if sub { x.v - y.v } else { x.v + y.v };
@@ -119,10 +115,7 @@ pub struct Verdict {
 impl RtiBound {
     /// Bounds for one ray (origin, direction) and triangle given as the format's values in f64.
     pub fn new(em: ErrorModel, div: DivMode, o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> Self {
-        let mut c = Ctx {
-            em,
-            overflow: false,
-        };
+        let mut c = Ctx { em, overflow: false };
         let o = o.map(|x| c.input(x));
         let d = d.map(|x| c.input(x));
         let v = v.map(|p| p.map(|x| c.input(x)));
@@ -166,9 +159,7 @@ impl RtiBound {
                     if 1.0 / denom > em.max {
                         c.overflow = true;
                     }
-                    (2.0 * u + u * u) * mag
-                        + em.eta * (num.v.abs() + num.err()) * (1.0 + u)
-                        + em.eta
+                    (2.0 * u + u * u) * mag + em.eta * (num.v.abs() + num.err()) * (1.0 + u) + em.eta
                 }
                 DivMode::Divide => u * mag + em.eta,
             };
@@ -180,17 +171,7 @@ impl RtiBound {
         let t_err = quot(tp, &mut c);
         let u_err = quot(up, &mut c);
         let v_err = quot(vp, &mut c);
-        Self {
-            det,
-            up,
-            vp,
-            tp,
-            uv,
-            t_err,
-            u_err,
-            v_err,
-            overflow: c.overflow,
-        }
+        Self { det, up, vp, tp, uv, t_err, u_err, v_err, overflow: c.overflow }
     }
 
     /// Exact t (f64 evaluation).

@@ -42,16 +42,11 @@ pub struct Recorder<V> {
 impl<V: Copy> Recorder<V> {
     /// An empty recorder.
     pub fn new() -> Self {
-        Self {
-            signals: Vec::new(),
-        }
+        Self { signals: Vec::new() }
     }
     /// The signal with this name, if recorded.
     pub fn get(&self, name: &str) -> Option<Signal<V>> {
-        self.signals
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, s)| *s)
+        self.signals.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
     }
     /// The register with this name, if recorded.
     pub fn value(&self, name: &str) -> Option<V> {

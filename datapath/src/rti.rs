@@ -81,11 +81,7 @@ pub struct RtiConfig {
 
 impl Default for RtiConfig {
     fn default() -> Self {
-        Self {
-            cull: Cull::TwoSided,
-            det_threshold: 0.0,
-            tie: TieRule::First,
-        }
+        Self { cull: Cull::TwoSided, det_threshold: 0.0, tie: TieRule::First }
     }
 }
 
@@ -122,31 +118,15 @@ pub struct SigDef {
 }
 
 const fn s(stage: u8, name: &'static str, op: Op, a: &'static str, b: &'static str) -> SigDef {
-    SigDef {
-        stage,
-        name,
-        op,
-        a,
-        b,
-        note: "",
-    }
+    SigDef { stage, name, op, a, b, note: "" }
 }
 const fn l(stage: u8, name: &'static str, note: &'static str) -> SigDef {
-    SigDef {
-        stage,
-        name,
-        op: Op::Logic,
-        a: "",
-        b: "",
-        note,
-    }
+    SigDef { stage, name, op: Op::Logic, a: "", b: "", note }
 }
 
 /// Input signal names: ray origin, direction, t interval, triangle vertices, and the constant one.
-pub const RTI_INPUTS: [&str; 17] = [
-    "ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax", "v0x", "v0y", "v0z", "v1x", "v1y", "v1z",
-    "v2x", "v2y", "v2z",
-];
+pub const RTI_INPUTS: [&str; 17] =
+    ["ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax", "v0x", "v0y", "v0z", "v1x", "v1y", "v1z", "v2x", "v2y", "v2z"];
 
 const STAGES_1_TO_7: [SigDef; 53] = [
     // stage 1: the nine subtracts, in parallel
@@ -204,11 +184,7 @@ const STAGES_1_TO_7: [SigDef; 53] = [
     s(6, "tp", Op::Add, "tp_xy", "tpz"),
     // stage 7: u' + v' and the division-free validity test; the valid bit may be cleared here
     s(7, "uv", Op::Add, "up", "vp"),
-    l(
-        7,
-        "det_ok",
-        "two-sided: threshold < |det|; backface culling: threshold < det",
-    ),
+    l(7, "det_ok", "two-sided: threshold < |det|; backface culling: threshold < det"),
     l(7, "u_ok", "det > 0 ? 0 <= u' : u' <= 0"),
     l(7, "v_ok", "det > 0 ? 0 <= v' : v' <= 0"),
     l(7, "uv_ok", "det > 0 ? u'+v' <= det : det <= u'+v'"),
@@ -287,40 +263,23 @@ impl<F: Format> Rti<F> {
     /// An RTI unit with the given options.
     pub fn new(fmt: F, cfg: RtiConfig) -> Self {
         let det_thr = fmt.from_f64(cfg.det_threshold.max(0.0));
-        Self {
-            fmt,
-            cull: cfg.cull,
-            det_thr,
-            tie: cfg.tie,
-        }
+        Self { fmt, cull: cfg.cull, det_thr, tie: cfg.tie }
     }
 
     /// Converts an f64 ray into the format.
     pub fn ray(&self, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64) -> Ray<F::V> {
         let f = &self.fmt;
-        Ray {
-            o: o.map(|x| f.from_f64(x)),
-            d: d.map(|x| f.from_f64(x)),
-            tmin: f.from_f64(tmin),
-            tmax: f.from_f64(tmax),
-        }
+        Ray { o: o.map(|x| f.from_f64(x)), d: d.map(|x| f.from_f64(x)), tmin: f.from_f64(tmin), tmax: f.from_f64(tmax) }
     }
 
     /// Converts an f64 triangle into the format.
     pub fn tri(&self, v: [[f64; 3]; 3]) -> Tri<F::V> {
-        Tri {
-            v: v.map(|p| p.map(|x| self.fmt.from_f64(x))),
-        }
+        Tri { v: v.map(|p| p.map(|x| self.fmt.from_f64(x))) }
     }
 
     /// Runs one ray–triangle test through every stage, reporting each signal to the probe.
     #[inline(always)]
-    pub fn trace<P: Probe<F::V>>(
-        &self,
-        ray: &Ray<F::V>,
-        tri: &Tri<F::V>,
-        p: &mut P,
-    ) -> RtiOut<F::V> {
+    pub fn trace<P: Probe<F::V>>(&self, ray: &Ray<F::V>, tri: &Tri<F::V>, p: &mut P) -> RtiOut<F::V> {
         let f = &self.fmt;
         let [ox, oy, oz] = ray.o;
         let [dx, dy, dz] = ray.d;
@@ -413,13 +372,7 @@ impl<F: Format> Rti<F> {
         let tmax_ok = f.le(t, ray.tmax);
         let hit = valid & tmin_ok & tmax_ok;
         record_flags!(p; tmin_ok, tmax_ok, hit);
-        RtiOut {
-            valid,
-            hit,
-            t,
-            u,
-            v,
-        }
+        RtiOut { valid, hit, t, u, v }
     }
 
     /// One ray–triangle test without probing.
@@ -441,13 +394,7 @@ impl<F: Format> Rti<F> {
                 TieRule::Last => self.fmt.le(out.t, c.t),
             };
         if take {
-            *c = Capture {
-                hit: true,
-                t: out.t,
-                u: out.u,
-                v: out.v,
-                id,
-            };
+            *c = Capture { hit: true, t: out.t, u: out.u, v: out.v, id };
         }
     }
 
@@ -466,18 +413,9 @@ impl<F: Format> Rti<F> {
     ///
     /// # Panics
     /// If `out` is shorter than the packet.
-    pub fn packet(
-        &self,
-        rays: &RaysSoa<F::V>,
-        tris: &TrisSoa<F::V>,
-        first_id: u32,
-        out: &mut [Capture<F::V>],
-    ) {
+    pub fn packet(&self, rays: &RaysSoa<F::V>, tris: &TrisSoa<F::V>, first_id: u32, out: &mut [Capture<F::V>]) {
         let n = rays.len();
-        assert!(
-            out.len() >= n,
-            "min-capture buffer shorter than the ray packet"
-        );
+        assert!(out.len() >= n, "min-capture buffer shorter than the ray packet");
         out[..n].fill(Capture::default());
         for i in 0..tris.len() {
             let tri = tris.get(i);
@@ -577,9 +515,7 @@ impl<V: Copy> TrisSoa<V> {
     /// Triangle i.
     #[inline(always)]
     pub fn get(&self, i: usize) -> Tri<V> {
-        Tri {
-            v: [0, 1, 2].map(|j| [self.v[j][0][i], self.v[j][1][i], self.v[j][2][i]]),
-        }
+        Tri { v: [0, 1, 2].map(|j| [self.v[j][0][i], self.v[j][1][i], self.v[j][2][i]]) }
     }
 }
 

@@ -54,6 +54,9 @@ pub struct SlabConfig {
     /// (0 = plain; negative narrows). 4 makes a float datapath with IEEE subnormals conservative
     /// (see [`CONSERVATIVE_ULPS`]); −4 makes it never report a hit the exact test misses.
     pub widen_ulps: i32,
+    /// Directed interval arithmetic instead of round-to-nearest (see [`Slab::trace_directed`]):
+    /// conservative in every format, fixed point and flush-to-zero included.
+    pub directed: bool,
 }
 
 /// Widening that makes the float slab test conservative: the exact t = (b − o)/d and the
@@ -64,39 +67,41 @@ pub struct SlabConfig {
 pub const CONSERVATIVE_ULPS: i32 = 4;
 
 /// The named slab variants: `plain` (Ignore, Plain, 0), `conservative` (Ignore, Plain, +4),
-/// `take-on-false` (TakeOnFalse, Plain, 0), `embree` (Ignore, Embree, 0).
-pub const SLAB_VARIANTS: [&str; 4] = ["plain", "conservative", "take-on-false", "embree"];
+/// `directed` (interval arithmetic), `take-on-false` (TakeOnFalse, Plain, 0), `embree` (Ignore, Embree, 0).
+pub const SLAB_VARIANTS: [&str; 5] = ["plain", "conservative", "directed", "take-on-false", "embree"];
 
 impl SlabConfig {
+    /// Whether this variant promises zero false misses in format `f`: the directed variant in
+    /// every format that does not wrap; ulp widening by at least [`CONSERVATIVE_ULPS`] in float
+    /// formats with IEEE subnormals.
+    pub fn is_conservative<F: Format>(&self, f: &F) -> bool {
+        let float = matches!(f.kind(), crate::format::FormatKind::Float(_));
+        (self.directed && !f.wraps())
+            || (!self.directed
+                && self.nan == SlabNan::Ignore
+                && self.prep == DirPrep::Plain
+                && self.widen_ulps >= CONSERVATIVE_ULPS
+                && float
+                && !f.flushes())
+    }
+
     /// A named variant (see [`SLAB_VARIANTS`]).
     pub fn named(name: &str) -> Result<Self, String> {
-        let c = |nan, prep, widen_ulps| {
-            Ok(SlabConfig {
-                nan,
-                prep,
-                widen_ulps,
-            })
-        };
+        let c = |nan, prep, widen_ulps| Ok(SlabConfig { nan, prep, widen_ulps, directed: false });
         match name {
             "plain" => c(SlabNan::Ignore, DirPrep::Plain, 0),
+            "directed" => Ok(SlabConfig { directed: true, ..SlabConfig::default() }),
             "conservative" => c(SlabNan::Ignore, DirPrep::Plain, CONSERVATIVE_ULPS),
             "take-on-false" => c(SlabNan::TakeOnFalse, DirPrep::Plain, 0),
             "embree" => c(SlabNan::Ignore, DirPrep::Embree, 0),
-            other => Err(format!(
-                "unknown slab variant '{other}'; variants: {}",
-                SLAB_VARIANTS.join(", ")
-            )),
+            other => Err(format!("unknown slab variant '{other}'; variants: {}", SLAB_VARIANTS.join(", "))),
         }
     }
 }
 
 impl Default for SlabConfig {
     fn default() -> Self {
-        Self {
-            nan: SlabNan::Ignore,
-            prep: DirPrep::Plain,
-            widen_ulps: 0,
-        }
+        Self { nan: SlabNan::Ignore, prep: DirPrep::Plain, widen_ulps: 0, directed: false }
     }
 }
 
@@ -111,6 +116,15 @@ pub struct SlabRay<V> {
     pub tmin: V,
     /// Largest accepted t.
     pub tmax: V,
+    /// Directed variant: a lower bound of 1/d per axis.
+    pub inv_lo: [V; 3],
+    /// Directed variant: an upper bound of 1/d per axis.
+    pub inv_hi: [V; 3],
+    /// Directed variant: the axis is treated as parallel (d = 0; in fixed point also a saturated 1/d).
+    pub parallel: [bool; 3],
+    /// Directed variant, fixed point: 1/d saturated, so its far end (`inv_hi` for d > 0,
+    /// `inv_lo` for d < 0) stands for ±∞.
+    pub inv_inf: [bool; 3],
 }
 
 /// An axis-aligned box.
@@ -205,12 +219,37 @@ impl<F: Format> Slab<F> {
         let inv_dy = f.div(one, pdy);
         let inv_dz = f.div(one, pdz);
         record!(p; dx, dy, dz, pdx, pdy, pdz, inv_dx, inv_dy, inv_dz);
-        SlabRay {
+        let inv = [inv_dx, inv_dy, inv_dz];
+        let mut ray = SlabRay {
             o: o.map(|x| f.from_f64(x)),
-            inv_d: [inv_dx, inv_dy, inv_dz],
+            inv_d: inv,
             tmin: f.from_f64(tmin),
             tmax: f.from_f64(tmax),
+            inv_lo: inv,
+            inv_hi: inv,
+            parallel: [false; 3],
+            inv_inf: [false; 3],
+        };
+        if self.cfg.directed {
+            let fixed = matches!(f.kind(), crate::format::FormatKind::Fixed { .. });
+            let (top, bottom) = (f.from_f64(f64::INFINITY), f.from_f64(f64::NEG_INFINITY));
+            let d = [dx, dy, dz];
+            for a in 0..3 {
+                let bits = f.to_bits(inv[a]);
+                let saturated = fixed && (bits == f.to_bits(top) || bits == f.to_bits(bottom));
+                ray.inv_inf[a] = saturated;
+                let zero = f.le(d[a], f.zero()) && f.le(f.zero(), d[a]);
+                ray.parallel[a] = zero;
+                ray.inv_lo[a] = f.next_down(inv[a]);
+                ray.inv_hi[a] = f.next_up(inv[a]);
+            }
+            let [inv_lox, inv_loy, inv_loz] = ray.inv_lo;
+            let [inv_hix, inv_hiy, inv_hiz] = ray.inv_hi;
+            let [parx, pary, parz] = ray.parallel;
+            record!(p; inv_lox, inv_loy, inv_loz, inv_hix, inv_hiy, inv_hiz);
+            record_flags!(p; parx, pary, parz);
         }
+        ray
     }
 
     /// Stage 0 without probing.
@@ -270,12 +309,10 @@ impl<F: Format> Slab<F> {
 
     /// One ray–box test through every stage, reporting each signal to the probe.
     #[inline(always)]
-    pub fn trace<P: Probe<F::V>>(
-        &self,
-        r: &SlabRay<F::V>,
-        b: &Aabb<F::V>,
-        p: &mut P,
-    ) -> SlabOut<F::V> {
+    pub fn trace<P: Probe<F::V>>(&self, r: &SlabRay<F::V>, b: &Aabb<F::V>, p: &mut P) -> SlabOut<F::V> {
+        if self.cfg.directed {
+            return self.trace_directed(r, b, p);
+        }
         let f = &self.fmt;
         let [ox, oy, oz] = r.o;
         let [ix, iy, iz] = r.inv_d;
@@ -325,11 +362,82 @@ impl<F: Format> Slab<F> {
         // stage 6: decision
         let hit = f.le(near_w, far_w);
         record_flags!(p; hit);
-        SlabOut {
-            hit,
-            t_near: near_w,
-            t_far: far_w,
+        SlabOut { hit, t_near: near_w, t_far: far_w }
+    }
+
+    /// The directed variant: interval arithmetic in the format's own operations, conservative
+    /// in every format. Stage 0 adds `1/d` bounds `inv_lo = next_down(1 ⊘ d)`,
+    /// `inv_hi = next_up(1 ⊘ d)` and a parallel flag per axis (d = 0; in fixed point also a
+    /// saturated 1/d). Stage 1 brackets each plane distance: `lo = next_down(b ⊖ o)`,
+    /// `hi = next_up(b ⊖ o)` (one rounded subtract, then ±1 step: the exact difference lies
+    /// within one step of any rounding, flushes included). Stage 2 forms, with 6 multiplies,
+    /// a lower bound of the entry plane's t and an upper bound of the exit plane's t, picking
+    /// the bracket ends by sign (entry plane = min plane when d > 0, max plane when d < 0) and
+    /// stepping each product outward once more. Stage 4 accumulates with the `Ignore`
+    /// comparator (a NaN, possible only as 0 × ∞, drops that constraint: conservative); a
+    /// parallel axis adds no constraint when `min <= o <= max` and forces a miss otherwise.
+    /// Saturated fixed-point values stay bounds: a saturated lower bound is below the true
+    /// value, and an upper bound saturated at the format's maximum still reaches `tmax`.
+    pub fn trace_directed<P: Probe<F::V>>(&self, r: &SlabRay<F::V>, b: &Aabb<F::V>, p: &mut P) -> SlabOut<F::V> {
+        let f = &self.fmt;
+        let mut near = r.tmin;
+        let mut far = r.tmax;
+        let mut outside = false;
+        for a in 0..3 {
+            let o = r.o[a];
+            if r.parallel[a] {
+                let inside = f.le(b.min[a], o) && f.le(o, b.max[a]);
+                outside |= !inside;
+                if P::ON {
+                    p.flag(["inside_x", "inside_y", "inside_z"][a], inside);
+                }
+                continue;
+            }
+            let neg = f.sign_bit(r.inv_d[a]);
+            // entry plane and exit plane of this axis
+            let (pe, px) = if neg { (b.max[a], b.min[a]) } else { (b.min[a], b.max[a]) };
+            let de = f.sub(pe, o);
+            let dxp = f.sub(px, o);
+            let (de_lo, de_hi) = (f.next_down(de), f.next_up(de));
+            let (dx_lo, dx_hi) = (f.next_down(dxp), f.next_up(dxp));
+            // lower bound of de·inv: inv > 0 → smallest de, inv < 0 → largest de; then the inv
+            // end by that product's sign. `true` marks the end of 1/d that is far from zero.
+            let (x_e, (inv_e, far_e)) = if neg {
+                (de_hi, if f.sign_bit(de_hi) { (r.inv_hi[a], false) } else { (r.inv_lo[a], true) })
+            } else {
+                (de_lo, if f.sign_bit(de_lo) { (r.inv_hi[a], true) } else { (r.inv_lo[a], false) })
+            };
+            // upper bound of dx·inv: inv > 0 → largest dx, inv < 0 → smallest dx
+            let (x_x, (inv_x, far_x)) = if neg {
+                (dx_lo, if f.sign_bit(dx_lo) { (r.inv_lo[a], true) } else { (r.inv_hi[a], false) })
+            } else {
+                (dx_hi, if f.sign_bit(dx_hi) { (r.inv_lo[a], false) } else { (r.inv_hi[a], true) })
+            };
+            // a saturated 1/d: its far end is ±∞, so the product saturates by the signs
+            let (top, bottom) = (f.from_f64(f64::INFINITY), f.from_f64(f64::NEG_INFINITY));
+            let inf_prod = |x: F::V| {
+                if f.le(x, f.zero()) && f.le(f.zero(), x) {
+                    f.zero()
+                } else if f.sign_bit(x) != neg {
+                    bottom
+                } else {
+                    top
+                }
+            };
+            let t_entry = if r.inv_inf[a] && far_e { inf_prod(x_e) } else { f.next_down(f.mul(x_e, inv_e)) };
+            let t_exit = if r.inv_inf[a] && far_x { inf_prod(x_x) } else { f.next_up(f.mul(x_x, inv_x)) };
+            if P::ON {
+                p.value(["entry_x", "entry_y", "entry_z"][a], t_entry);
+                p.value(["exit_x", "exit_y", "exit_z"][a], t_exit);
+            }
+            near = self.near_sel(near, t_entry);
+            far = self.far_sel(far, t_exit);
         }
+        let (t_near, t_far) = (near, far);
+        record!(p; t_near, t_far);
+        let hit = !outside && f.le(t_near, t_far);
+        record_flags!(p; outside, hit);
+        SlabOut { hit, t_near, t_far }
     }
 
     /// One ray–box test without probing.
@@ -349,10 +457,7 @@ impl<F: Format> Slab<F> {
         if (0..3).any(|a| min[a] > max[a]) {
             return Err(BoxError::Inverted);
         }
-        let mut b = Aabb {
-            min: [f.zero(); 3],
-            max: [f.zero(); 3],
-        };
+        let mut b = Aabb { min: [f.zero(); 3], max: [f.zero(); 3] };
         for a in 0..3 {
             b.min[a] = f.round_down(min[a]);
             b.max[a] = f.round_up(max[a]);
@@ -369,12 +474,7 @@ impl<F: Format> Slab<F> {
     /// Stores an f64 box in a (narrower) storage format `S`, outward-rounded, then widens it into
     /// this compute format, again outward: the datapath's box contains the original (the
     /// thesis's fp16 bounding volumes with f32 arithmetic).
-    pub fn store_box_via<S: Format>(
-        &self,
-        s: &S,
-        min: [f64; 3],
-        max: [f64; 3],
-    ) -> Result<Aabb<F::V>, BoxError> {
+    pub fn store_box_via<S: Format>(&self, s: &S, min: [f64; 3], max: [f64; 3]) -> Result<Aabb<F::V>, BoxError> {
         let stored = Slab::new(*s, self.cfg).store_box(min, max)?;
         let lo = stored.min.map(|v| s.to_f64(v));
         let hi = stored.max.map(|v| s.to_f64(v));
@@ -388,10 +488,7 @@ impl<F: Format> Slab<F> {
         let f = &self.fmt;
         let hi = f.from_f64(f64::INFINITY);
         let lo = f.from_f64(f64::NEG_INFINITY);
-        Aabb {
-            min: [hi; 3],
-            max: [lo; 3],
-        }
+        Aabb { min: [hi; 3], max: [lo; 3] }
     }
 
     /// Pairwise batch over structure-of-arrays: ray i against box i. Bit-identical to
@@ -399,17 +496,9 @@ impl<F: Format> Slab<F> {
     ///
     /// # Panics
     /// If the columns differ in length.
-    pub fn batch(
-        &self,
-        rays: &SlabRaysSoa<F::V>,
-        boxes: &BoxesSoa<F::V>,
-        out: &mut SlabOutSoa<F::V>,
-    ) {
+    pub fn batch(&self, rays: &SlabRaysSoa<F::V>, boxes: &BoxesSoa<F::V>, out: &mut SlabOutSoa<F::V>) {
         let n = rays.tmin.len();
-        assert!(
-            boxes.min[0].len() == n && out.hit.len() == n,
-            "batch lengths differ"
-        );
+        assert!(boxes.min[0].len() == n && out.hit.len() == n, "batch lengths differ");
         for i in 0..n {
             let o = self.test(&rays.get(i), &boxes.get(i));
             out.hit[i] = o.hit;
@@ -426,6 +515,14 @@ pub struct SlabRaysSoa<V> {
     pub o: [Vec<V>; 3],
     /// Reciprocal direction columns.
     pub inv_d: [Vec<V>; 3],
+    /// Lower 1/d bound columns (directed variant).
+    pub inv_lo: [Vec<V>; 3],
+    /// Upper 1/d bound columns (directed variant).
+    pub inv_hi: [Vec<V>; 3],
+    /// Parallel-axis flag columns (directed variant).
+    pub parallel: [Vec<bool>; 3],
+    /// Saturated-reciprocal flag columns (directed variant, fixed point).
+    pub inv_inf: [Vec<bool>; 3],
     /// tmin column.
     pub tmin: Vec<V>,
     /// tmax column.
@@ -438,6 +535,10 @@ impl<V: Copy> SlabRaysSoa<V> {
         for a in 0..3 {
             self.o[a].push(r.o[a]);
             self.inv_d[a].push(r.inv_d[a]);
+            self.inv_lo[a].push(r.inv_lo[a]);
+            self.inv_hi[a].push(r.inv_hi[a]);
+            self.parallel[a].push(r.parallel[a]);
+            self.inv_inf[a].push(r.inv_inf[a]);
         }
         self.tmin.push(r.tmin);
         self.tmax.push(r.tmax);
@@ -450,6 +551,10 @@ impl<V: Copy> SlabRaysSoa<V> {
             inv_d: [self.inv_d[0][i], self.inv_d[1][i], self.inv_d[2][i]],
             tmin: self.tmin[i],
             tmax: self.tmax[i],
+            inv_lo: [self.inv_lo[0][i], self.inv_lo[1][i], self.inv_lo[2][i]],
+            inv_hi: [self.inv_hi[0][i], self.inv_hi[1][i], self.inv_hi[2][i]],
+            parallel: [self.parallel[0][i], self.parallel[1][i], self.parallel[2][i]],
+            inv_inf: [self.inv_inf[0][i], self.inv_inf[1][i], self.inv_inf[2][i]],
         }
     }
 }
@@ -495,10 +600,6 @@ pub struct SlabOutSoa<V> {
 impl<V: Copy + Default> SlabOutSoa<V> {
     /// Output columns for `n` results.
     pub fn with_len(n: usize) -> Self {
-        Self {
-            hit: vec![false; n],
-            t_near: vec![V::default(); n],
-            t_far: vec![V::default(); n],
-        }
+        Self { hit: vec![false; n], t_near: vec![V::default(); n], t_far: vec![V::default(); n] }
     }
 }

@@ -6,8 +6,8 @@
 mod oracle;
 
 use datapath::format::{
-    Bf16, DivMode, F16Half, F32Native, Fixed, FloatLayout, Format, FpOpts, FxOverflow, FxRound,
-    Ieee, IeeeBackend, NanMode, Soft, Subnormals,
+    Bf16, DivMode, F16Half, F32Native, Fixed, FloatLayout, Format, FpOpts, FxOverflow, FxRound, Ieee, IeeeBackend,
+    NanMode, Soft, Subnormals,
 };
 use datapath::rng::SplitMix64;
 use num_rational::BigRational;
@@ -17,10 +17,7 @@ use softfloat_wrapper::{Float as _, RoundingMode, F16 as Sf16, F32 as Sf32};
 const SEED: u64 = 0x5eed_0001;
 
 fn divide() -> FpOpts {
-    FpOpts {
-        div: DivMode::Divide,
-        ..FpOpts::default()
-    }
+    FpOpts { div: DivMode::Divide, ..FpOpts::default() }
 }
 
 fn apply<F: Format>(f: &F, op: Op, a: F::V, b: F::V) -> F::V {
@@ -40,18 +37,7 @@ fn specials(l: FloatLayout) -> Vec<u64> {
     exps.retain(|&e| e <= top);
     let mm = l.man_mask();
     let half = 1u64 << (l.man_bits - 1);
-    let fracs = [
-        0,
-        1,
-        2,
-        half,
-        half + 1,
-        mm,
-        mm - 1,
-        0x5555_5555_5555_5555 & mm,
-        mm >> 1,
-        (half >> 1) | 1,
-    ];
+    let fracs = [0, 1, 2, half, half + 1, mm, mm - 1, 0x5555_5555_5555_5555 & mm, mm >> 1, (half >> 1) | 1];
     let mut v = Vec::new();
     for &e in &exps {
         for &f in &fracs {
@@ -99,10 +85,7 @@ fn random_pairs(l: FloatLayout, n: usize, seed: u64) -> Vec<(u64, u64)> {
 
 fn all_cases(l: FloatLayout, n: usize, seed: u64) -> Vec<(u64, u64)> {
     let sp = specials(l);
-    let mut v: Vec<(u64, u64)> = sp
-        .iter()
-        .flat_map(|&a| sp.iter().map(move |&b| (a, b)))
-        .collect();
+    let mut v: Vec<(u64, u64)> = sp.iter().flat_map(|&a| sp.iter().map(move |&b| (a, b))).collect();
     v.extend(random_pairs(l, n, seed));
     v
 }
@@ -115,10 +98,7 @@ fn check_against_rationals<B: IeeeBackend>(f: &Ieee<B>, n: usize) {
             let got = f.to_bits(apply(f, op, f.from_bits(a), f.from_bits(b)));
             let want = oracle::float_op(l, op, a, b);
             if got != want && failures.len() < 10 {
-                failures.push(format!(
-                    "{} {op:?} {a:#x} {b:#x}: got {got:#x} want {want:#x}",
-                    f.name()
-                ));
+                failures.push(format!("{} {op:?} {a:#x} {b:#x}: got {got:#x} want {want:#x}", f.name()));
             }
         }
     }
@@ -127,18 +107,7 @@ fn check_against_rationals<B: IeeeBackend>(f: &Ieee<B>, n: usize) {
 
 #[test]
 fn custom_layouts_match_exact_rationals() {
-    for (e, m) in [
-        (8, 16),
-        (5, 2),
-        (4, 3),
-        (2, 1),
-        (6, 9),
-        (5, 10),
-        (8, 7),
-        (8, 23),
-        (11, 52),
-        (3, 20),
-    ] {
+    for (e, m) in [(8, 16), (5, 2), (4, 3), (2, 1), (6, 9), (5, 10), (8, 7), (8, 23), (11, 52), (3, 20)] {
         check_against_rationals(&Ieee::new(Soft(FloatLayout::new(e, m)), divide()), 3000);
     }
 }
@@ -188,17 +157,10 @@ fn check_against_softfloat<B: IeeeBackend>(f: &Ieee<B>, sf: fn(Op, u64, u64) -> 
         for op in OPS {
             let got = f.to_bits(apply(f, op, f.from_bits(a), f.from_bits(b)));
             let want = sf(op, a, b);
-            let ok = if l.is_nan(want) {
-                got == l.canonical_nan()
-            } else {
-                got == want
-            };
+            let ok = if l.is_nan(want) { got == l.canonical_nan() } else { got == want };
             count += 1;
             if !ok && failures.len() < 10 {
-                failures.push(format!(
-                    "{} {op:?} {a:#x} {b:#x}: got {got:#x} softfloat {want:#x}",
-                    f.name()
-                ));
+                failures.push(format!("{} {op:?} {a:#x} {b:#x}: got {got:#x} softfloat {want:#x}", f.name()));
             }
         }
     }
@@ -231,11 +193,7 @@ fn native_backends_equal_the_soft_engine() {
     for opts in [
         divide(),
         FpOpts::default(),
-        FpOpts {
-            subnormals: Subnormals::Ftz,
-            nan: NanMode::Propagate,
-            div: DivMode::Divide,
-        },
+        FpOpts { subnormals: Subnormals::Ftz, nan: NanMode::Propagate, div: DivMode::Divide },
     ] {
         cmp(Ieee::new(F32Native, opts));
         cmp(Ieee::new(F16Half, opts));
@@ -246,37 +204,18 @@ fn native_backends_equal_the_soft_engine() {
 fn conversions<B: IeeeBackend>(f: &Ieee<B>) {
     let l = f.backend.layout();
     let mut r = SplitMix64::new(SEED ^ 0xc0);
-    let mut xs: Vec<f64> = vec![
-        0.0,
-        -0.0,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::MIN_POSITIVE,
-        5e-324,
-        f64::MAX,
-        1.0,
-        -1.0,
-    ];
+    let mut xs: Vec<f64> =
+        vec![0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, f64::MIN_POSITIVE, 5e-324, f64::MAX, 1.0, -1.0];
     for _ in 0..20_000 {
         // random f64 across and beyond the format's range
-        let e = r
-            .range(
-                l.emin() as f64 - l.man_bits as f64 - 4.0,
-                l.emax() as f64 + 3.0,
-            )
-            .floor() as i32;
+        let e = r.range(l.emin() as f64 - l.man_bits as f64 - 4.0, l.emax() as f64 + 3.0).floor() as i32;
         let x = r.range(1.0, 2.0) * 2f64.powi(e);
         xs.push(if r.below(2) == 0 { x } else { -x });
         // exact midpoints between neighbours (ties) and their neighbours in f64
         let b = r.next_u64() & (l.sign_mask() | l.exp_mask() | l.man_mask()) & !l.sign_mask();
         if !l.is_nan(b) && !l.is_inf(b) && !l.is_inf(b + 1) && l.man_bits < 52 {
             let mid = (l.to_f64(b) + l.to_f64(b + 1)) / 2.0;
-            xs.extend([
-                mid,
-                -mid,
-                f64::from_bits(mid.to_bits() + 1),
-                f64::from_bits(mid.to_bits() - 1),
-            ]);
+            xs.extend([mid, -mid, f64::from_bits(mid.to_bits() + 1), f64::from_bits(mid.to_bits() - 1)]);
         }
     }
     for x in xs {
@@ -285,12 +224,7 @@ fn conversions<B: IeeeBackend>(f: &Ieee<B>) {
         assert_eq!(got, want, "{} from_f64({x:e})", f.name());
         if !l.is_nan(got) && !l.is_inf(got) {
             let back = f.to_f64(f.from_bits(got));
-            assert_eq!(
-                BigRational::from_float(back).unwrap(),
-                oracle::exact(l, got),
-                "{} to_f64({got:#x})",
-                f.name()
-            );
+            assert_eq!(BigRational::from_float(back).unwrap(), oracle::exact(l, got), "{} to_f64({got:#x})", f.name());
         }
     }
 }
@@ -318,21 +252,12 @@ fn half_crate_from_f64_is_not_correctly_rounded_but_ours_is() {
 #[test]
 fn flush_to_zero_flushes_operands_and_results() {
     fn ftz<B: IeeeBackend>(b: B) {
-        let f = Ieee::new(
-            b,
-            FpOpts {
-                subnormals: Subnormals::Ftz,
-                ..divide()
-            },
-        );
+        let f = Ieee::new(b, FpOpts { subnormals: Subnormals::Ftz, ..divide() });
         let l = b.layout();
         for (a, c) in all_cases(l, 5000, SEED ^ 0xf7) {
             for op in OPS {
                 let got = f.to_bits(apply(&f, op, f.from_bits(a), f.from_bits(c)));
-                let want = oracle::flush(
-                    l,
-                    oracle::float_op(l, op, oracle::flush(l, a), oracle::flush(l, c)),
-                );
+                let want = oracle::flush(l, oracle::float_op(l, op, oracle::flush(l, a), oracle::flush(l, c)));
                 assert_eq!(got, want, "{} {op:?} {a:#x} {c:#x}", f.name());
             }
         }
@@ -351,13 +276,7 @@ fn nan_rules_canonical_and_propagate() {
     fn nan<B: IeeeBackend>(b: B) {
         let l = b.layout();
         let canon = Ieee::new(b, divide());
-        let prop = Ieee::new(
-            b,
-            FpOpts {
-                nan: NanMode::Propagate,
-                ..divide()
-            },
-        );
+        let prop = Ieee::new(b, FpOpts { nan: NanMode::Propagate, ..divide() });
         let snan = l.exp_mask() | 1; // signalling, payload 1
         let neg_qnan = l.sign_mask() | l.exp_mask() | (1 << (l.man_bits - 1)) | 1;
         let one = l.from_f64(1.0);
@@ -373,14 +292,8 @@ fn nan_rules_canonical_and_propagate() {
         }
         // invalid operations make the canonical NaN in both modes
         for f in [&canon, &prop] {
-            assert_eq!(
-                f.to_bits(f.sub(f.from_bits(inf), f.from_bits(inf))),
-                l.canonical_nan()
-            );
-            assert_eq!(
-                f.to_bits(f.mul(f.from_bits(inf), f.zero())),
-                l.canonical_nan()
-            );
+            assert_eq!(f.to_bits(f.sub(f.from_bits(inf), f.from_bits(inf))), l.canonical_nan());
+            assert_eq!(f.to_bits(f.mul(f.from_bits(inf), f.zero())), l.canonical_nan());
             assert_eq!(f.to_bits(f.div(f.zero(), f.zero())), l.canonical_nan());
         }
     }
@@ -404,10 +317,7 @@ fn recip_mul_division_is_reciprocal_then_multiply() {
             assert_eq!(got, want, "{} {a:#x} / {c:#x}", f.name());
             differs += (want != oracle::float_op(l, Op::Div, a, c)) as u32;
         }
-        assert!(
-            differs > 0,
-            "recip-mul never differed from a true divide: the test cannot tell them apart"
-        );
+        assert!(differs > 0, "recip-mul never differed from a true divide: the test cannot tell them apart");
     }
     rm(F32Native);
     rm(F16Half);
@@ -416,22 +326,8 @@ fn recip_mul_division_is_reciprocal_then_multiply() {
 
 fn fixed_formats() -> Vec<Fixed> {
     let mut v = Vec::new();
-    for (i, f) in [
-        (8, 24),
-        (16, 16),
-        (1, 15),
-        (4, 4),
-        (33, 31),
-        (2, 62),
-        (64, 0),
-        (1, 1),
-    ] {
-        for round in [
-            FxRound::Floor,
-            FxRound::Ceil,
-            FxRound::Trunc,
-            FxRound::NearestEven,
-        ] {
+    for (i, f) in [(8, 24), (16, 16), (1, 15), (4, 4), (33, 31), (2, 62), (64, 0), (1, 1)] {
+        for round in [FxRound::Floor, FxRound::Ceil, FxRound::Trunc, FxRound::NearestEven] {
             for overflow in [FxOverflow::Saturate, FxOverflow::Wrap] {
                 v.push(Fixed::new(i, f, round, overflow, DivMode::Divide).unwrap());
             }
@@ -444,34 +340,11 @@ fn fixed_formats() -> Vec<Fixed> {
 fn fixed_point_ops_match_exact_rationals() {
     let mut r = SplitMix64::new(SEED ^ 0xf1);
     for f in fixed_formats() {
-        let o = Fx {
-            i: f.int_bits,
-            f: f.frac_bits,
-            round: f.round,
-            overflow: f.overflow,
-        };
+        let o = Fx { i: f.int_bits, f: f.frac_bits, round: f.round, overflow: f.overflow };
         let (max, min) = (f.max_raw(), f.min_raw());
-        let one = 1i64
-            .checked_shl(f.frac_bits)
-            .filter(|&x| x <= max)
-            .unwrap_or(max);
-        let mut vals = vec![
-            0,
-            1,
-            -1,
-            2,
-            -2,
-            max,
-            min,
-            max - 1,
-            min + 1,
-            one,
-            -one,
-            one / 2,
-            -one / 2,
-            one / 2 + 1,
-            one * 3 / 2,
-        ];
+        let one = 1i64.checked_shl(f.frac_bits).filter(|&x| x <= max).unwrap_or(max);
+        let mut vals =
+            vec![0, 1, -1, 2, -2, max, min, max - 1, min + 1, one, -one, one / 2, -one / 2, one / 2 + 1, one * 3 / 2];
         for _ in 0..40 {
             vals.push(f.from_bits(r.next_u64()));
             vals.push(f.from_bits(r.next_u64() >> r.below(64)));
@@ -487,10 +360,7 @@ fn fixed_point_ops_match_exact_rationals() {
         }
         for _ in 0..2000 {
             let x = r.range(-1.5, 1.5)
-                * 2f64.powi(
-                    f.int_bits as i32 + 1
-                        - r.below(f.int_bits as u64 + f.frac_bits as u64 + 4) as i32,
-                );
+                * 2f64.powi(f.int_bits as i32 + 1 - r.below(f.int_bits as u64 + f.frac_bits as u64 + 4) as i32);
             let want = o.round(&BigRational::from_float(x).unwrap());
             assert_eq!(f.from_f64(x), want, "{} from_f64({x:e})", f.name());
         }
@@ -502,24 +372,11 @@ fn fixed_point_ops_match_exact_rationals() {
 
 #[test]
 fn fixed_recip_mul_is_reciprocal_then_multiply() {
-    let f = Fixed::new(
-        8,
-        24,
-        FxRound::NearestEven,
-        FxOverflow::Saturate,
-        DivMode::RecipMul,
-    )
-    .unwrap();
-    let exact = Fixed {
-        div: DivMode::Divide,
-        ..f
-    };
+    let f = Fixed::new(8, 24, FxRound::NearestEven, FxOverflow::Saturate, DivMode::RecipMul).unwrap();
+    let exact = Fixed { div: DivMode::Divide, ..f };
     let mut r = SplitMix64::new(SEED ^ 0xf2);
     for _ in 0..10_000 {
-        let (a, b) = (
-            f.from_bits(r.next_u64() >> 4),
-            f.from_bits(r.next_u64() >> 8),
-        );
+        let (a, b) = (f.from_bits(r.next_u64() >> 4), f.from_bits(r.next_u64() >> 8));
         assert_eq!(f.div(a, b), exact.mul(a, exact.div(f.one(), b)));
     }
 }

@@ -47,11 +47,7 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -83,18 +79,8 @@ pub fn intersect(ray: &Ray64, tri: &Tri64, faces: Faces) -> MtResult {
     let v = dot(ray.d, q) * inv;
     let t = dot(e2, q) * inv;
     let w = 1.0 - u - v;
-    let face_ok = if faces.cull {
-        det > faces.det_threshold
-    } else {
-        det.abs() > faces.det_threshold
-    };
-    let hit = face_ok
-        && det.is_finite()
-        && u >= 0.0
-        && v >= 0.0
-        && w >= 0.0
-        && t >= ray.tmin
-        && t <= ray.tmax;
+    let face_ok = if faces.cull { det > faces.det_threshold } else { det.abs() > faces.det_threshold };
+    let hit = face_ok && det.is_finite() && u >= 0.0 && v >= 0.0 && w >= 0.0 && t >= ray.tmin && t <= ray.tmax;
     let bary_margin = u.min(v).min(w);
     // heights of the triangle over each edge: 2·area / |edge|
     let area2 = norm(cross(e1, e2));
@@ -105,16 +91,7 @@ pub fn intersect(ray: &Ray64, tri: &Tri64, faces: Faces) -> MtResult {
         .fold(f64::INFINITY, f64::min);
     let scale = norm(ray.d) * norm(e1) * norm(e2);
     let det_rel = if scale > 0.0 { det.abs() / scale } else { 0.0 };
-    MtResult {
-        hit,
-        t,
-        u,
-        v,
-        det,
-        det_rel,
-        bary_margin,
-        edge_dist,
-    }
+    MtResult { hit, t, u, v, det, det_rel, bary_margin, edge_dist }
 }
 
 /// Nearest hit of `ray` over `tris`: (index, t); on equal t the lower index wins.
@@ -134,19 +111,12 @@ mod tests {
     use super::*;
 
     fn unit_tri() -> Tri64 {
-        Tri64 {
-            v: [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-        }
+        Tri64 { v: [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] }
     }
 
     #[test]
     fn hits_the_plane_at_the_expected_point() {
-        let ray = Ray64 {
-            o: [0.25, 0.25, 2.0],
-            d: [0.0, 0.0, -1.0],
-            tmin: 0.0,
-            tmax: f64::INFINITY,
-        };
+        let ray = Ray64 { o: [0.25, 0.25, 2.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY };
         let r = intersect(&ray, &unit_tri(), Faces::default());
         assert!(r.hit);
         assert_eq!((r.t, r.u, r.v), (2.0, 0.25, 0.25));
@@ -158,56 +128,21 @@ mod tests {
     #[test]
     fn misses_outside_and_behind_and_culls_back_faces() {
         let t = unit_tri();
-        let outside = Ray64 {
-            o: [0.75, 0.75, 2.0],
-            d: [0.0, 0.0, -1.0],
-            tmin: 0.0,
-            tmax: f64::INFINITY,
-        };
+        let outside = Ray64 { o: [0.75, 0.75, 2.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY };
         let r = intersect(&outside, &t, Faces::default());
         assert!(!r.hit && r.bary_margin < 0.0);
-        let behind = Ray64 {
-            o: [0.25, 0.25, 2.0],
-            d: [0.0, 0.0, 1.0],
-            tmin: 0.0,
-            tmax: f64::INFINITY,
-        };
+        let behind = Ray64 { o: [0.25, 0.25, 2.0], d: [0.0, 0.0, 1.0], tmin: 0.0, tmax: f64::INFINITY };
         assert!(!intersect(&behind, &t, Faces::default()).hit);
         // from below the ray sees the back face (normal +z)
-        let below = Ray64 {
-            o: [0.25, 0.25, -2.0],
-            d: [0.0, 0.0, 1.0],
-            tmin: 0.0,
-            tmax: f64::INFINITY,
-        };
+        let below = Ray64 { o: [0.25, 0.25, -2.0], d: [0.0, 0.0, 1.0], tmin: 0.0, tmax: f64::INFINITY };
         assert!(intersect(&below, &t, Faces::default()).hit);
-        assert!(
-            !intersect(
-                &below,
-                &t,
-                Faces {
-                    cull: true,
-                    det_threshold: 0.0
-                }
-            )
-            .hit
-        );
+        assert!(!intersect(&below, &t, Faces { cull: true, det_threshold: 0.0 }).hit);
     }
 
     #[test]
     fn closest_hit_takes_the_nearest_and_the_first_on_ties() {
-        let near = Tri64 {
-            v: [[-1.0, -1.0, 1.0], [3.0, -1.0, 1.0], [-1.0, 3.0, 1.0]],
-        };
-        let ray = Ray64 {
-            o: [0.25, 0.25, 2.0],
-            d: [0.0, 0.0, -1.0],
-            tmin: 0.0,
-            tmax: f64::INFINITY,
-        };
-        assert_eq!(
-            closest_hit(&ray, &[unit_tri(), near, near], Faces::default()),
-            Some((1, 1.0))
-        );
+        let near = Tri64 { v: [[-1.0, -1.0, 1.0], [3.0, -1.0, 1.0], [-1.0, 3.0, 1.0]] };
+        let ray = Ray64 { o: [0.25, 0.25, 2.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY };
+        assert_eq!(closest_hit(&ray, &[unit_tri(), near, near], Faces::default()), Some((1, 1.0)));
     }
 }

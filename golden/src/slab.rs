@@ -19,24 +19,13 @@ pub struct SlabResult {
 }
 
 /// f64 slab test: per axis t = (plane − o) / d with a true divide; zero components per the rule above.
-pub fn slab_f64(
-    o: [f64; 3],
-    d: [f64; 3],
-    tmin: f64,
-    tmax: f64,
-    min: [f64; 3],
-    max: [f64; 3],
-) -> SlabResult {
+pub fn slab_f64(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], max: [f64; 3]) -> SlabResult {
     let mut near = tmin;
     let mut far = tmax;
     for a in 0..3 {
         if d[a] == 0.0 {
             if o[a] < min[a] || o[a] > max[a] {
-                return SlabResult {
-                    hit: false,
-                    t_near: near,
-                    t_far: far,
-                };
+                return SlabResult { hit: false, t_near: near, t_far: far };
             }
             continue;
         }
@@ -50,11 +39,7 @@ pub fn slab_f64(
             far = hi;
         }
     }
-    SlabResult {
-        hit: near <= far,
-        t_near: near,
-        t_far: far,
-    }
+    SlabResult { hit: near <= far, t_near: near, t_far: far }
 }
 
 fn q(x: f64) -> BigRational {
@@ -63,25 +48,10 @@ fn q(x: f64) -> BigRational {
 
 /// The exact decision (rational arithmetic) for finite inputs; ±∞ is allowed for tmax and for
 /// box planes (an infinite plane bounds nothing on its side).
-pub fn slab_exact(
-    o: [f64; 3],
-    d: [f64; 3],
-    tmin: f64,
-    tmax: f64,
-    min: [f64; 3],
-    max: [f64; 3],
-) -> bool {
+pub fn slab_exact(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], max: [f64; 3]) -> bool {
     // interval [near, far] of t; None = unbounded on that side
-    let mut near: Option<BigRational> = if tmin.is_finite() {
-        Some(q(tmin))
-    } else {
-        None
-    };
-    let mut far: Option<BigRational> = if tmax.is_finite() {
-        Some(q(tmax))
-    } else {
-        None
-    };
+    let mut near: Option<BigRational> = if tmin.is_finite() { Some(q(tmin)) } else { None };
+    let mut far: Option<BigRational> = if tmax.is_finite() { Some(q(tmax)) } else { None };
     if tmin == f64::INFINITY || tmax == f64::NEG_INFINITY {
         return false;
     }
@@ -98,16 +68,10 @@ pub fn slab_exact(
         let da = q(d[a]);
         let oa = q(o[a]);
         // plane distances; an infinite plane gives an unbounded side
-        let t = |plane: f64| -> Option<BigRational> {
-            plane.is_finite().then(|| (q(plane) - &oa) / &da)
-        };
+        let t = |plane: f64| -> Option<BigRational> { plane.is_finite().then(|| (q(plane) - &oa) / &da) };
         let (t_min_plane, t_max_plane) = (t(min[a]), t(max[a]));
         // with d > 0 the min plane is the entry; with d < 0 the max plane is
-        let (lo, hi) = if d[a] > 0.0 {
-            (t_min_plane, t_max_plane)
-        } else {
-            (t_max_plane, t_min_plane)
-        };
+        let (lo, hi) = if d[a] > 0.0 { (t_min_plane, t_max_plane) } else { (t_max_plane, t_min_plane) };
         if let Some(lo) = lo {
             if near.as_ref().is_none_or(|n| &lo > n) {
                 near = Some(lo);
@@ -134,42 +98,11 @@ mod tests {
 
     #[test]
     fn through_the_middle_and_beside() {
-        let r = slab_f64(
-            [-3.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            0.0,
-            f64::INFINITY,
-            LO,
-            HI,
-        );
+        let r = slab_f64([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI);
         assert_eq!((r.hit, r.t_near, r.t_far), (true, 2.0, 4.0));
-        assert!(slab_exact(
-            [-3.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            0.0,
-            f64::INFINITY,
-            LO,
-            HI
-        ));
-        assert!(
-            !slab_f64(
-                [-3.0, 2.0, 0.0],
-                [1.0, 0.0, 0.0],
-                0.0,
-                f64::INFINITY,
-                LO,
-                HI
-            )
-            .hit
-        );
-        assert!(!slab_exact(
-            [-3.0, 2.0, 0.0],
-            [1.0, 0.0, 0.0],
-            0.0,
-            f64::INFINITY,
-            LO,
-            HI
-        ));
+        assert!(slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI));
+        assert!(!slab_f64([-3.0, 2.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI).hit);
+        assert!(!slab_exact([-3.0, 2.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI));
     }
 
     #[test]
@@ -179,66 +112,17 @@ mod tests {
             assert!(slab_exact([-3.0, 1.0, 0.0], d, 0.0, f64::INFINITY, LO, HI));
         }
         // touching an edge exactly
-        assert!(slab_exact(
-            [-3.0, 1.0, 1.0],
-            [1.0, 0.0, 0.0],
-            0.0,
-            f64::INFINITY,
-            LO,
-            HI
-        ));
+        assert!(slab_exact([-3.0, 1.0, 1.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI));
         // the line x + y = 2 touches the corner (1, 1); x + y = 2.001 passes beside it
-        assert!(slab_exact(
-            [3.0, -1.0, 0.0],
-            [-1.0, 1.0, 0.0],
-            0.0,
-            f64::INFINITY,
-            LO,
-            HI
-        ));
-        assert!(!slab_exact(
-            [3.0, -0.999, 0.0],
-            [-1.0, 1.0, 0.0],
-            0.0,
-            f64::INFINITY,
-            LO,
-            HI
-        ));
+        assert!(slab_exact([3.0, -1.0, 0.0], [-1.0, 1.0, 0.0], 0.0, f64::INFINITY, LO, HI));
+        assert!(!slab_exact([3.0, -0.999, 0.0], [-1.0, 1.0, 0.0], 0.0, f64::INFINITY, LO, HI));
     }
 
     #[test]
     fn interval_limits_are_closed() {
-        assert!(slab_exact(
-            [-3.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            0.0,
-            2.0,
-            LO,
-            HI
-        ));
-        assert!(!slab_exact(
-            [-3.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            0.0,
-            1.999,
-            LO,
-            HI
-        ));
-        assert!(slab_exact(
-            [-3.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            4.0,
-            9.0,
-            LO,
-            HI
-        ));
-        assert!(!slab_exact(
-            [-3.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            4.001,
-            9.0,
-            LO,
-            HI
-        ));
+        assert!(slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, 2.0, LO, HI));
+        assert!(!slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, 1.999, LO, HI));
+        assert!(slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 4.0, 9.0, LO, HI));
+        assert!(!slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 4.001, 9.0, LO, HI));
     }
 }

@@ -36,23 +36,10 @@ pub fn aimed_case(r: &mut SplitMix64) -> (Ray64, Tri64) {
     let o = p();
     let (b1, b2) = (r.range(-0.3, 1.3), r.range(-0.3, 1.3));
     let b0 = 1.0 - b1 - b2;
-    let target: [f64; 3] =
-        std::array::from_fn(|a| b0 * tri.v[0][a] + b1 * tri.v[1][a] + b2 * tri.v[2][a]);
+    let target: [f64; 3] = std::array::from_fn(|a| b0 * tri.v[0][a] + b1 * tri.v[1][a] + b2 * tri.v[2][a]);
     let d = [target[0] - o[0], target[1] - o[1], target[2] - o[2]];
-    let tmax = if r.below(4) == 0 {
-        r.range(0.0, 2.0)
-    } else {
-        f64::INFINITY
-    };
-    (
-        Ray64 {
-            o,
-            d,
-            tmin: 0.0,
-            tmax,
-        },
-        tri,
-    )
+    let tmax = if r.below(4) == 0 { r.range(0.0, 2.0) } else { f64::INFINITY };
+    (Ray64 { o, d, tmin: 0.0, tmax }, tri)
 }
 
 /// Raw input encodings for the 17 RTI inputs: mostly in-range values, some random bit patterns
@@ -60,12 +47,6 @@ pub fn aimed_case(r: &mut SplitMix64) -> (Ray64, Tri64) {
 pub fn raw_inputs(r: &mut SplitMix64, f: &AnyFormat) -> [u64; 17] {
     use datapath::{with_format, Format};
     with_format!(f, |f| {
-        std::array::from_fn(|_| {
-            if r.below(5) == 0 {
-                r.next_u64()
-            } else {
-                f.to_bits(f.from_f64(r.range(-1.0, 1.0)))
-            }
-        })
+        std::array::from_fn(|_| if r.below(5) == 0 { r.next_u64() } else { f.to_bits(f.from_f64(r.range(-1.0, 1.0))) })
     })
 }

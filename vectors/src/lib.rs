@@ -4,11 +4,7 @@
 /// Formats `bits` (the low `width` bits) as exactly `ceil(width/4)` lowercase hex digits, no prefix.
 pub fn hex_field(bits: u64, width: u32) -> String {
     let digits = width.div_ceil(4) as usize;
-    let masked = if width >= 64 {
-        bits
-    } else {
-        bits & ((1u64 << width) - 1)
-    };
+    let masked = if width >= 64 { bits } else { bits & ((1u64 << width) - 1) };
     format!("{masked:0digits$x}")
 }
 

@@ -53,15 +53,11 @@ impl Fixed {
     ) -> Result<Self, String> {
         let w = int_bits + frac_bits;
         if int_bits == 0 || !(2..=64).contains(&w) {
-            return Err(format!("q{int_bits}.{frac_bits}: need at least 1 integer (sign) bit and a total width of 2..=64"));
+            return Err(format!(
+                "q{int_bits}.{frac_bits}: need at least 1 integer (sign) bit and a total width of 2..=64"
+            ));
         }
-        Ok(Self {
-            int_bits,
-            frac_bits,
-            round,
-            overflow,
-            div,
-        })
+        Ok(Self { int_bits, frac_bits, round, overflow, div })
     }
     fn w(&self) -> u32 {
         self.int_bits + self.frac_bits
@@ -149,10 +145,7 @@ impl Format for Fixed {
         }
     }
     fn kind(&self) -> FormatKind {
-        FormatKind::Fixed {
-            int_bits: self.int_bits,
-            frac_bits: self.frac_bits,
-        }
+        FormatKind::Fixed { int_bits: self.int_bits, frac_bits: self.frac_bits }
     }
     fn width(&self) -> u32 {
         self.w()
@@ -193,17 +186,8 @@ impl Format for Fixed {
     }
     fn error_model(&self) -> ErrorModel {
         let step = pow2(-(self.frac_bits as i32));
-        let eta = if self.round == FxRound::NearestEven {
-            step / 2.0
-        } else {
-            step
-        };
-        ErrorModel {
-            u: 0.0,
-            eta,
-            add_eta: 0.0,
-            max: self.max_raw() as f64 * step,
-        }
+        let eta = if self.round == FxRound::NearestEven { step / 2.0 } else { step };
+        ErrorModel { u: 0.0, eta, add_eta: 0.0, max: self.max_raw() as f64 * step }
     }
     fn div_mode(&self) -> DivMode {
         self.div
@@ -214,11 +198,7 @@ impl Format for Fixed {
             return 0;
         }
         if x.is_infinite() {
-            return if x > 0.0 {
-                self.max_raw()
-            } else {
-                self.min_raw()
-            };
+            return if x > 0.0 { self.max_raw() } else { self.min_raw() };
         }
         // scaling by 2^F is exact in f64 for every finite x of interest (no overflow below 2^960)
         let y = x * pow2(self.frac_bits as i32);
@@ -297,6 +277,9 @@ impl Format for Fixed {
     }
     fn ulp(&self, _x: f64) -> f64 {
         pow2(-(self.frac_bits as i32))
+    }
+    fn wraps(&self) -> bool {
+        self.overflow == FxOverflow::Wrap
     }
     fn sign_bit(&self, v: i64) -> bool {
         v < 0

@@ -171,17 +171,9 @@ impl FloatLayout {
         let frac = b & self.man_mask();
         let m = self.man_bits as i32;
         if biased == 0 {
-            Decoded {
-                neg,
-                sig: frac,
-                exp: self.emin() - m,
-            }
+            Decoded { neg, sig: frac, exp: self.emin() - m }
         } else {
-            Decoded {
-                neg,
-                sig: frac | (1 << self.man_bits),
-                exp: biased - self.bias() - m,
-            }
+            Decoded { neg, sig: frac | (1 << self.man_bits), exp: biased - self.bias() - m }
         }
     }
 
@@ -222,11 +214,7 @@ impl FloatLayout {
         if kept == 0 {
             return sign;
         }
-        let biased = if kept >> m != 0 {
-            q + m + self.bias()
-        } else {
-            0
-        };
+        let biased = if kept >> m != 0 { q + m + self.bias() } else { 0 };
         if biased >= (1 << self.exp_bits) - 1 {
             return self.inf(neg);
         }
@@ -253,11 +241,7 @@ impl FloatLayout {
             return f64::NAN;
         }
         if self.is_inf(b) {
-            return if self.is_neg(b) {
-                f64::NEG_INFINITY
-            } else {
-                f64::INFINITY
-            };
+            return if self.is_neg(b) { f64::NEG_INFINITY } else { f64::INFINITY };
         }
         let d = self.decode(b);
         // sig < 2^53 is exact; scaling by 2^exp is exact because the result is representable.

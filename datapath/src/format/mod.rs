@@ -57,11 +57,7 @@ pub struct FpOpts {
 
 impl Default for FpOpts {
     fn default() -> Self {
-        Self {
-            subnormals: Subnormals::Ieee,
-            nan: NanMode::Canonical,
-            div: DivMode::RecipMul,
-        }
+        Self { subnormals: Subnormals::Ieee, nan: NanMode::Canonical, div: DivMode::RecipMul }
     }
 }
 
@@ -165,6 +161,14 @@ pub trait Format: Copy + Debug + Send + Sync + 'static {
     }
     /// Spacing of the format's grid near |x|.
     fn ulp(&self, x: f64) -> f64;
+    /// Subnormal results are flushed to zero.
+    fn flushes(&self) -> bool {
+        false
+    }
+    /// Out-of-range results wrap around (fixed point `wrap`) instead of saturating or overflowing to ∞.
+    fn wraps(&self) -> bool {
+        false
+    }
     /// The sign bit (fixed point: negative).
     fn sign_bit(&self, v: Self::V) -> bool;
     /// The next value toward +∞ (NaN and +∞ unchanged; under FTZ it skips the subnormals).
@@ -191,11 +195,7 @@ pub trait Format: Copy + Debug + Send + Sync + 'static {
     }
     /// Hex digits of one encoding: `ceil(width / 4)`.
     fn hex(&self, v: Self::V) -> String {
-        format!(
-            "{:0w$x}",
-            self.to_bits(v),
-            w = self.width().div_ceil(4) as usize
-        )
+        format!("{:0w$x}", self.to_bits(v), w = self.width().div_ceil(4) as usize)
     }
 }
 
@@ -318,12 +318,7 @@ impl<B: IeeeBackend> Format for Ieee<B> {
             Subnormals::Ieee => 0.0, // a sum on the subnormal grid is exact
             Subnormals::Ftz => l.min_normal(),
         };
-        ErrorModel {
-            u: l.unit_roundoff(),
-            eta,
-            add_eta,
-            max: l.max_finite(),
-        }
+        ErrorModel { u: l.unit_roundoff(), eta, add_eta, max: l.max_finite() }
     }
     fn div_mode(&self) -> DivMode {
         self.opts.div
@@ -396,6 +391,9 @@ impl<B: IeeeBackend> Format for Ieee<B> {
     }
     fn ulp(&self, x: f64) -> f64 {
         self.lay().ulp(x)
+    }
+    fn flushes(&self) -> bool {
+        self.opts.subnormals == Subnormals::Ftz
     }
     #[inline(always)]
     fn sign_bit(&self, v: B::V) -> bool {

@@ -2,8 +2,7 @@
 //! [`AnyFormat`], the run-time choice that dispatches to the generic models.
 
 use super::{
-    Bf16, DivMode, F16Half, F32Native, Fixed, FloatLayout, FpOpts, FxOverflow, FxRound, Ieee,
-    NanMode, Soft, Subnormals,
+    Bf16, DivMode, F16Half, F32Native, Fixed, FloatLayout, FpOpts, FxOverflow, FxRound, Ieee, NanMode, Soft, Subnormals,
 };
 use std::fmt;
 use std::str::FromStr;
@@ -72,14 +71,10 @@ impl FromStr for AnyFormat {
     fn from_str(s: &str) -> Result<Self, String> {
         let lower = s.trim().to_ascii_lowercase();
         let (base, opts) = match lower.split_once(':') {
-            Some((b, o)) => (
-                b,
-                o.split('+').filter(|t| !t.is_empty()).collect::<Vec<_>>(),
-            ),
+            Some((b, o)) => (b, o.split('+').filter(|t| !t.is_empty()).collect::<Vec<_>>()),
             None => (lower.as_str(), Vec::new()),
         };
-        let unknown =
-            |what: &str| format!("unknown format option '{what}' in '{s}'; {FORMAT_HELP}");
+        let unknown = |what: &str| format!("unknown format option '{what}' in '{s}'; {FORMAT_HELP}");
         if let Some((i, f)) = parse_q(base) {
             let mut round = FxRound::Floor;
             let mut overflow = FxOverflow::Saturate;
@@ -152,18 +147,7 @@ mod tests {
 
     #[test]
     fn bad_names_are_clear_errors() {
-        for n in [
-            "f31",
-            "e12m3",
-            "e8m0",
-            "q0.8",
-            "q40.40",
-            "fp16:fast",
-            "q8.8:ftz",
-            "",
-            "e8",
-            "q8",
-        ] {
+        for n in ["f31", "e12m3", "e8m0", "q0.8", "q40.40", "fp16:fast", "q8.8:ftz", "", "e8", "q8"] {
             let e = n.parse::<AnyFormat>().unwrap_err();
             assert!(e.contains("format"), "{n}: {e}");
         }

@@ -35,8 +35,7 @@ pub fn exact(l: FloatLayout, bits: u64) -> BigRational {
     let mag = if biased == 0 {
         BigRational::from_integer(BigInt::from(frac)) * pow2(1 - bias - m as i64)
     } else {
-        BigRational::from_integer(BigInt::from(frac | (1 << m)))
-            * pow2(biased as i64 - bias - m as i64)
+        BigRational::from_integer(BigInt::from(frac | (1 << m))) * pow2(biased as i64 - bias - m as i64)
     };
     if bits >> (l.exp_bits + m) & 1 == 1 {
         -mag
@@ -80,11 +79,7 @@ pub fn round_float(l: FloatLayout, q: &BigRational) -> u64 {
         k /= 2;
         qe += 1;
     }
-    let sign = if neg {
-        1u64 << (l.exp_bits + l.man_bits)
-    } else {
-        0
-    };
+    let sign = if neg { 1u64 << (l.exp_bits + l.man_bits) } else { 0 };
     let inf = sign | (((1u64 << l.exp_bits) - 1) << m);
     let k64: u64 = k.try_into().unwrap();
     if k64 == 0 {
@@ -142,11 +137,7 @@ pub fn float_op(l: FloatLayout, op: Op, a: u64, b: u64) -> u64 {
                 Op::Mul => fa * fb,
                 Op::Div => fa / fb,
             };
-            let sign = if r.is_sign_negative() {
-                1u64 << (l.exp_bits + l.man_bits)
-            } else {
-                0
-            };
+            let sign = if r.is_sign_negative() { 1u64 << (l.exp_bits + l.man_bits) } else { 0 };
             if r.is_nan() {
                 canonical
             } else if r.is_infinite() {
@@ -164,11 +155,7 @@ pub fn float_from_f64(l: FloatLayout, x: f64) -> u64 {
     if x.is_nan() {
         return (((1u64 << l.exp_bits) - 1) << l.man_bits) | (1 << (l.man_bits - 1));
     }
-    let sign = if x.is_sign_negative() {
-        1u64 << (l.exp_bits + l.man_bits)
-    } else {
-        0
-    };
+    let sign = if x.is_sign_negative() { 1u64 << (l.exp_bits + l.man_bits) } else { 0 };
     if x.is_infinite() {
         return sign | (((1u64 << l.exp_bits) - 1) << l.man_bits);
     }
