@@ -120,7 +120,10 @@ enum Cmd {
     },
     /// Print the RTI stage table (markdown).
     Stages {
-        /// Division mode: recip (1/det then multiplies) or divide.
+        /// Unit: rti or slab.
+        #[arg(long, default_value = "rti")]
+        unit: String,
+        /// Division mode of the RTI unit: recip (1/det then multiplies) or divide.
         #[arg(long, default_value = "recip")]
         div: String,
     },
@@ -165,9 +168,9 @@ fn run_verify(a: VerifyArgs) -> Result<bool, String> {
     Ok(rep.passed)
 }
 
-fn stages_markdown(div: DivMode) -> String {
+fn stages_markdown(table: &[datapath::rti::SigDef]) -> String {
     let mut s = String::from("| stage | signal | op | operands |\n|---|---|---|---|\n");
-    for d in stage_table(div) {
+    for d in table {
         let (op, operands) = match d.op {
             Op::Sub => ("sub", format!("{} − {}", d.a, d.b)),
             Op::Add => ("add", format!("{} + {}", d.a, d.b)),
@@ -218,13 +221,17 @@ fn run() -> Result<bool, String> {
             }
             Ok(true)
         }
-        Some(Cmd::Stages { div }) => {
+        Some(Cmd::Stages { unit, div }) => {
             let d = match div.as_str() {
                 "recip" => DivMode::RecipMul,
                 "divide" => DivMode::Divide,
                 other => return Err(format!("--div must be recip or divide, got '{other}'")),
             };
-            print!("{}", stages_markdown(d));
+            match unit.as_str() {
+                "rti" => print!("{}", stages_markdown(&stage_table(d))),
+                "slab" => print!("{}", stages_markdown(&datapath::slab::SLAB_TABLE)),
+                other => return Err(format!("unknown unit '{other}'; units: rti, slab")),
+            }
             Ok(true)
         }
     }

@@ -387,3 +387,112 @@ fn batch_equals_scalar_and_empty_slots_are_never_hit() {
     }
     let _ = Subnormals::Ieee;
 }
+
+/// Every recorded slab signal follows `SLAB_TABLE`: names in order, arithmetic rows recomputed
+/// from their recorded operands, selects and the decision recomputed from their formulas.
+#[test]
+fn every_slab_signal_follows_the_stage_table() {
+    let mut r = SplitMix64::new(0x51ab_0006);
+    for name in ALL {
+        with_format!(fmt(name), |f| {
+            for v in ["plain", "conservative", "take-on-false", "embree"] {
+                for _ in 0..2000 {
+                    check_slab_table(f, name, v, &mut r);
+                }
+            }
+        });
+    }
+}
+
+fn check_slab_table<F: Format>(f: F, name: &str, v: &str, r: &mut SplitMix64) {
+    use datapath::rti::Op;
+    use datapath::slab::SLAB_TABLE;
+    let sc = SlabConfig::named(v).unwrap();
+    let s = Slab::new(f, sc);
+    let (o, d, tmax, lo, hi) = random_case(r);
+    let mut rec = Recorder::new();
+    let ray = s.prepare_trace(o, d, 0.0, tmax, &mut rec);
+    let b = s.store_box(lo, hi).unwrap_or_else(|_| s.empty_box());
+    let out = s.trace(&ray, &b, &mut rec);
+    let names: Vec<&str> = rec.signals.iter().map(|(n, _)| *n).collect();
+    let want: Vec<&str> = SLAB_TABLE.iter().map(|d| d.name).collect();
+    assert_eq!(names, want, "{name} {v}");
+    let val = |n: &str| -> F::V {
+        match n {
+            "one" => f.one(),
+            "ox" | "oy" | "oz" => ray.o[(n.as_bytes()[1] - b'x') as usize],
+            "minx" | "miny" | "minz" => b.min[(n.as_bytes()[3] - b'x') as usize],
+            "maxx" | "maxy" | "maxz" => b.max[(n.as_bytes()[3] - b'x') as usize],
+            _ => rec.value(n).unwrap(),
+        }
+    };
+    let flag = |n: &str| rec.flag(n).unwrap();
+    let bits = |x| f.to_bits(x);
+    for row in SLAB_TABLE.iter().filter(|d| d.op != Op::Logic) {
+        let want = match row.op {
+            Op::Sub => f.sub(val(row.a), val(row.b)),
+            Op::Mul => f.mul(val(row.a), val(row.b)),
+            Op::Div => f.div(val(row.a), val(row.b)),
+            _ => unreachable!(),
+        };
+        assert_eq!(bits(val(row.name)), bits(want), "{name} {v}: {}", row.name);
+    }
+    // selects by sign, compare-selects, widening and decision
+    let sel = |neg: bool, a: &str, b: &str| if neg { val(a) } else { val(b) };
+    for (ax, inv, n, fr, lo_, hi_) in [
+        ("negx", "inv_dx", "nearx", "farx", "tlox", "thix"),
+        ("negy", "inv_dy", "neary", "fary", "tloy", "thiy"),
+        ("negz", "inv_dz", "nearz", "farz", "tloz", "thiz"),
+    ] {
+        let neg = flag(ax);
+        assert_eq!(neg, f.sign_bit(val(inv)));
+        assert_eq!(bits(val(n)), bits(sel(neg, hi_, lo_)));
+        assert_eq!(bits(val(fr)), bits(sel(neg, lo_, hi_)));
+    }
+    let near = |acc, x| match sc.nan {
+        SlabNan::Ignore => {
+            if f.lt(acc, x) {
+                x
+            } else {
+                acc
+            }
+        }
+        SlabNan::TakeOnFalse => {
+            if f.le(x, acc) {
+                acc
+            } else {
+                x
+            }
+        }
+    };
+    let far = |acc, x| match sc.nan {
+        SlabNan::Ignore => {
+            if f.lt(x, acc) {
+                x
+            } else {
+                acc
+            }
+        }
+        SlabNan::TakeOnFalse => {
+            if f.le(acc, x) {
+                acc
+            } else {
+                x
+            }
+        }
+    };
+    assert_eq!(bits(val("tn_x")), bits(near(ray.tmin, val("nearx"))));
+    assert_eq!(bits(val("tn_xy")), bits(near(val("tn_x"), val("neary"))));
+    assert_eq!(bits(val("t_near")), bits(near(val("tn_xy"), val("nearz"))));
+    assert_eq!(bits(val("tf_x")), bits(far(ray.tmax, val("farx"))));
+    assert_eq!(bits(val("tf_xy")), bits(far(val("tf_x"), val("fary"))));
+    assert_eq!(bits(val("t_far")), bits(far(val("tf_xy"), val("farz"))));
+    let (mut nw, mut fw) = (val("t_near"), val("t_far"));
+    for _ in 0..sc.widen_ulps {
+        nw = f.next_down(nw);
+        fw = f.next_up(fw);
+    }
+    assert_eq!((bits(val("near_w")), bits(val("far_w"))), (bits(nw), bits(fw)));
+    assert_eq!(flag("hit"), f.le(nw, fw));
+    assert_eq!((out.hit, bits(out.t_near), bits(out.t_far)), (flag("hit"), bits(nw), bits(fw)));
+}

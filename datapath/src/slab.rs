@@ -15,6 +15,7 @@
 
 use crate::format::Format;
 use crate::probe::{NoProbe, Probe};
+use crate::rti::{Op, SigDef};
 use crate::{record, record_flags};
 
 /// What the compare unit does with a NaN slab distance.
@@ -65,6 +66,58 @@ pub struct SlabConfig {
 /// including just below a power of two and across a binade step-down (steps there are halved
 /// but 4 of them still cover 3u·2^e·(1+γ₃)). Overflow to ∞ only widens the interval.
 pub const CONSERVATIVE_ULPS: i32 = 4;
+
+/// The stage table of the round-to-nearest slab datapath (variants plain, conservative,
+/// take-on-false, embree), in the order the probe reports the signals. Stage 0 runs once per
+/// ray; `sel*` rows are the compare unit's compare-selects; `step*` rows the widening.
+pub const SLAB_TABLE: [SigDef; 39] = [
+    l(0, "dx", "input conversion of d.x"),
+    l(0, "dy", "input conversion of d.y"),
+    l(0, "dz", "input conversion of d.z"),
+    l(0, "pdx", "embree: |dx| < δ ? ±δ : dx; else dx"),
+    l(0, "pdy", "likewise"),
+    l(0, "pdz", "likewise"),
+    s(0, "inv_dx", Op::Div, "one", "pdx"),
+    s(0, "inv_dy", Op::Div, "one", "pdy"),
+    s(0, "inv_dz", Op::Div, "one", "pdz"),
+    s(1, "lox", Op::Sub, "minx", "ox"),
+    s(1, "hix", Op::Sub, "maxx", "ox"),
+    s(1, "loy", Op::Sub, "miny", "oy"),
+    s(1, "hiy", Op::Sub, "maxy", "oy"),
+    s(1, "loz", Op::Sub, "minz", "oz"),
+    s(1, "hiz", Op::Sub, "maxz", "oz"),
+    s(2, "tlox", Op::Mul, "lox", "inv_dx"),
+    s(2, "thix", Op::Mul, "hix", "inv_dx"),
+    s(2, "tloy", Op::Mul, "loy", "inv_dy"),
+    s(2, "thiy", Op::Mul, "hiy", "inv_dy"),
+    s(2, "tloz", Op::Mul, "loz", "inv_dz"),
+    s(2, "thiz", Op::Mul, "hiz", "inv_dz"),
+    l(3, "negx", "sign bit of inv_dx"),
+    l(3, "negy", "sign bit of inv_dy"),
+    l(3, "negz", "sign bit of inv_dz"),
+    l(3, "nearx", "negx ? thix : tlox"),
+    l(3, "farx", "negx ? tlox : thix"),
+    l(3, "neary", "negy ? thiy : tloy"),
+    l(3, "fary", "negy ? tloy : thiy"),
+    l(3, "nearz", "negz ? thiz : tloz"),
+    l(3, "farz", "negz ? tloz : thiz"),
+    l(4, "tn_x", "selnear(tmin, nearx)"),
+    l(4, "tn_xy", "selnear(tn_x, neary)"),
+    l(4, "t_near", "selnear(tn_xy, nearz)"),
+    l(4, "tf_x", "selfar(tmax, farx)"),
+    l(4, "tf_xy", "selfar(tf_x, fary)"),
+    l(4, "t_far", "selfar(tf_xy, farz)"),
+    l(5, "near_w", "t_near stepped down widen_ulps times (up if negative)"),
+    l(5, "far_w", "t_far stepped up widen_ulps times (down if negative)"),
+    l(6, "hit", "near_w <= far_w"),
+];
+
+const fn s(stage: u8, name: &'static str, op: Op, a: &'static str, b: &'static str) -> SigDef {
+    SigDef { stage, name, op, a, b, note: "" }
+}
+const fn l(stage: u8, name: &'static str, note: &'static str) -> SigDef {
+    SigDef { stage, name, op: Op::Logic, a: "", b: "", note }
+}
 
 /// The named slab variants: `plain` (Ignore, Plain, 0), `conservative` (Ignore, Plain, +4),
 /// `directed` (interval arithmetic), `take-on-false` (TakeOnFalse, Plain, 0), `embree` (Ignore, Embree, 0).
