@@ -123,28 +123,23 @@ fn fp16_and_f32_match_exact_rationals() {
     check_against_rationals(&Ieee::new(F32Native, divide()), 5000);
 }
 
-fn sf_op16(op: Op, a: u64, b: u64) -> u64 {
-    let (x, y) = (Sf16::from_bits(a as u16), Sf16::from_bits(b as u16));
+/// One SoftFloat operation, nearest-even.
+fn sf_apply<T: softfloat_wrapper::Float>(op: Op, x: T, y: T) -> T {
     let rm = RoundingMode::TiesToEven;
-    let r = match op {
+    match op {
         Op::Add => x.add(y, rm),
         Op::Sub => x.sub(y, rm),
         Op::Mul => x.mul(y, rm),
         Op::Div => x.div(y, rm),
-    };
-    r.to_bits() as u64
+    }
+}
+
+fn sf_op16(op: Op, a: u64, b: u64) -> u64 {
+    sf_apply(op, Sf16::from_bits(a as u16), Sf16::from_bits(b as u16)).to_bits() as u64
 }
 
 fn sf_op32(op: Op, a: u64, b: u64) -> u64 {
-    let (x, y) = (Sf32::from_bits(a as u32), Sf32::from_bits(b as u32));
-    let rm = RoundingMode::TiesToEven;
-    let r = match op {
-        Op::Add => x.add(y, rm),
-        Op::Sub => x.sub(y, rm),
-        Op::Mul => x.mul(y, rm),
-        Op::Div => x.div(y, rm),
-    };
-    r.to_bits() as u64
+    sf_apply(op, Sf32::from_bits(a as u32), Sf32::from_bits(b as u32)).to_bits() as u64
 }
 
 /// SoftFloat returns its own default NaN and payloads; ours is the canonical NaN: compare NaN-ness
