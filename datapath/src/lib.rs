@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 
 pub mod bound;
+pub mod bvh;
 pub mod format;
 pub mod probe;
 pub mod rng;
