@@ -4,7 +4,9 @@
 //! (`golden`) and the error bounds ([`judge`]) → report ([`verify`], [`explain`]).
 #![warn(missing_docs)]
 
+pub mod bvh;
 pub mod explain;
 pub mod judge;
 pub mod scene;
+pub mod traverse;
 pub mod verify;

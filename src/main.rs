@@ -118,6 +118,36 @@ enum Cmd {
         #[command(flatten)]
         rti: RtiArgs,
     },
+    /// The 2-bit ray history and 1-bit trail traversals against the stack traversal on a scene's BVH.
+    Traverse {
+        /// OBJ scene (default: the built-in scene).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Box format(s) of the slab tester, comma-separated.
+        #[arg(long, value_delimiter = ',', value_parser = parse_format, default_value = "f32,fp16,bf16,q8.24:divide")]
+        format: Vec<AnyFormat>,
+        /// Slab variant: plain, conservative, directed, take-on-false, embree.
+        #[arg(long, default_value = "plain")]
+        variant: String,
+        /// Rays (half primary from a camera in front, half random incoherent).
+        #[arg(long, default_value_t = 20000, value_parser = clap::value_parser!(u64).range(1..))]
+        rays: u64,
+        /// Random-ray seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// First N leaves per ray.
+        #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u64).range(1..))]
+        n: u64,
+        /// Triangles per leaf at most (1..=255).
+        #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=255))]
+        leaf_size: u32,
+        /// Level pipelines available (the history holds 2 bits per level).
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
+        levels: u64,
+        /// Print the results as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Print the RTI stage table (markdown).
     Stages {
         /// Unit: rti or slab.
@@ -220,6 +250,28 @@ fn run() -> Result<bool, String> {
                 other => return Err(format!("unknown unit '{other}'; units: rti, slab")),
             }
             Ok(true)
+        }
+        Some(Cmd::Traverse { scene, format, variant, rays, seed, n, leaf_size, levels, json }) => {
+            let scene = match &scene {
+                Some(p) => Scene::load_obj(p).map_err(|e| e.to_string())?,
+                None => Scene::builtin(),
+            };
+            let cfg = raypipe::traverse::TraverseConfig {
+                formats: format,
+                variant,
+                rays: rays as usize,
+                seed,
+                n: n as usize,
+                leaf_size,
+                levels: levels as usize,
+            };
+            let rep = raypipe::traverse::traverse(&cfg, &scene)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&rep).map_err(|e| e.to_string())?);
+            } else {
+                print!("{}", raypipe::traverse::render(&rep));
+            }
+            Ok(rep.passed)
         }
         Some(Cmd::Stages { unit, div }) => {
             let d = match div.as_str() {

@@ -207,3 +207,33 @@ fn verify_json_has_the_slab_table() {
     }
     assert!(slab.iter().any(|r| r["variant"] == "conservative" && r["format"] == "fp16" && r["conservative"] == true));
 }
+
+#[test]
+fn traverse_matches_the_stack_traversal_and_reports_json() {
+    let o = raypipe(&["traverse", "--rays", "2000", "--format", "f32,fp16", "--json"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["passed"], true);
+    for row in v["rows"].as_array().unwrap() {
+        assert_eq!(row["rays"], 2000);
+        assert_eq!(row["history_mismatches"], 0);
+        assert_eq!(row["trail_mismatches"], 0);
+        assert!(row["leaves"].as_u64().unwrap() > 1000, "{row}");
+    }
+    let o = raypipe(&["traverse", "--rays", "100", "--variant", "directed", "--n", "1", "--leaf-size", "1"]);
+    assert!(o.status.success());
+    assert!(text(&o).0.contains("equivalence: PASS"));
+}
+
+#[test]
+fn traverse_bad_input_is_a_clear_error() {
+    assert_clear_error(
+        &raypipe(&["traverse", "--levels", "3", "--rays", "10"]),
+        "but the hardware has 3 level pipelines",
+    );
+    assert_clear_error(&raypipe(&["traverse", "--variant", "fast", "--rays", "10"]), "unknown slab variant");
+    assert_clear_error(&raypipe(&["traverse", "--scene", "/nonexistent.obj"]), "no such file");
+    assert_eq!(raypipe(&["traverse", "--leaf-size", "0"]).status.code(), Some(2));
+    assert_eq!(raypipe(&["traverse", "--format", "f99"]).status.code(), Some(2));
+}
