@@ -8,5 +8,6 @@ pub mod bvh;
 pub mod explain;
 pub mod judge;
 pub mod scene;
+pub mod stats;
 pub mod traverse;
 pub mod verify;

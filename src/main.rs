@@ -148,6 +148,27 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// The thesis's experiments (figs. 3-1, 3-2, 3-4, 3-5, restart overhead) over leaf sizes.
+    Stats {
+        /// OBJ scene (default: the built-in scene).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Rays (half primary, half random incoherent).
+        #[arg(long, default_value_t = 20000, value_parser = clap::value_parser!(u64).range(1..))]
+        rays: u64,
+        /// Random-ray seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Leaf sizes to sweep (1..=255), comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,2,4,8,16,32", value_parser = clap::value_parser!(u32).range(1..=255))]
+        leaf_sizes: Vec<u32>,
+        /// Write the figures as SVG into this directory.
+        #[arg(long)]
+        svg: Option<PathBuf>,
+        /// Print the results as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Print the RTI stage table (markdown).
     Stages {
         /// Unit: rti or slab.
@@ -272,6 +293,24 @@ fn run() -> Result<bool, String> {
                 print!("{}", raypipe::traverse::render(&rep));
             }
             Ok(rep.passed)
+        }
+        Some(Cmd::Stats { scene, rays, seed, leaf_sizes, svg, json }) => {
+            let scene = match &scene {
+                Some(p) => Scene::load_obj(p).map_err(|e| e.to_string())?,
+                None => Scene::builtin(),
+            };
+            let rep = raypipe::stats::stats(&scene, &leaf_sizes, rays as usize, seed)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&rep).map_err(|e| e.to_string())?);
+            } else {
+                print!("{}", raypipe::stats::render(&rep));
+            }
+            if let Some(dir) = svg {
+                for p in raypipe::stats::write_svgs(&rep, &dir)? {
+                    eprintln!("wrote {}", p.display());
+                }
+            }
+            Ok(true)
         }
         Some(Cmd::Stages { unit, div }) => {
             let d = match div.as_str() {

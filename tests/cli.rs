@@ -237,3 +237,34 @@ fn traverse_bad_input_is_a_clear_error() {
     assert_eq!(raypipe(&["traverse", "--leaf-size", "0"]).status.code(), Some(2));
     assert_eq!(raypipe(&["traverse", "--format", "f99"]).status.code(), Some(2));
 }
+
+#[test]
+fn stats_reports_the_thesis_figures_and_writes_svgs() {
+    let dir = std::env::temp_dir().join(format!("raypipe-cli-{}-svg", std::process::id()));
+    let o = raypipe(&["stats", "--rays", "500", "--leaf-sizes", "1,4", "--json", "--svg", dir.to_str().unwrap()]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    for r in rows {
+        let backs: u64 = r["back_traversals"].as_array().unwrap().iter().map(|x| x.as_u64().unwrap()).sum();
+        assert_eq!(backs, 500, "every ray lands in one back-traversal bin");
+        assert!(r["rays_per_leaf"].as_f64().unwrap() >= 1.0);
+        assert!(r["restart_overhead"].as_f64().unwrap() >= 1.0);
+    }
+    // the same rays hit whatever the leaf size
+    assert_eq!(rows[0]["rays_hit"], rows[1]["rays_hit"]);
+    for f in [
+        "fig3-1_rays_per_leaf.svg",
+        "fig3-2_wasted_rti.svg",
+        "fig3-4_no_back_traversal.svg",
+        "fig3-5_back_distance.svg",
+        "restart_overhead.svg",
+    ] {
+        let svg = std::fs::read_to_string(dir.join(f)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("<polyline"), "{f}");
+    }
+    assert_eq!(raypipe(&["stats", "--leaf-sizes", "0"]).status.code(), Some(2));
+    assert_clear_error(&raypipe(&["stats", "--scene", "/nonexistent.obj"]), "no such file");
+}
