@@ -169,6 +169,33 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// Render through the bit-accurate pipeline (slab traversal → RTI min-capture) and diff with the golden.
+    Render {
+        /// OBJ scene (default: the built-in scene).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Format of both units.
+        #[arg(long, value_parser = parse_format, default_value = "f32")]
+        format: AnyFormat,
+        /// Slab variant: plain, conservative, directed, take-on-false, embree.
+        #[arg(long, default_value = "plain")]
+        variant: String,
+        /// Image width.
+        #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=8192))]
+        width: u32,
+        /// Image height.
+        #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=8192))]
+        height: u32,
+        /// Triangles per leaf at most.
+        #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=255))]
+        leaf_size: u32,
+        /// Output directory for render.png and diff.png.
+        #[arg(long, default_value = "render-out")]
+        out: PathBuf,
+        /// Print the counts as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Print the RTI stage table (markdown).
     Stages {
         /// Unit: rti or slab.
@@ -309,6 +336,23 @@ fn run() -> Result<bool, String> {
                 for p in raypipe::stats::write_svgs(&rep, &dir)? {
                     eprintln!("wrote {}", p.display());
                 }
+            }
+            Ok(true)
+        }
+        Some(Cmd::Render { scene, format, variant, width, height, leaf_size, out, json }) => {
+            let scene = match &scene {
+                Some(p) => Scene::load_obj(p).map_err(|e| e.to_string())?,
+                None => Scene::builtin(),
+            };
+            let rep =
+                with_format!(format, |f| raypipe::render::render(f, &variant, &scene, width, height, leaf_size, &out))?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&rep).map_err(|e| e.to_string())?);
+            } else {
+                println!(
+                    "raypipe render: scene {}, format {}, slab variant {}: {} pixels, golden hits {}, holes (golden hit, pipeline miss) {}, false hits {}, other triangle {}; wrote {}/render.png and {}/diff.png (red: hole, blue: false hit, yellow: other triangle)",
+                    scene.name, rep.format, rep.variant, rep.pixels, rep.golden_hits, rep.holes, rep.false_hits, rep.other_triangle, out.display(), out.display()
+                );
             }
             Ok(true)
         }

@@ -268,3 +268,36 @@ fn stats_reports_the_thesis_figures_and_writes_svgs() {
     assert_eq!(raypipe(&["stats", "--leaf-sizes", "0"]).status.code(), Some(2));
     assert_clear_error(&raypipe(&["stats", "--scene", "/nonexistent.obj"]), "no such file");
 }
+
+#[test]
+fn render_writes_the_image_and_the_diff() {
+    let dir = std::env::temp_dir().join(format!("raypipe-cli-{}-render", std::process::id()));
+    let o = raypipe(&[
+        "render",
+        "--format",
+        "f32",
+        "--width",
+        "48",
+        "--height",
+        "32",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["pixels"], 48 * 32);
+    assert!(v["golden_hits"].as_u64().unwrap() > 300);
+    // f32 on this scene: no holes at this resolution
+    assert_eq!(v["holes"], 0, "{v}");
+    for f in ["render.png", "diff.png"] {
+        let bytes = std::fs::read(dir.join(f)).unwrap();
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{f}");
+    }
+    assert_eq!(raypipe(&["render", "--width", "0"]).status.code(), Some(2));
+    assert_clear_error(
+        &raypipe(&["render", "--variant", "x", "--width", "4", "--height", "4"]),
+        "unknown slab variant",
+    );
+}
