@@ -223,3 +223,43 @@ fn history_states_are_the_thesis_encoding() {
         _ => unreachable!(),
     });
 }
+
+#[test]
+fn layout_with_real_boxes_in_a_narrow_storage_format() {
+    // boxes stored in fp16 (outward-rounded) inside the level banks, tested by the f32 slab unit
+    let f32_fmt = match "f32".parse::<AnyFormat>().unwrap() {
+        AnyFormat::F32(f) => f,
+        _ => unreachable!(),
+    };
+    let fp16 = match "fp16".parse::<AnyFormat>().unwrap() {
+        AnyFormat::F16(f) => f,
+        _ => unreachable!(),
+    };
+    let s = Slab::new(f32_fmt, SlabConfig::named("conservative").unwrap());
+    let mut r = SplitMix64::new(11);
+    for _ in 0..50 {
+        let nodes = make_tree(1 + r.below(40) as usize, Shape::Random, &mut r);
+        let hw = HwTree::build(&nodes, 0, 64, |_, n| s.store_box_via(&fp16, n.min, n.max)).unwrap();
+        let stored: Vec<_> = nodes.iter().map(|n| s.store_box_via(&fp16, n.min, n.max).unwrap()).collect();
+        // every bank entry contains its node's original box
+        for lv in &hw.levels {
+            for bank in [&lv.left, &lv.right] {
+                for b in &bank.boxes {
+                    assert!((0..3).all(|a| b.min[a] <= b.max[a]));
+                }
+            }
+        }
+        for _ in 0..20 {
+            let o: [f64; 3] = std::array::from_fn(|_| r.range(-1.5, 1.5));
+            let d: [f64; 3] = std::array::from_fn(|_| r.range(-1.0, 1.0));
+            let ray = s.prepare(o, d, 0.0, f64::INFINITY);
+            let on_box = |b: &datapath::slab::Aabb<f32>| {
+                let out = s.test(&ray, b);
+                out.hit.then_some(out.t_near as f64)
+            };
+            let g = stack_traverse(&golden_tree(&nodes), 8, |i| on_box(&stored[i as usize]));
+            assert_eq!(history_traverse(&hw, 8, on_box).leaves, g.leaves);
+            assert_eq!(trail_traverse(&hw, 8, on_box).leaves, g.leaves);
+        }
+    }
+}
