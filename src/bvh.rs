@@ -22,6 +22,30 @@ pub struct SceneBvh {
     pub depth: usize,
 }
 
+impl SceneBvh {
+    /// The same tree for the golden stack traversal.
+    pub fn golden_tree(&self) -> golden::bvh::Tree {
+        use golden::bvh::Node;
+        golden::bvh::Tree {
+            nodes: self
+                .nodes
+                .iter()
+                .map(|n| match n.children {
+                    Some([l, r]) => Node::Inner { left: l, right: r },
+                    None => Node::Leaf { leaf: n.leaf },
+                })
+                .collect(),
+            root: Some(0),
+        }
+    }
+
+    /// The hardware layout for `levels` level pipelines, each entry naming its node (the box
+    /// tester looks the stored box up by node index).
+    pub fn layout_ids(&self, levels: usize) -> Result<datapath::bvh::HwTree<u32>, String> {
+        datapath::bvh::HwTree::build(&self.nodes, 0, levels, |i, _| Ok::<u32, String>(i)).map_err(|e| e.to_string())
+    }
+}
+
 fn bounds(tris: &[golden::Tri64], ids: &[u32]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];

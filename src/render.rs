@@ -5,11 +5,11 @@
 
 use crate::bvh::build;
 use crate::scene::Scene;
-use datapath::bvh::{history_traverse, HwTree};
+use datapath::bvh::history_traverse;
 use datapath::rti::{Capture, Rti, RtiConfig};
 use datapath::slab::{Slab, SlabConfig};
 use datapath::Format;
-use golden::bvh::{stack_traverse, Node, Tree};
+use golden::bvh::stack_traverse;
 use golden::{intersect, slab_f64, Faces, Ray64};
 use serde::Serialize;
 use std::path::Path;
@@ -68,18 +68,8 @@ pub fn render<F: Format>(
     let slab = Slab::new(f, sc);
     let rti = Rti::new(f, RtiConfig::default());
     let b = build(scene, leaf_size);
-    let hw = HwTree::build(&b.nodes, 0, 256, |i, _| Ok::<u32, String>(i)).map_err(|e| e.to_string())?;
-    let tree = Tree {
-        nodes: b
-            .nodes
-            .iter()
-            .map(|n| match n.children {
-                Some([l, r]) => Node::Inner { left: l, right: r },
-                None => Node::Leaf { leaf: n.leaf },
-            })
-            .collect(),
-        root: Some(0),
-    };
+    let hw = b.layout_ids(256)?;
+    let tree = b.golden_tree();
     let boxes: Vec<_> =
         b.nodes.iter().map(|n| slab.store_box(n.min, n.max)).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
     let tris: Vec<_> = scene.tris.iter().map(|t| rti.tri(t.v)).collect();

@@ -10,8 +10,8 @@
 
 use crate::bvh::build;
 use crate::scene::Scene;
-use datapath::bvh::{history_traverse, HwTree};
-use golden::bvh::{stack_traverse, Node, Tree};
+use datapath::bvh::history_traverse;
+use golden::bvh::stack_traverse;
 use golden::{intersect, slab_f64, Faces};
 use serde::Serialize;
 
@@ -67,18 +67,8 @@ pub fn stats(scene: &Scene, leaf_sizes: &[u32], rays: usize, seed: u64) -> Resul
     let mut rows = Vec::new();
     for &ls in leaf_sizes {
         let b = build(scene, ls);
-        let hw = HwTree::build(&b.nodes, 0, 256, |i, _| Ok::<u32, String>(i)).map_err(|e| e.to_string())?;
-        let tree = Tree {
-            nodes: b
-                .nodes
-                .iter()
-                .map(|n| match n.children {
-                    Some([l, r]) => Node::Inner { left: l, right: r },
-                    None => Node::Leaf { leaf: n.leaf },
-                })
-                .collect(),
-            root: Some(0),
-        };
+        let hw = b.layout_ids(256)?;
+        let tree = b.golden_tree();
         let mut per_leaf = vec![0u64; b.leaf_tris.len()];
         let mut wasted = 0u64;
         let mut back = vec![0u64; BACK_BINS];

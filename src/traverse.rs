@@ -8,7 +8,7 @@ use datapath::bvh::{history_traverse, trail_traverse, HwTree};
 use datapath::rng::SplitMix64;
 use datapath::slab::{Slab, SlabConfig};
 use datapath::{with_format, AnyFormat, Format};
-use golden::bvh::{stack_traverse, Node, Tree};
+use golden::bvh::{stack_traverse, Tree};
 use golden::Ray64;
 use serde::Serialize;
 
@@ -113,26 +113,12 @@ pub fn rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray64> {
     out
 }
 
-fn golden_tree(b: &SceneBvh) -> Tree {
-    Tree {
-        nodes: b
-            .nodes
-            .iter()
-            .map(|n| match n.children {
-                Some([l, r]) => Node::Inner { left: l, right: r },
-                None => Node::Leaf { leaf: n.leaf },
-            })
-            .collect(),
-        root: Some(0),
-    }
-}
-
 /// Runs the equivalence check.
 pub fn traverse(cfg: &TraverseConfig, scene: &Scene) -> Result<TraverseReport, String> {
     let sc = SlabConfig::named(&cfg.variant)?;
     let b = build(scene, cfg.leaf_size);
-    let hw = HwTree::build(&b.nodes, 0, cfg.levels, |i, _| Ok::<u32, String>(i)).map_err(|e| e.to_string())?;
-    let tree = golden_tree(&b);
+    let hw = b.layout_ids(cfg.levels)?;
+    let tree = b.golden_tree();
     let rays = rays(scene, cfg.rays, cfg.seed);
     let mut rows = Vec::new();
     for f in &cfg.formats {

@@ -200,6 +200,24 @@ pub struct StacklessResult {
     pub state: Vec<u8>,
 }
 
+/// The ray's entry into the tree: tests the root box; a miss, N = 0 or a root leaf (emitted)
+/// finishes the ray (false); otherwise the passes begin (true).
+fn enter<B>(t: &HwTree<B>, n: usize, test: &mut impl FnMut(&B) -> Option<f64>, r: &mut StacklessResult) -> bool {
+    if n == 0 {
+        return false;
+    }
+    r.box_tests += 1;
+    if test(&t.root_box).is_none() {
+        return false;
+    }
+    if t.root_addr & LEAF_FLAG != 0 {
+        r.passes = 1;
+        r.leaves.push(t.root_addr & !LEAF_FLAG);
+        return false;
+    }
+    true
+}
+
 /// Tests the pair at `level`/`idx`: (left hit entry, right hit entry).
 fn test_pair<B>(
     t: &HwTree<B>,
@@ -244,16 +262,7 @@ fn addr_of<B>(t: &HwTree<B>, level: usize, idx: u32, side: usize) -> u32 {
 /// leaves or when no level is in state 10 at the end of a pass.
 pub fn history_traverse<B>(t: &HwTree<B>, n: usize, mut test: impl FnMut(&B) -> Option<f64>) -> StacklessResult {
     let mut r = StacklessResult { state: vec![hist::NEW; t.depth()], ..Default::default() };
-    if n == 0 {
-        return r;
-    }
-    r.box_tests += 1;
-    if test(&t.root_box).is_none() {
-        return r;
-    }
-    if t.root_addr & LEAF_FLAG != 0 {
-        r.passes = 1;
-        r.leaves.push(t.root_addr & !LEAF_FLAG);
+    if !enter(t, n, &mut test, &mut r) {
         return r;
     }
     let h = &mut r.state;
@@ -316,16 +325,7 @@ pub fn history_traverse<B>(t: &HwTree<B>, n: usize, mut test: impl FnMut(&B) -> 
 /// where it ended becomes 1 and every deeper bit 0; no such 0 ends the traversal.
 pub fn trail_traverse<B>(t: &HwTree<B>, n: usize, mut test: impl FnMut(&B) -> Option<f64>) -> StacklessResult {
     let mut r = StacklessResult { state: vec![0; t.depth()], ..Default::default() };
-    if n == 0 {
-        return r;
-    }
-    r.box_tests += 1;
-    if test(&t.root_box).is_none() {
-        return r;
-    }
-    if t.root_addr & LEAF_FLAG != 0 {
-        r.passes = 1;
-        r.leaves.push(t.root_addr & !LEAF_FLAG);
+    if !enter(t, n, &mut test, &mut r) {
         return r;
     }
     let trail = &mut r.state;
