@@ -196,6 +196,35 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// Write a self-describing vector set for RTL testbenches (or check one with --check).
+    Vectors {
+        /// Unit: rti, slab or op.
+        #[arg(long, default_value = "rti")]
+        unit: String,
+        /// Number format.
+        #[arg(long, value_parser = parse_format, default_value = "f32")]
+        format: AnyFormat,
+        /// Output directory (replaced atomically).
+        #[arg(long, required_unless_present = "check")]
+        out: Option<PathBuf>,
+        /// Vectors per coverage class.
+        #[arg(long, default_value_t = 64)]
+        count: u64,
+        /// Seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Coverage level (1: every class on its own).
+        #[arg(long, default_value_t = 1)]
+        level: u32,
+        /// Slab variant (unit slab).
+        #[arg(long, default_value = "plain")]
+        variant: String,
+        /// Re-check an existing set against the models instead of writing one.
+        #[arg(long)]
+        check: Option<PathBuf>,
+        #[command(flatten)]
+        rti: RtiArgs,
+    },
     /// Print the RTI stage table (markdown).
     Stages {
         /// Unit: rti or slab.
@@ -354,6 +383,37 @@ fn run() -> Result<bool, String> {
                     scene.name, rep.format, rep.variant, rep.pixels, rep.golden_hits, rep.holes, rep.false_hits, rep.other_triangle, out.display(), out.display()
                 );
             }
+            Ok(true)
+        }
+        Some(Cmd::Vectors { unit, format, out, count, seed, level, variant, check, rti }) => {
+            if let Some(dir) = check {
+                let n = vectors::gen::check_set(&dir)?;
+                println!("{}: {n} vectors, every expected and stage row equals the model's bits", dir.display());
+                return Ok(true);
+            }
+            let out = out.ok_or("--out is required")?;
+            let req = vectors::gen::Request {
+                unit: unit.parse()?,
+                format,
+                count: count as usize,
+                seed,
+                level,
+                command: std::env::args().collect::<Vec<_>>().join(" "),
+                rti: rti.config()?,
+                slab_variant: variant,
+            };
+            let set = vectors::gen::generate(&req)?;
+            vectors::gen::write_set(&set, &out)?;
+            let m = &set.manifest;
+            println!(
+                "wrote {}: unit {}, format {}, {} vectors ({}), seed {}",
+                out.display(),
+                m.unit,
+                m.format,
+                m.files[0].rows,
+                m.classes.iter().map(|c| format!("{} {}", c.name, c.count)).collect::<Vec<_>>().join(", "),
+                m.seed
+            );
             Ok(true)
         }
         Some(Cmd::Stages { unit, div }) => {

@@ -1,11 +1,18 @@
-//! Test-vector export for RTL testbenches: fixed-width hex fields, MSB first.
+//! Test vectors for RTL testbenches: self-describing vector sets (data files of packed hex
+//! rows, one vector per line, plus a `manifest.json` that says what every bit means), written
+//! atomically and deterministically, and read back to re-check every bit.
 #![warn(missing_docs)]
+
+pub mod gen;
+pub mod manifest;
+pub mod pack;
+
+pub use pack::{pack, unpack, Bits};
 
 /// Formats `bits` (the low `width` bits) as exactly `ceil(width/4)` lowercase hex digits, no prefix.
 pub fn hex_field(bits: u64, width: u32) -> String {
-    let digits = width.div_ceil(4) as usize;
     let masked = if width >= 64 { bits } else { bits & ((1u64 << width) - 1) };
-    format!("{masked:0digits$x}")
+    pack(&[Bits { value: masked, width }])
 }
 
 #[cfg(test)]

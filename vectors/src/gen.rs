@@ -1,0 +1,775 @@
+//! Vector generation, atomic writing and the read-back check, for the `rti`, `slab` and `op` units.
+//!
+//! Every vector carries a coverage-class id. Level 1 covers each named class with `count`
+//! vectors (TestFloat's level 1: each class on its own). Inputs are always produced through the
+//! format's own input conversion, so re-reading them reproduces the same bits.
+
+use crate::manifest::{self, Class, Field, Kind, Manifest, Stage};
+use crate::pack::{pack, unpack, Bits};
+use datapath::format::FormatKind;
+use datapath::probe::{Recorder, Signal};
+use datapath::rng::SplitMix64;
+use datapath::rti::{stage_count, stage_table, Op, Ray, Rti, RtiConfig, Tri, RTI_INPUTS};
+use datapath::slab::{Aabb, Slab, SlabConfig, SLAB_TABLE};
+use datapath::{with_format, AnyFormat, Format};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// The unit a vector set exercises.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    /// Ray–triangle pipeline.
+    Rti,
+    /// Ray–box pipeline.
+    Slab,
+    /// Single operations.
+    Op,
+}
+
+impl FromStr for Unit {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "rti" => Ok(Unit::Rti),
+            "slab" => Ok(Unit::Slab),
+            "op" => Ok(Unit::Op),
+            "traverse" => Err("unit 'traverse' has no vector writer yet (units: rti, slab, op)".into()),
+            other => Err(format!("unknown unit '{other}' (units: rti, slab, op)")),
+        }
+    }
+}
+
+impl Unit {
+    fn name(self) -> &'static str {
+        match self {
+            Unit::Rti => "rti",
+            Unit::Slab => "slab",
+            Unit::Op => "op",
+        }
+    }
+}
+
+/// What to generate.
+#[derive(Clone, Debug)]
+pub struct Request {
+    /// Unit.
+    pub unit: Unit,
+    /// Number format.
+    pub format: AnyFormat,
+    /// Vectors per coverage class.
+    pub count: usize,
+    /// Seed.
+    pub seed: u64,
+    /// Coverage level (1).
+    pub level: u32,
+    /// The command line, recorded in the manifest.
+    pub command: String,
+    /// RTI options.
+    pub rti: RtiConfig,
+    /// Slab variant name.
+    pub slab_variant: String,
+}
+
+/// A generated set: the manifest (hashes filled on writing) and the file contents.
+#[derive(Clone, Debug)]
+pub struct VectorSet {
+    /// Manifest.
+    pub manifest: Manifest,
+    /// (file name, contents).
+    pub files: Vec<(String, String)>,
+}
+
+fn kind_of<F: Format>(f: &F) -> Kind {
+    match f.kind() {
+        FormatKind::Float(l) => Kind::Ieee { exp: l.exp_bits, man: l.man_bits },
+        FormatKind::Fixed { int_bits, frac_bits } => Kind::Fixed { int: int_bits, frac: frac_bits },
+    }
+}
+
+/// Field list builder: names, directions, kinds and widths, most significant first.
+struct Layout(Vec<(String, &'static str, Kind, u32, Option<u8>)>);
+
+impl Layout {
+    fn fields(&self) -> Vec<Field> {
+        let total: u32 = self.0.iter().map(|f| f.3).sum();
+        let mut top = total;
+        self.0
+            .iter()
+            .map(|(name, dir, kind, width, stage)| {
+                top -= width;
+                Field {
+                    name: name.clone(),
+                    dir: dir.to_string(),
+                    kind: kind.clone(),
+                    width: *width,
+                    lsb: top,
+                    stage: *stage,
+                }
+            })
+            .collect()
+    }
+    fn widths(&self) -> Vec<u32> {
+        self.0.iter().map(|f| f.3).collect()
+    }
+}
+
+/// Rows of one file.
+struct Rows {
+    name: String,
+    role: &'static str,
+    layout: Layout,
+    lines: Vec<String>,
+}
+
+impl Rows {
+    fn push(&mut self, values: &[u64]) {
+        let bits: Vec<Bits> =
+            values.iter().zip(self.layout.widths()).map(|(&value, width)| Bits { value, width }).collect();
+        self.lines.push(pack(&bits));
+    }
+}
+
+fn contract_map<F: Format>(f: &F) -> BTreeMap<String, String> {
+    let c = f.contract();
+    [
+        ("encoding", c.encoding),
+        ("rounding", c.rounding),
+        ("subnormals", c.subnormals),
+        ("nan", c.nan),
+        ("overflow", c.overflow),
+        ("division", c.division),
+        ("compare", c.compare),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect()
+}
+
+const RTI_CLASSES: [(&str, &str); 12] = [
+    ("random", "ray aimed at a random barycentric point in [-0.3, 1.3]^2 of a random triangle in [-1, 1]^3"),
+    ("edge", "aimed exactly at a point of an edge (one barycentric 0)"),
+    ("vertex", "aimed exactly at a vertex"),
+    ("near_parallel", "direction within ~1e-3 of the triangle's plane (|det| -> 0)"),
+    ("degenerate", "collinear vertices (zero area)"),
+    ("needle", "long triangle 1e-3 wide"),
+    ("huge", "coordinates scaled by 2^12"),
+    ("tiny", "coordinates scaled by 2^-12"),
+    ("t_near_zero", "origin on the triangle's plane (t = 0)"),
+    ("signed_zero", "some coordinates +0 or -0"),
+    ("subnormal", "some inputs the format's smallest subnormals (floats only)"),
+    ("inf_nan", "some inputs +inf, -inf or NaN (floats only)"),
+];
+
+const SLAB_CLASSES: [(&str, &str); 6] = [
+    ("random", "random ray and box in [-1, 1]^3"),
+    ("face_signed_zero", "origin on a face plane, one direction component +0 or -0"),
+    ("grazing", "aimed at a face, edge or corner point of the box"),
+    ("inside", "origin inside the box"),
+    ("zero_extent", "box of zero extent on one or more axes"),
+    ("inf_nan", "ray inputs +inf, -inf or NaN (floats only)"),
+];
+
+const OP_CLASSES: [(&str, &str); 2] = [
+    ("special", "TestFloat level 1: every pair of special operands (zeros, subnormals, min/max normal, one, all-ones significands, inf, NaN; fixed: extremes and one)"),
+    ("random", "uniform random operand bits"),
+];
+
+/// Op codes of the `op` unit.
+pub const OPCODES: [&str; 6] = ["add", "sub", "mul", "div", "lt", "le"];
+
+fn is_float<F: Format>(f: &F) -> bool {
+    matches!(f.kind(), FormatKind::Float(_))
+}
+
+fn rti_case(class: usize, r: &mut SplitMix64) -> ([f64; 17], bool) {
+    let p = |r: &mut SplitMix64| [r.range(-1.0, 1.0), r.range(-1.0, 1.0), r.range(-1.0, 1.0)];
+    let mut v = [p(r), p(r), p(r)];
+    let o = p(r);
+    let (mut b1, mut b2) = (r.range(-0.3, 1.3), r.range(-0.3, 1.3));
+    match class {
+        1 => match r.below(3) {
+            0 => b1 = 0.0,
+            1 => b2 = 0.0,
+            _ => b2 = 1.0 - b1,
+        },
+        2 => {
+            let k = r.below(3);
+            (b1, b2) = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)][k as usize];
+        }
+        4 => {
+            let t = r.range(-1.0, 2.0);
+            v[2] = std::array::from_fn(|a| v[0][a] + t * (v[1][a] - v[0][a]));
+        }
+        5 => {
+            let w = 1e-3;
+            v[2] = std::array::from_fn(|a| v[1][a] + w * r.range(-1.0, 1.0));
+        }
+        _ => {}
+    }
+    let b0 = 1.0 - b1 - b2;
+    let target: [f64; 3] = std::array::from_fn(|a| b0 * v[0][a] + b1 * v[1][a] + b2 * v[2][a]);
+    let mut o = o;
+    let mut d: [f64; 3] = std::array::from_fn(|a| target[a] - o[a]);
+    if class == 3 {
+        // move the origin into the plane, then lift it slightly off
+        let e1: [f64; 3] = std::array::from_fn(|a| v[1][a] - v[0][a]);
+        let e2: [f64; 3] = std::array::from_fn(|a| v[2][a] - v[0][a]);
+        let s = r.range(-1.0, 1.0);
+        let t = r.range(-1.0, 1.0);
+        o = std::array::from_fn(|a| target[a] + s * e1[a] + t * e2[a]);
+        let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+        let eps = 1e-3 * r.range(-1.0, 1.0);
+        o = std::array::from_fn(|a| o[a] + eps * n[a]);
+        d = std::array::from_fn(|a| target[a] - o[a]);
+    }
+    if class == 8 {
+        o = target;
+        d = p(r);
+    }
+    let scale = match class {
+        6 => 4096.0,
+        7 => 1.0 / 4096.0,
+        _ => 1.0,
+    };
+    let mut x = [0.0; 17];
+    for a in 0..3 {
+        x[a] = o[a] * scale;
+        x[3 + a] = d[a] * scale;
+        for k in 0..3 {
+            x[8 + 3 * k + a] = v[k][a] * scale;
+        }
+    }
+    x[6] = 0.0;
+    x[7] = if r.below(4) == 0 { r.range(0.0, 3.0) * scale } else { f64::INFINITY };
+    if class == 9 {
+        for xi in x.iter_mut() {
+            if r.below(3) == 0 {
+                *xi = if r.below(2) == 0 { 0.0 } else { -0.0 };
+            }
+        }
+    }
+    (x, class >= 10)
+}
+
+fn specials_for<F: Format>(f: &F) -> Vec<u64> {
+    match f.kind() {
+        FormatKind::Float(l) => {
+            let top = (1u64 << l.exp_bits) - 1;
+            let bias = l.bias() as u64;
+            let mm = l.man_mask();
+            let mut v = Vec::new();
+            for e in [0, 1, bias - 1, bias, bias + 1, top - 1, top] {
+                for fr in [0, 1, mm >> 1, mm, 1 << (l.man_bits - 1)] {
+                    for s in [0, l.sign_mask()] {
+                        v.push(s | (e << l.man_bits) | (fr & mm));
+                    }
+                }
+            }
+            v.sort_unstable();
+            v.dedup();
+            v
+        }
+        FormatKind::Fixed { .. } => {
+            let vals = [0.0, 1.0, -1.0, 0.5, -0.5, f64::INFINITY, f64::NEG_INFINITY];
+            let mut v: Vec<u64> = vals.iter().map(|&x| f.to_bits(f.from_f64(x))).collect();
+            v.extend([1, u64::MAX].map(|raw| f.to_bits(f.from_bits(raw)))); // one step, minus one step
+            v.sort_unstable();
+            v.dedup();
+            v
+        }
+    }
+}
+
+/// Generates a vector set.
+pub fn generate(req: &Request) -> Result<VectorSet, String> {
+    if req.count == 0 {
+        return Err("--count must be at least 1".into());
+    }
+    if req.level != 1 {
+        return Err(format!("coverage level {} is not available yet (level 1 only)", req.level));
+    }
+    with_format!(req.format, |f| generate_in(f, req))
+}
+
+fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
+    let w = f.width();
+    let k = kind_of(&f);
+    let mut r = SplitMix64::new(req.seed);
+    let mut options = BTreeMap::new();
+    let (classes, latency, stages): (&[(&str, &str)], u32, Vec<Stage>);
+    let unit = req.unit.name();
+    let mut files: Vec<Rows> = Vec::new();
+    let mut counts: Vec<usize>;
+    let inputs_layout = |names: &[&str], extra: Vec<(String, &'static str, Kind, u32, Option<u8>)>| {
+        let mut l = vec![("class".to_string(), "in", Kind::Uint, 8, None)];
+        l.extend(extra);
+        l.extend(names.iter().map(|n| (n.to_string(), "in", k.clone(), w, None)));
+        Layout(l)
+    };
+    match req.unit {
+        Unit::Rti => {
+            let rti = Rti::new(f, req.rti);
+            options.insert("cull".into(), format!("{:?}", req.rti.cull));
+            options.insert(
+                "det_threshold".into(),
+                format!("{:?} (as the format rounds it: {})", req.rti.det_threshold, f.hex(rti.det_thr)),
+            );
+            options.insert("tie".into(), format!("{:?}", req.rti.tie));
+            let table = stage_table(f.div_mode());
+            classes = &RTI_CLASSES;
+            latency = stage_count(f.div_mode()) as u32;
+            stages = table
+                .iter()
+                .map(|d| Stage { stage: d.stage, name: d.name.into(), op: op_text(d.op, d.a, d.b, d.note) })
+                .collect();
+            let out = Layout(vec![
+                ("valid".into(), "out", Kind::Flag, 1, Some(7)),
+                ("hit".into(), "out", Kind::Flag, 1, Some(table.last().unwrap().stage)),
+                ("t".into(), "out", k.clone(), w, Some(table.iter().find(|d| d.name == "t").unwrap().stage)),
+                ("u".into(), "out", k.clone(), w, Some(table.iter().find(|d| d.name == "u").unwrap().stage)),
+                ("v".into(), "out", k.clone(), w, Some(table.iter().find(|d| d.name == "v").unwrap().stage)),
+            ]);
+            let st = Layout(
+                table
+                    .iter()
+                    .map(|d| {
+                        if d.op == Op::Logic {
+                            (d.name.to_string(), "out", Kind::Flag, 1, Some(d.stage))
+                        } else {
+                            (d.name.to_string(), "out", k.clone(), w, Some(d.stage))
+                        }
+                    })
+                    .collect(),
+            );
+            files.push(Rows {
+                name: "rti_inputs.hex".into(),
+                role: "inputs",
+                layout: inputs_layout(&RTI_INPUTS, vec![]),
+                lines: vec![],
+            });
+            files.push(Rows { name: "rti_expected.hex".into(), role: "expected outputs", layout: out, lines: vec![] });
+            files.push(Rows {
+                name: "rti_stages.hex".into(),
+                role: "expected stage signals",
+                layout: st,
+                lines: vec![],
+            });
+            counts = vec![0; classes.len()];
+            for (c, _) in classes.iter().enumerate() {
+                if c >= 10 && !is_float(&f) {
+                    continue;
+                }
+                for _ in 0..req.count {
+                    let (mut x, special) = rti_case(c, &mut r);
+                    if special {
+                        for _ in 0..1 + r.below(3) {
+                            let i = r.below(17) as usize;
+                            x[i] = if c == 10 {
+                                let sub = f.to_f64(f.from_bits(1 + r.below(3)));
+                                if r.below(2) == 0 {
+                                    sub
+                                } else {
+                                    -sub
+                                }
+                            } else {
+                                [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][r.below(3) as usize]
+                            };
+                        }
+                    }
+                    let bits: Vec<u64> = x.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
+                    let row = rti_rows(&rti, c as u64, &bits);
+                    for (file, vals) in files.iter_mut().zip(row) {
+                        file.push(&vals);
+                    }
+                    counts[c] += 1;
+                }
+            }
+        }
+        Unit::Slab => {
+            let sc = SlabConfig::named(&req.slab_variant)?;
+            if sc.directed {
+                return Err("the directed slab variant has a data-dependent signal set; vectors support plain, conservative, take-on-false and embree".into());
+            }
+            let slab = Slab::new(f, sc);
+            options.insert("variant".into(), req.slab_variant.clone());
+            options.insert("config".into(), format!("{sc:?}"));
+            classes = &SLAB_CLASSES;
+            latency = 7;
+            stages = SLAB_TABLE
+                .iter()
+                .map(|d| Stage { stage: d.stage, name: d.name.into(), op: op_text(d.op, d.a, d.b, d.note) })
+                .collect();
+            let names =
+                ["ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax", "minx", "miny", "minz", "maxx", "maxy", "maxz"];
+            let out = Layout(vec![
+                ("hit".into(), "out", Kind::Flag, 1, Some(6)),
+                ("t_near".into(), "out", k.clone(), w, Some(5)),
+                ("t_far".into(), "out", k.clone(), w, Some(5)),
+            ]);
+            let st = Layout(
+                SLAB_TABLE
+                    .iter()
+                    .map(|d| {
+                        let flag = matches!(d.name, "negx" | "negy" | "negz" | "hit");
+                        if flag {
+                            (d.name.to_string(), "out", Kind::Flag, 1, Some(d.stage))
+                        } else {
+                            (d.name.to_string(), "out", k.clone(), w, Some(d.stage))
+                        }
+                    })
+                    .collect(),
+            );
+            files.push(Rows {
+                name: "slab_inputs.hex".into(),
+                role: "inputs (box already stored outward-rounded)",
+                layout: inputs_layout(&names, vec![]),
+                lines: vec![],
+            });
+            files.push(Rows { name: "slab_expected.hex".into(), role: "expected outputs", layout: out, lines: vec![] });
+            files.push(Rows {
+                name: "slab_stages.hex".into(),
+                role: "expected stage signals",
+                layout: st,
+                lines: vec![],
+            });
+            counts = vec![0; classes.len()];
+            for (c, _) in classes.iter().enumerate() {
+                if c == 5 && !is_float(&f) {
+                    continue;
+                }
+                for _ in 0..req.count {
+                    let x = slab_case(c, &mut r);
+                    let b = slab.store_box([x[8], x[9], x[10]], [x[11], x[12], x[13]]).map_err(|e| e.to_string())?;
+                    let mut bits: Vec<u64> = x[..8].iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
+                    bits.extend(b.min.iter().chain(b.max.iter()).map(|&v| f.to_bits(v)));
+                    let row = slab_rows(&slab, c as u64, &bits);
+                    for (file, vals) in files.iter_mut().zip(row) {
+                        file.push(&vals);
+                    }
+                    counts[c] += 1;
+                }
+            }
+        }
+        Unit::Op => {
+            classes = &OP_CLASSES;
+            latency = 1;
+            stages = OPCODES
+                .iter()
+                .enumerate()
+                .map(|(i, o)| Stage { stage: 1, name: format!("opcode {i}"), op: o.to_string() })
+                .collect();
+            options.insert(
+                "opcodes".into(),
+                OPCODES.iter().enumerate().map(|(i, o)| format!("{i}={o}")).collect::<Vec<_>>().join(", "),
+            );
+            let inl = Layout(vec![
+                ("class".into(), "in", Kind::Uint, 8, None),
+                ("opcode".into(), "in", Kind::Uint, 4, None),
+                ("a".into(), "in", k.clone(), w, None),
+                ("b".into(), "in", k.clone(), w, None),
+            ]);
+            let out = Layout(vec![
+                ("result".into(), "out", k.clone(), w, Some(1)),
+                ("cmp".into(), "out", Kind::Flag, 1, Some(1)),
+            ]);
+            files.push(Rows { name: "op_inputs.hex".into(), role: "inputs", layout: inl, lines: vec![] });
+            files.push(Rows {
+                name: "op_expected.hex".into(),
+                role: "expected outputs (result is 0 for compares, cmp is 0 for arithmetic)",
+                layout: out,
+                lines: vec![],
+            });
+            counts = vec![0; 2];
+            let sp = specials_for(&f);
+            let mask = if w >= 64 { u64::MAX } else { (1u64 << w) - 1 };
+            let mut pairs: Vec<(u64, u64, u64)> = Vec::new();
+            for op in 0..OPCODES.len() as u64 {
+                for &a in &sp {
+                    for &b in &sp {
+                        pairs.push((0, a, b | (op << 60)));
+                    }
+                }
+                for _ in 0..req.count {
+                    pairs.push((1, r.next_u64() & mask, (r.next_u64() & mask) | (op << 60)));
+                }
+            }
+            for (c, a, bop) in pairs {
+                let (op, b) = (bop >> 60, bop & ((1u64 << 60) - 1) & mask);
+                let (x, y) = (f.from_bits(a), f.from_bits(b));
+                let (res, cmp) = op_eval(&f, op, x, y);
+                files[0].push(&[c, op, a, b]);
+                files[1].push(&[res, cmp]);
+                counts[c as usize] += 1;
+            }
+        }
+    }
+    let manifest = Manifest {
+        schema: manifest::SCHEMA,
+        raypipe_version: env!("CARGO_PKG_VERSION").into(),
+        git: git_hash(),
+        command: req.command.clone(),
+        seed: req.seed,
+        unit: unit.into(),
+        level: req.level,
+        format: f.name(),
+        contract: contract_map(&f),
+        options,
+        latency,
+        stages,
+        acceptable_values: "exact: every operation is correctly rounded per the contract, so each output has exactly one acceptable value".into(),
+        files: files
+            .iter()
+            .map(|fr| {
+                let fields = fr.layout.fields();
+                let width: u32 = fields.iter().map(|x| x.width).sum();
+                manifest::File { name: fr.name.clone(), role: fr.role.into(), rows: fr.lines.len(), width, digits: width.div_ceil(4), fields, sha256: String::new() }
+            })
+            .collect(),
+        classes: classes.iter().enumerate().map(|(i, (n, c))| Class { id: i as u32, name: n.to_string(), covers: c.to_string(), count: counts[i] }).collect(),
+    };
+    Ok(VectorSet { manifest, files: files.into_iter().map(|fr| (fr.name, fr.lines.join("\n") + "\n")).collect() })
+}
+
+fn op_text(op: Op, a: &str, b: &str, note: &str) -> String {
+    match op {
+        Op::Sub => format!("{a} - {b}"),
+        Op::Add => format!("{a} + {b}"),
+        Op::Mul => format!("{a} * {b}"),
+        Op::Div => format!("{a} / {b}"),
+        Op::Logic => note.to_string(),
+    }
+}
+
+fn op_eval<F: Format>(f: &F, op: u64, x: F::V, y: F::V) -> (u64, u64) {
+    match op {
+        0 => (f.to_bits(f.add(x, y)), 0),
+        1 => (f.to_bits(f.sub(x, y)), 0),
+        2 => (f.to_bits(f.mul(x, y)), 0),
+        3 => (f.to_bits(f.div(x, y)), 0),
+        4 => (0, f.lt(x, y) as u64),
+        _ => (0, f.le(x, y) as u64),
+    }
+}
+
+/// Model rows for one RTI vector: inputs, expected outputs, stage signals.
+fn rti_rows<F: Format>(rti: &Rti<F>, class: u64, bits: &[u64]) -> [Vec<u64>; 3] {
+    let f = &rti.fmt;
+    let v = |i: usize| f.from_bits(bits[i]);
+    let ray = Ray { o: [v(0), v(1), v(2)], d: [v(3), v(4), v(5)], tmin: v(6), tmax: v(7) };
+    let tri = Tri { v: [[v(8), v(9), v(10)], [v(11), v(12), v(13)], [v(14), v(15), v(16)]] };
+    let mut rec = Recorder::new();
+    let out = rti.trace(&ray, &tri, &mut rec);
+    let mut inputs = vec![class];
+    inputs.extend_from_slice(bits);
+    let expected = vec![out.valid as u64, out.hit as u64, f.to_bits(out.t), f.to_bits(out.u), f.to_bits(out.v)];
+    let stages = signals(f, &rec);
+    [inputs, expected, stages]
+}
+
+fn signals<F: Format>(f: &F, rec: &Recorder<F::V>) -> Vec<u64> {
+    rec.signals
+        .iter()
+        .map(|(_, s)| match s {
+            Signal::Value(x) => f.to_bits(*x),
+            Signal::Flag(b) => *b as u64,
+        })
+        .collect()
+}
+
+fn slab_case(class: usize, r: &mut SplitMix64) -> [f64; 14] {
+    let mut lo = [0.0; 3];
+    let mut hi = [0.0; 3];
+    for a in 0..3 {
+        let c = r.range(-1.0, 1.0);
+        let e = if class == 4 && r.below(2) == 0 { 0.0 } else { r.range(0.01, 0.5) };
+        lo[a] = c - e;
+        hi[a] = c + e;
+    }
+    let mut o: [f64; 3] = std::array::from_fn(|_| r.range(-2.0, 2.0));
+    let mut d: [f64; 3] = std::array::from_fn(|_| r.range(-1.0, 1.0));
+    match class {
+        1 => {
+            let a = r.below(3) as usize;
+            o[a] = if r.below(2) == 0 { lo[a] } else { hi[a] };
+            for b in 0..3 {
+                if b != a {
+                    o[b] = r.range(lo[b], hi[b]);
+                }
+            }
+            let z = r.below(3) as usize;
+            d[z] = if r.below(2) == 0 { 0.0 } else { -0.0 };
+        }
+        2 => {
+            let mut p: [f64; 3] = std::array::from_fn(|a| r.range(lo[a], hi[a]));
+            for a in 0..1 + r.below(3) as usize {
+                p[a] = if r.below(2) == 0 { lo[a] } else { hi[a] };
+            }
+            d = std::array::from_fn(|a| p[a] - o[a]);
+        }
+        3 => o = std::array::from_fn(|a| r.range(lo[a], hi[a])),
+        5 => {
+            let i = r.below(6) as usize;
+            let v = [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][r.below(3) as usize];
+            if i < 3 {
+                o[i] = v;
+            } else {
+                d[i - 3] = v;
+            }
+        }
+        _ => {}
+    }
+    let tmax = if r.below(4) == 0 { r.range(0.0, 3.0) } else { f64::INFINITY };
+    [o[0], o[1], o[2], d[0], d[1], d[2], 0.0, tmax, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]]
+}
+
+/// Model rows for one slab vector.
+fn slab_rows<F: Format>(s: &Slab<F>, class: u64, bits: &[u64]) -> [Vec<u64>; 3] {
+    let f = &s.fmt;
+    let x = |i: usize| f.to_f64(f.from_bits(bits[i]));
+    let mut rec = Recorder::new();
+    let ray = s.prepare_trace([x(0), x(1), x(2)], [x(3), x(4), x(5)], x(6), x(7), &mut rec);
+    let v = |i: usize| f.from_bits(bits[i]);
+    let b = Aabb { min: [v(8), v(9), v(10)], max: [v(11), v(12), v(13)] };
+    let out = s.trace(&ray, &b, &mut rec);
+    let mut inputs = vec![class];
+    inputs.extend_from_slice(bits);
+    [inputs, vec![out.hit as u64, f.to_bits(out.t_near), f.to_bits(out.t_far)], signals(f, &rec)]
+}
+
+fn git_hash() -> String {
+    std::process::Command::new("git")
+        .args(["rev-parse", "HEAD"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_else(|| "unknown".into())
+}
+
+fn sha256_hex(data: &[u8]) -> String {
+    Sha256::digest(data).iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Writes a set into `dir` atomically: everything goes to a sibling temporary directory first,
+/// which then replaces `dir` with one rename. A `dir` that exists must be an earlier vector set
+/// (it has a manifest.json) or empty; anything else is refused.
+pub fn write_set(set: &VectorSet, dir: &Path) -> Result<PathBuf, String> {
+    if dir.exists() {
+        let empty = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?.next().is_none();
+        if !empty && !dir.join("manifest.json").is_file() {
+            return Err(format!("{} exists and is not a vector set; refusing to replace it", dir.display()));
+        }
+    }
+    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
+    let name = dir.file_name().ok_or_else(|| format!("{}: not a directory name", dir.display()))?.to_string_lossy();
+    let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
+    let mut manifest = set.manifest.clone();
+    for (fname, content) in &set.files {
+        std::fs::write(tmp.join(fname), content).map_err(|e| format!("{fname}: {e}"))?;
+        if let Some(m) = manifest.files.iter_mut().find(|m| &m.name == fname) {
+            m.sha256 = sha256_hex(content.as_bytes());
+        }
+    }
+    let json = serde_json::to_string_pretty(&manifest).map_err(|e| e.to_string())? + "\n";
+    std::fs::write(tmp.join("manifest.json"), json).map_err(|e| format!("manifest.json: {e}"))?;
+    if dir.exists() {
+        std::fs::remove_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    std::fs::rename(&tmp, dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    Ok(dir.to_path_buf())
+}
+
+/// Reads a set back, checks every file's hash, re-runs the model on every input row and
+/// compares every expected and stage row bit for bit. Returns the number of vectors checked.
+pub fn check_set(dir: &Path) -> Result<usize, String> {
+    let text = std::fs::read_to_string(dir.join("manifest.json"))
+        .map_err(|e| format!("{}: {e}", dir.join("manifest.json").display()))?;
+    let m: Manifest = serde_json::from_str(&text).map_err(|e| format!("manifest.json: {e}"))?;
+    if m.schema != manifest::SCHEMA {
+        return Err(format!("manifest schema {} is not {}", m.schema, manifest::SCHEMA));
+    }
+    let any: AnyFormat = m.format.parse()?;
+    let mut contents = Vec::new();
+    for fm in &m.files {
+        let c = std::fs::read_to_string(dir.join(&fm.name)).map_err(|e| format!("{}: {e}", fm.name))?;
+        if sha256_hex(c.as_bytes()) != fm.sha256 {
+            return Err(format!("{}: sha256 differs from the manifest", fm.name));
+        }
+        let rows: Vec<Vec<u64>> = c
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                unpack(l, &fm.fields.iter().map(|x| x.width).collect::<Vec<_>>())
+                    .map_err(|e| format!("{} line {}: {e}", fm.name, i + 1))
+            })
+            .collect::<Result<_, _>>()?;
+        if rows.len() != fm.rows {
+            return Err(format!("{}: {} rows, manifest says {}", fm.name, rows.len(), fm.rows));
+        }
+        contents.push(rows);
+    }
+    let unit: Unit = m.unit.parse()?;
+    with_format!(any, |f| {
+        let n = contents[0].len();
+        for (i, input) in contents[0].iter().enumerate() {
+            let (class, bits) = (input[0], &input[1..]);
+            let want: Vec<Vec<u64>> = match unit {
+                Unit::Rti => {
+                    let rti = Rti::new(f, rti_config_from(&m)?);
+                    rti_rows(&rti, class, bits)[1..].to_vec()
+                }
+                Unit::Slab => {
+                    let sc = SlabConfig::named(m.options.get("variant").map_or("plain", |s| s.as_str()))?;
+                    slab_rows(&Slab::new(f, sc), class, bits)[1..].to_vec()
+                }
+                Unit::Op => {
+                    let (res, cmp) = op_eval(&f, bits[0], f.from_bits(bits[1]), f.from_bits(bits[2]));
+                    vec![vec![res, cmp]]
+                }
+            };
+            for (k, w) in want.iter().enumerate() {
+                if &contents[k + 1][i] != w {
+                    let fm = &m.files[k + 1];
+                    let bad = fm
+                        .fields
+                        .iter()
+                        .zip(w.iter().zip(&contents[k + 1][i]))
+                        .find(|(_, (a, b))| a != b)
+                        .map(|(x, _)| x.name.clone());
+                    return Err(format!(
+                        "{} line {}: field {} differs from the model",
+                        fm.name,
+                        i + 1,
+                        bad.unwrap_or_default()
+                    ));
+                }
+            }
+        }
+        Ok(n)
+    })
+}
+
+fn rti_config_from(m: &Manifest) -> Result<RtiConfig, String> {
+    use datapath::rti::{Cull, TieRule};
+    let cull = match m.options.get("cull").map(String::as_str) {
+        Some("Backface") => Cull::Backface,
+        _ => Cull::TwoSided,
+    };
+    let tie = match m.options.get("tie").map(String::as_str) {
+        Some("Last") => TieRule::Last,
+        _ => TieRule::First,
+    };
+    let det_threshold = m
+        .options
+        .get("det_threshold")
+        .and_then(|s| s.split_whitespace().next())
+        .and_then(|s| s.parse().ok())
+        .ok_or("manifest has no det_threshold")?;
+    Ok(RtiConfig { cull, det_threshold, tie })
+}

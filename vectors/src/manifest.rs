@@ -1,0 +1,126 @@
+//! `manifest.json`: what every file, field and bit of a vector set means.
+
+use serde::{Deserialize, Serialize};
+
+/// Manifest schema version.
+pub const SCHEMA: u32 = 1;
+
+/// How a field's bits are interpreted.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Kind {
+    /// Unsigned integer.
+    Uint,
+    /// One control bit.
+    Flag,
+    /// IEEE-754-like float: 1 sign, `exp` exponent, `man` fraction bits.
+    Ieee {
+        /// Exponent bits.
+        exp: u32,
+        /// Fraction bits.
+        man: u32,
+    },
+    /// Signed two's-complement fixed point.
+    Fixed {
+        /// Integer bits, sign included.
+        int: u32,
+        /// Fraction bits.
+        frac: u32,
+    },
+}
+
+/// One field of a row.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Field {
+    /// Signal name.
+    pub name: String,
+    /// "in" (drive the DUT) or "out" (compare).
+    pub dir: String,
+    /// Interpretation.
+    pub kind: Kind,
+    /// Width in bits.
+    pub width: u32,
+    /// Bit offset of the field's LSB within the row (row bit 0 = the last hex digit's LSB).
+    pub lsb: u32,
+    /// Pipeline stage that produces it (outputs and stage signals).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub stage: Option<u8>,
+}
+
+/// One data file.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct File {
+    /// File name within the set.
+    pub name: String,
+    /// What it holds.
+    pub role: String,
+    /// Rows (vectors).
+    pub rows: usize,
+    /// Bits per row.
+    pub width: u32,
+    /// Hex digits per row: ceil(width / 4), zero-padded at the top.
+    pub digits: u32,
+    /// Fields, most significant first.
+    pub fields: Vec<Field>,
+    /// SHA-256 of the file's bytes.
+    pub sha256: String,
+}
+
+/// One coverage class.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Class {
+    /// Id (the `class` field of every input row).
+    pub id: u32,
+    /// Name.
+    pub name: String,
+    /// What it covers.
+    pub covers: String,
+    /// Vectors in the set.
+    pub count: usize,
+}
+
+/// One stage-table row.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Stage {
+    /// Stage number.
+    pub stage: u8,
+    /// Signal.
+    pub name: String,
+    /// Operation.
+    pub op: String,
+}
+
+/// The manifest.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// Schema version.
+    pub schema: u32,
+    /// raypipe version.
+    pub raypipe_version: String,
+    /// Git commit of the generator, when known.
+    pub git: String,
+    /// The command that wrote the set.
+    pub command: String,
+    /// Seed of every random stream.
+    pub seed: u64,
+    /// Unit: rti, slab or op.
+    pub unit: String,
+    /// Coverage level.
+    pub level: u32,
+    /// Format name (parseable by raypipe).
+    pub format: String,
+    /// The format's rounding, flush, NaN, overflow, division and compare rules.
+    pub contract: std::collections::BTreeMap<String, String>,
+    /// Unit options (culling, thresholds, tie rule, slab variant, op codes).
+    pub options: std::collections::BTreeMap<String, String>,
+    /// Pipeline latency in cycles at one stage per cycle.
+    pub latency: u32,
+    /// The stage table.
+    pub stages: Vec<Stage>,
+    /// Acceptable values: every output is exact (one value) — no faithful operation is modelled.
+    pub acceptable_values: String,
+    /// Data files.
+    pub files: Vec<File>,
+    /// Coverage classes with counts.
+    pub classes: Vec<Class>,
+}
