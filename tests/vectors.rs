@@ -144,3 +144,30 @@ fn bad_requests_are_clear_errors() {
     assert_eq!(partials, 0);
     assert!(check_set(&d).is_ok());
 }
+
+#[test]
+fn hdl_packages_match_the_manifest() {
+    let set = generate(&req(Unit::Slab, "e8m16", 2)).unwrap();
+    let sv = vectors::hdl::sv_package(&set.manifest);
+    let vhd = vectors::hdl::vhdl_package(&set.manifest);
+    assert!(sv.contains("package raypipe_slab_pkg;") && sv.contains("localparam int LATENCY = 7;"));
+    assert!(sv.contains("localparam int SLAB_INPUTS_W = 358;")); // 8 + 14 x 25
+    assert!(sv.contains("logic [7:0] class_id;") && sv.contains("logic [24:0] t_near;"));
+    assert!(vhd.contains("r.class_id := row(357 downto 350);"), "{vhd}");
+    assert!(vhd.contains("r.maxz := row(24 downto 0);"));
+    // every field appears in both packages with its width
+    for f in &set.manifest.files {
+        for fld in &f.fields {
+            let name = if fld.name == "class" { "class_id" } else { fld.name.as_str() };
+            assert!(sv.contains(&format!("logic [{}:0] {name};", fld.width - 1)), "{name}");
+            assert!(
+                vhd.contains(&format!("r.{name} := row({} downto {});", fld.lsb + fld.width - 1, fld.lsb)),
+                "{name}"
+            );
+        }
+    }
+    let dir = tmp("pkgs");
+    write_set(&set, &dir).unwrap();
+    assert_eq!(std::fs::read_to_string(dir.join("raypipe_pkg.sv")).unwrap(), sv);
+    assert!(dir.join("raypipe_pkg.vhd").is_file());
+}

@@ -676,6 +676,10 @@ pub fn write_set(set: &VectorSet, dir: &Path) -> Result<PathBuf, String> {
             m.sha256 = sha256_hex(content.as_bytes());
         }
     }
+    std::fs::write(tmp.join("raypipe_pkg.sv"), crate::hdl::sv_package(&manifest))
+        .map_err(|e| format!("raypipe_pkg.sv: {e}"))?;
+    std::fs::write(tmp.join("raypipe_pkg.vhd"), crate::hdl::vhdl_package(&manifest))
+        .map_err(|e| format!("raypipe_pkg.vhd: {e}"))?;
     let json = serde_json::to_string_pretty(&manifest).map_err(|e| e.to_string())? + "\n";
     std::fs::write(tmp.join("manifest.json"), json).map_err(|e| format!("manifest.json: {e}"))?;
     if dir.exists() {

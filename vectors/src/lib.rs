@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 
 pub mod gen;
+pub mod hdl;
 pub mod manifest;
 pub mod pack;
 
