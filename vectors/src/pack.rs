@@ -72,11 +72,11 @@ mod tests {
         let f = [Bits { value: 0x5, width: 3 }, Bits { value: 0x1ffffff, width: 25 }, Bits { value: 1, width: 1 }];
         let h = pack(&f);
         assert_eq!(h.len(), 8); // 29 bits -> 8 digits, 3 pad bits
-        assert_eq!(h, "bfffffff");
+        assert_eq!(h, "17ffffff");
         assert_eq!(unpack(&h, &[3, 25, 1]).unwrap(), vec![5, 0x1ffffff, 1]);
         assert!(unpack("ffffffff", &[3, 25, 1]).is_err(), "padding must be zero");
-        assert!(unpack("bffffff", &[3, 25, 1]).is_err());
-        assert!(unpack("bfffffxf", &[3, 25, 1]).is_err());
+        assert!(unpack("17fffff", &[3, 25, 1]).is_err());
+        assert!(unpack("17ffffxf", &[3, 25, 1]).is_err());
         assert_eq!(pack(&[Bits { value: 0x3c00, width: 16 }]), "3c00");
     }
 }
