@@ -496,3 +496,60 @@ fn check_slab_table<F: Format>(f: F, name: &str, v: &str, r: &mut SplitMix64) {
     assert_eq!(flag("hit"), f.le(nw, fw));
     assert_eq!((out.hit, bits(out.t_near), bits(out.t_far)), (flag("hit"), bits(nw), bits(fw)));
 }
+
+/// Fixed point, plain variant: every disagreement with the exact decision (on the stored box)
+/// lies within the derived band, or has a saturated reciprocal (|d| below 1/max, where 1 ⊘ d
+/// saturates: the known hazard the directed variant removes). Band: the plane differences are
+/// exact, 1 ⊘ d is off by at most one step s, the product by at most s more, so each axis's t is
+/// within E = |b − o|·s + s of exact and a disagreement needs |t_far − t_near| <= 2·E_max.
+#[test]
+fn fixed_plain_disagreements_lie_within_the_derived_band() {
+    for name in ["q8.24:divide", "q16.16:nearest+divide", "q12.20:divide"] {
+        with_format!(fmt(name), |f| {
+            let s = Slab::new(f, cfg(SlabNan::Ignore, DirPrep::Plain, 0));
+            let step = f.ulp(0.0);
+            let max = f.error_model().max;
+            let mut r = SplitMix64::new(0x51ab_0007);
+            let (mut n, mut wrong, mut saturated) = (0, 0, 0);
+            for _ in 0..20_000 {
+                let (o, d, tmax, lo, hi) = random_case(&mut r);
+                let q = |x: f64| f.to_f64(f.from_f64(x));
+                let (oq, dq) = (o.map(q), d.map(q));
+                if o.iter().chain(d.iter()).any(|x| x.abs() >= max / 2.0) {
+                    continue; // the ray does not fit the format
+                }
+                let Ok(b) = s.store_box(lo, hi) else { continue };
+                let (bl, bh) = (b.min.map(|v| f.to_f64(v)), b.max.map(|v| f.to_f64(v)));
+                // products beyond the range saturate: outside the model of the band
+                let big = (0..3).any(|a| {
+                    dq[a] != 0.0 && ((bl[a] - oq[a]) / dq[a]).abs().max(((bh[a] - oq[a]) / dq[a]).abs()) >= max / 2.0
+                });
+                if big {
+                    continue;
+                }
+                let tq = q(tmax);
+                let exact = slab_exact(oq, dq, 0.0, tq, bl, bh);
+                let hit = s.test(&s.prepare(o, d, 0.0, tmax), &b).hit;
+                n += 1;
+                if hit == exact {
+                    continue;
+                }
+                wrong += 1;
+                if dq.iter().any(|&x| x == 0.0 || 1.0 / x.abs() >= max) {
+                    saturated += 1;
+                    continue;
+                }
+                let e =
+                    (0..3).map(|a| (bl[a] - oq[a]).abs().max((bh[a] - oq[a]).abs()) * step + step).fold(0.0, f64::max);
+                let g = golden::slab_f64(oq, dq, 0.0, tq, bl, bh);
+                assert!(
+                    (g.t_far - g.t_near).abs() <= 2.0 * e,
+                    "{name}: disagreement outside the band: gap {} > 2·{e}; o {o:?} d {d:?} box {lo:?}..{hi:?}",
+                    (g.t_far - g.t_near).abs()
+                );
+            }
+            assert!(n > 10_000, "{name}: too few cases ({n})");
+            eprintln!("{name}: {n} cases, {wrong} disagreements, {saturated} with a saturated reciprocal");
+        });
+    }
+}
