@@ -254,12 +254,27 @@ fn parse_list(what: &str, s: &str, n: usize) -> Result<Vec<f64>, String> {
     Ok(v)
 }
 
+/// Prints `value` as JSON, or the text `render` gives.
+fn emit<T: serde::Serialize>(json: bool, value: &T, render: impl FnOnce(&T) -> String) -> Result<(), String> {
+    if json {
+        println!("{}", serde_json::to_string_pretty(value).map_err(|e| e.to_string())?);
+    } else {
+        print!("{}", render(value));
+    }
+    Ok(())
+}
+
+/// The OBJ scene at `path`, or the built-in scene.
+fn load_scene(path: Option<&std::path::Path>) -> Result<Scene, String> {
+    match path {
+        Some(p) => Scene::load_obj(p).map_err(|e| e.to_string()),
+        None => Ok(Scene::builtin()),
+    }
+}
+
 fn run_verify(a: VerifyArgs) -> Result<bool, String> {
     let rti = a.rti.config()?;
-    let scene = match &a.scene {
-        Some(p) => Scene::load_obj(p).map_err(|e| e.to_string())?,
-        None => Scene::builtin(),
-    };
+    let scene = load_scene(a.scene.as_deref())?;
     let formats = if a.format.is_empty() {
         DEFAULT_FORMATS.iter().map(|f| f.parse().expect("built-in format name")).collect()
     } else {
@@ -267,11 +282,7 @@ fn run_verify(a: VerifyArgs) -> Result<bool, String> {
     };
     let cfg = VerifyConfig { formats, rays: a.rays as usize, seed: a.seed, rti, sample: a.sample as usize };
     let rep = verify(&cfg, &scene);
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&rep).map_err(|e| e.to_string())?);
-    } else {
-        print!("{}", render(&rep));
-    }
+    emit(a.json, &rep, render)?;
     Ok(rep.passed)
 }
 
@@ -329,10 +340,7 @@ fn run() -> Result<bool, String> {
             Ok(true)
         }
         Some(Cmd::Traverse { scene, format, variant, rays, seed, n, leaf_size, levels, json }) => {
-            let scene = match &scene {
-                Some(p) => Scene::load_obj(p).map_err(|e| e.to_string())?,
-                None => Scene::builtin(),
-            };
+            let scene = load_scene(scene.as_deref())?;
             let cfg = raypipe::traverse::TraverseConfig {
                 formats: format,
                 variant,
@@ -343,24 +351,13 @@ fn run() -> Result<bool, String> {
                 levels: levels as usize,
             };
             let rep = raypipe::traverse::traverse(&cfg, &scene)?;
-            if json {
-                println!("{}", serde_json::to_string_pretty(&rep).map_err(|e| e.to_string())?);
-            } else {
-                print!("{}", raypipe::traverse::render(&rep));
-            }
+            emit(json, &rep, raypipe::traverse::render)?;
             Ok(rep.passed)
         }
         Some(Cmd::Stats { scene, rays, seed, leaf_sizes, svg, json }) => {
-            let scene = match &scene {
-                Some(p) => Scene::load_obj(p).map_err(|e| e.to_string())?,
-                None => Scene::builtin(),
-            };
+            let scene = load_scene(scene.as_deref())?;
             let rep = raypipe::stats::stats(&scene, &leaf_sizes, rays as usize, seed)?;
-            if json {
-                println!("{}", serde_json::to_string_pretty(&rep).map_err(|e| e.to_string())?);
-            } else {
-                print!("{}", raypipe::stats::render(&rep));
-            }
+            emit(json, &rep, raypipe::stats::render)?;
             if let Some(dir) = svg {
                 for p in raypipe::stats::write_svgs(&rep, &dir)? {
                     eprintln!("wrote {}", p.display());
@@ -369,20 +366,15 @@ fn run() -> Result<bool, String> {
             Ok(true)
         }
         Some(Cmd::Render { scene, format, variant, width, height, leaf_size, out, json }) => {
-            let scene = match &scene {
-                Some(p) => Scene::load_obj(p).map_err(|e| e.to_string())?,
-                None => Scene::builtin(),
-            };
+            let scene = load_scene(scene.as_deref())?;
             let rep =
                 with_format!(format, |f| raypipe::render::render(f, &variant, &scene, width, height, leaf_size, &out))?;
-            if json {
-                println!("{}", serde_json::to_string_pretty(&rep).map_err(|e| e.to_string())?);
-            } else {
-                println!(
+            emit(json, &rep, |rep| {
+                format!(
                     "raypipe render: scene {}, format {}, slab variant {}: {} pixels, golden hits {}, holes (golden hit, pipeline miss) {}, false hits {}, other triangle {}; wrote {}/render.png and {}/diff.png (red: hole, blue: false hit, yellow: other triangle)",
                     scene.name, rep.format, rep.variant, rep.pixels, rep.golden_hits, rep.holes, rep.false_hits, rep.other_triangle, out.display(), out.display()
-                );
-            }
+                ) + "\n"
+            })?;
             Ok(true)
         }
         Some(Cmd::Vectors { unit, format, out, count, seed, level, variant, check, rti }) => {

@@ -218,6 +218,32 @@ fn enter<B>(t: &HwTree<B>, n: usize, test: &mut impl FnMut(&B) -> Option<f64>, r
     true
 }
 
+/// One pass from the root: at each level the pair of children is tested and `choose(level,
+/// left entry, right entry)` picks the side to follow (`None` ends the pass at a dead end); a
+/// leaf reached is emitted. Returns the level where the pass ended.
+fn pass<B>(
+    t: &HwTree<B>,
+    test: &mut impl FnMut(&B) -> Option<f64>,
+    box_tests: &mut u64,
+    leaves: &mut Vec<u32>,
+    mut choose: impl FnMut(usize, Option<f64>, Option<f64>) -> Option<usize>,
+) -> usize {
+    let mut idx = t.root_addr;
+    let mut level = 0;
+    loop {
+        *box_tests += 2;
+        let (el, er) = test_pair(t, level, idx, test);
+        let Some(side) = choose(level, el, er) else { return level };
+        let a = addr_of(t, level, idx, side);
+        if a & LEAF_FLAG != 0 {
+            leaves.push(a & !LEAF_FLAG);
+            return level;
+        }
+        idx = a;
+        level += 1;
+    }
+}
+
 /// Tests the pair at `level`/`idx`: (left hit entry, right hit entry).
 fn test_pair<B>(
     t: &HwTree<B>,
@@ -273,12 +299,8 @@ pub fn history_traverse<B>(t: &HwTree<B>, n: usize, mut test: impl FnMut(&B) -> 
         if let (Some(end), Some(k)) = (prev_end, resume) {
             r.back_distances.push((end - k) as u32);
         }
-        let mut idx = t.root_addr;
-        let mut level = 0;
-        let end = loop {
-            r.box_tests += 2;
-            let (el, er) = test_pair(t, level, idx, &mut test);
-            let side = match (h[level], el, er) {
+        let end = pass(t, &mut test, &mut r.box_tests, &mut r.leaves, |level, el, er| {
+            match (h[level], el, er) {
                 (hist::NEW, Some(a), Some(b)) => {
                     h[level] = hist::SPLIT;
                     Some(near_far(a, b).0)
@@ -301,16 +323,8 @@ pub fn history_traverse<B>(t: &HwTree<B>, n: usize, mut test: impl FnMut(&B) -> 
                 // NEW with no hit: dead end. Other combinations cannot occur with a
                 // deterministic tester; they end the pass as a dead end too.
                 _ => None,
-            };
-            let Some(side) = side else { break level };
-            let a = addr_of(t, level, idx, side);
-            if a & LEAF_FLAG != 0 {
-                r.leaves.push(a & !LEAF_FLAG);
-                break level;
             }
-            idx = a;
-            level += 1;
-        };
+        });
         prev_end = Some(end);
         if r.leaves.len() == n || !h.contains(&hist::SPLIT) {
             break;
@@ -331,38 +345,24 @@ pub fn trail_traverse<B>(t: &HwTree<B>, n: usize, mut test: impl FnMut(&B) -> Op
     let trail = &mut r.state;
     loop {
         r.passes += 1;
-        let mut idx = t.root_addr;
-        let mut level = 0;
-        let end = loop {
-            r.box_tests += 2;
-            let (el, er) = test_pair(t, level, idx, &mut test);
-            let side = match (el, er) {
-                (Some(a), Some(b)) => {
-                    let (near, far) = near_far(a, b);
-                    Some(if trail[level] == 0 { near } else { far })
-                }
-                (Some(_), None) => {
-                    trail[level] = 1;
-                    Some(0)
-                }
-                (None, Some(_)) => {
-                    trail[level] = 1;
-                    Some(1)
-                }
-                (None, None) => {
-                    trail[level] = 1;
-                    None
-                }
-            };
-            let Some(side) = side else { break level };
-            let a = addr_of(t, level, idx, side);
-            if a & LEAF_FLAG != 0 {
-                r.leaves.push(a & !LEAF_FLAG);
-                break level;
+        let end = pass(t, &mut test, &mut r.box_tests, &mut r.leaves, |level, el, er| match (el, er) {
+            (Some(a), Some(b)) => {
+                let (near, far) = near_far(a, b);
+                Some(if trail[level] == 0 { near } else { far })
             }
-            idx = a;
-            level += 1;
-        };
+            (Some(_), None) => {
+                trail[level] = 1;
+                Some(0)
+            }
+            (None, Some(_)) => {
+                trail[level] = 1;
+                Some(1)
+            }
+            (None, None) => {
+                trail[level] = 1;
+                None
+            }
+        });
         if r.leaves.len() == n {
             break;
         }
