@@ -298,6 +298,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
     let k = kind_of(&f);
     let mut r = SplitMix64::new(req.seed);
     let mut options = BTreeMap::new();
+    let mut params = format_params(&f);
     let (classes, latency, stages): (&[(&str, &str)], u32, Vec<Stage>);
     let unit = req.unit.name();
     let mut files: Vec<Rows> = Vec::new();
@@ -317,6 +318,9 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                 format!("{:?} (as the format rounds it: {})", req.rti.det_threshold, f.hex(rti.det_thr)),
             );
             options.insert("tie".into(), format!("{:?}", req.rti.tie));
+            params.insert("cull_backface".into(), (req.rti.cull == datapath::rti::Cull::Backface) as u64);
+            params.insert("det_thr".into(), f.to_bits(rti.det_thr));
+            params.insert("tie_last".into(), (req.rti.tie == datapath::rti::TieRule::Last) as u64);
             let table = stage_table(f.div_mode());
             classes = &RTI_CLASSES;
             latency = stage_count(f.div_mode()) as u32;
@@ -395,6 +399,13 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             let slab = Slab::new(f, sc);
             options.insert("variant".into(), req.slab_variant.clone());
             options.insert("config".into(), format!("{sc:?}"));
+            params.insert("slab_take_on_false".into(), (sc.nan == datapath::slab::SlabNan::TakeOnFalse) as u64);
+            params.insert("slab_embree".into(), (sc.prep == datapath::slab::DirPrep::Embree) as u64);
+            params.insert("slab_delta".into(), f.to_bits(slab.delta()));
+            params.insert(
+                "slab_widen_ulps".into(),
+                u64::try_from(sc.widen_ulps).map_err(|_| "vectors support only non-negative widening")?,
+            );
             classes = &SLAB_CLASSES;
             latency = 7;
             stages = SLAB_TABLE
@@ -516,6 +527,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
         format: f.name(),
         contract: contract_map(&f),
         options,
+        params,
         latency,
         stages,
         acceptable_values: "exact: every operation is correctly rounded per the contract, so each output has exactly one acceptable value".into(),
@@ -530,6 +542,28 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
         classes: classes.iter().enumerate().map(|(i, (n, c))| Class { id: i as u32, name: n.to_string(), covers: c.to_string(), count: counts[i] }).collect(),
     };
     Ok(VectorSet { manifest, files: files.into_iter().map(|fr| (fr.name, fr.lines.join("\n") + "\n")).collect() })
+}
+
+/// The format's contract as integers.
+fn format_params<F: Format>(f: &F) -> BTreeMap<String, u64> {
+    let mut p = BTreeMap::new();
+    match f.kind() {
+        FormatKind::Float(l) => {
+            p.insert("float".into(), 1);
+            p.insert("exp".into(), l.exp_bits as u64);
+            p.insert("man".into(), l.man_bits as u64);
+        }
+        FormatKind::Fixed { int_bits, frac_bits } => {
+            p.insert("float".into(), 0);
+            p.insert("fx_int".into(), int_bits as u64);
+            p.insert("fx_frac".into(), frac_bits as u64);
+        }
+    }
+    p.insert("width".into(), f.width() as u64);
+    p.insert("ftz".into(), f.flushes() as u64);
+    p.insert("nan_propagate".into(), f.nan_propagates() as u64);
+    p.insert("recip_mul".into(), (f.div_mode() == datapath::format::DivMode::RecipMul) as u64);
+    p
 }
 
 fn op_text(op: Op, a: &str, b: &str, note: &str) -> String {

@@ -50,6 +50,47 @@ pub fn sv_package(m: &Manifest) -> String {
         }
         s += &format!("  }} {};\n", type_name(&f.name));
     }
+    s += "endpackage\n\n";
+    s + &sv_set_package(m)
+}
+
+/// `raypipe_set_pkg`: the unit-independent view the kit's testbench and DUTs import: row
+/// widths, file names, vector count, latency, the contract parameters (`manifest.params`,
+/// upper-cased) and functions naming the first output / stage field that differs.
+fn sv_set_package(m: &crate::manifest::Manifest) -> String {
+    let mut s = String::from("// Unit-independent parameters of this set for the HDL kit (hdl/sv/raypipe_tb.sv).\n");
+    if m.params.get("recip_mul") == Some(&1) {
+        s += "// the division is a x (1 / b): the rti stage table has inv_det\n`define RAYPIPE_RECIP_MUL\n";
+    }
+    s += "package raypipe_set_pkg;\n";
+    s += &format!("  localparam UNIT = \"{}\";\n  localparam int LATENCY = {};\n", m.unit, m.latency);
+    let n = m.files.first().map_or(0, |f| f.rows);
+    s += &format!("  localparam int N = {n};\n");
+    let get = |i: usize| m.files.get(i);
+    for (i, tag) in ["IN", "OUT", "STG"].iter().enumerate() {
+        let (w, name) = get(i).map_or((1, String::new()), |f| (f.width, f.name.clone()));
+        s += &format!("  localparam int {tag}_W = {w};\n  localparam {tag}_FILE = \"{name}\";\n");
+    }
+    s += &format!("  localparam bit HAS_STAGES = {};\n", u8::from(m.files.len() > 2));
+    for (k, v) in &m.params {
+        s += &format!("  localparam logic [63:0] {} = 64'h{v:x};\n", k.to_uppercase());
+    }
+    for (i, fname) in [(1, "diff_out"), (2, "diff_stg")] {
+        let w = get(i).map_or(1, |f| f.width);
+        s += &format!(
+            "  // The first field (in file order: earliest stage first) where got and want differ, or \"none\".\n  function automatic string {fname}(logic [{}:0] got, logic [{}:0] want);\n",
+            w - 1,
+            w - 1
+        );
+        if let Some(f) = get(i) {
+            for fld in &f.fields {
+                let (hi, lo) = (fld.lsb + fld.width - 1, fld.lsb);
+                let at = fld.stage.map_or(String::new(), |k| format!(" (stage {k})"));
+                s += &format!("    if (got[{hi}:{lo}] !== want[{hi}:{lo}]) return \"{}{at}\";\n", fld.name);
+            }
+        }
+        s += "    return \"none\";\n  endfunction\n";
+    }
     s += "endpackage\n";
     s
 }

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Manifest schema version.
-pub const SCHEMA: u32 = 1;
+pub const SCHEMA: u32 = 2;
 
 /// How a field's bits are interpreted.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -113,6 +113,11 @@ pub struct Manifest {
     pub contract: std::collections::BTreeMap<String, String>,
     /// Unit options (culling, thresholds, tie rule, slab variant, op codes).
     pub options: std::collections::BTreeMap<String, String>,
+    /// The contract and unit options as integers (the generated HDL packages' localparams):
+    /// `float`, `exp`, `man` or `fx_int`, `fx_frac`; `ftz`, `nan_propagate`, `recip_mul`;
+    /// rti `cull_backface`, `det_thr` (bits), `tie_last`; slab `slab_take_on_false`,
+    /// `slab_embree`, `slab_delta` (bits), `slab_widen_ulps`.
+    pub params: std::collections::BTreeMap<String, u64>,
     /// Pipeline latency in cycles at one stage per cycle.
     pub latency: u32,
     /// The stage table.

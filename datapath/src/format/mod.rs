@@ -165,6 +165,10 @@ pub trait Format: Copy + Debug + Send + Sync + 'static {
     fn flushes(&self) -> bool {
         false
     }
+    /// A NaN result carries the first NaN operand's payload (quieted) instead of the canonical NaN.
+    fn nan_propagates(&self) -> bool {
+        false
+    }
     /// Out-of-range results wrap around (fixed point `wrap`) instead of saturating or overflowing to ∞.
     fn wraps(&self) -> bool {
         false
@@ -394,6 +398,9 @@ impl<B: IeeeBackend> Format for Ieee<B> {
     }
     fn flushes(&self) -> bool {
         self.opts.subnormals == Subnormals::Ftz
+    }
+    fn nan_propagates(&self) -> bool {
+        self.opts.nan == NanMode::Propagate
     }
     #[inline(always)]
     fn sign_bit(&self, v: B::V) -> bool {

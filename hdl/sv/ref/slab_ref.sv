@@ -1,0 +1,160 @@
+// Reference DUT of the `slab` ray-box unit (raypipe HDL kit): a real pipeline, one register
+// per stage of raypipe's slab stage table (stage 0: direction conversion, preparation and
+// the three reciprocals; 1: six subtracts; 2: six multiplies; 3: near/far by the sign of
+// 1/d; 4: the compare-select chains from tmin/tmax in axis order x, y, z; 5: widening by
+// SLAB_WIDEN_ULPS grid steps; 6: hit = near_w <= far_w). Latency 7.
+// Every stage signal is carried to the end of the pipeline and presented on stg_row.
+// Define RAYPIPE_INJECT_FAULT to make the tlox multiplier truncate instead of rounding to
+// nearest (the kit's negative check: the testbench must fail, naming stage signal tlox).
+module raypipe_slab_ref
+  import raypipe_fp::*;
+  import raypipe_set_pkg::*;
+  import raypipe_slab_pkg::*;
+(
+  input  logic             clk,
+  input  logic             rst_n,
+  input  logic             in_valid,
+  input  logic [IN_W-1:0]  in_row,
+  output logic             out_valid,
+  output logic [OUT_W-1:0] out_row,
+  output logic [STG_W-1:0] stg_row
+);
+  localparam logic [$bits(fmt_t)-1:0] F = {EXP[7:0], MAN[7:0], FTZ[0], NAN_PROPAGATE[0]};  // an fmt_t
+  localparam int L = raypipe_set_pkg::LATENCY;
+
+  typedef struct packed {
+    slab_inputs_t i;
+    slab_stages_t s;
+  } state_t;
+
+  // The ray's input conversion: a NaN becomes the canonical NaN, under FTZ a subnormal zero.
+  function automatic word_t conv(word_t a);
+    if (is_nan(F, a)) return canonical_nan(F);
+    return rd(F, a);
+  endfunction
+
+  // Embree's preparation: |d| < delta becomes +-delta by the sign bit of d.
+  function automatic word_t prep(word_t d);
+    if (!SLAB_EMBREE[0] || !flt(F, fabs(F, d), SLAB_DELTA)) return d;
+    return sign_of(F, d) ? fsub(F, zero_of(F, 1'b0), SLAB_DELTA) : SLAB_DELTA;
+  endfunction
+
+  function automatic word_t near_sel(word_t acc, word_t x);
+    if (SLAB_TAKE_ON_FALSE[0]) return fle(F, x, acc) ? acc : x;
+    return flt(F, acc, x) ? x : acc;
+  endfunction
+
+  function automatic word_t far_sel(word_t acc, word_t x);
+    if (SLAB_TAKE_ON_FALSE[0]) return fle(F, acc, x) ? acc : x;
+    return flt(F, x, acc) ? x : acc;
+  endfunction
+
+  // the tlox multiplier: the negative check's injected fault goes here
+  function automatic word_t mul_tlox(word_t a, word_t b);
+`ifdef RAYPIPE_INJECT_FAULT
+    return fmul_faulty(F, a, b);
+`else
+    return fmul(F, a, b);
+`endif
+  endfunction
+
+  // Table stage k - 1 applied to the state registered by stage k - 1.
+  function automatic state_t stage(int k, state_t x);
+    state_t y = x;
+    word_t n, f;
+    case (k - 1)
+      0: begin
+        y.s.dx = conv(x.i.dx);
+        y.s.dy = conv(x.i.dy);
+        y.s.dz = conv(x.i.dz);
+        y.i.ox = conv(x.i.ox);
+        y.i.oy = conv(x.i.oy);
+        y.i.oz = conv(x.i.oz);
+        y.i.tmin = conv(x.i.tmin);
+        y.i.tmax = conv(x.i.tmax);
+        y.s.pdx = prep(y.s.dx);
+        y.s.pdy = prep(y.s.dy);
+        y.s.pdz = prep(y.s.dz);
+        y.s.inv_dx = fdivide(F, RECIP_MUL[0], one_of(F), y.s.pdx);
+        y.s.inv_dy = fdivide(F, RECIP_MUL[0], one_of(F), y.s.pdy);
+        y.s.inv_dz = fdivide(F, RECIP_MUL[0], one_of(F), y.s.pdz);
+      end
+      1: begin
+        y.s.lox = fsub(F, x.i.minx, x.i.ox);
+        y.s.hix = fsub(F, x.i.maxx, x.i.ox);
+        y.s.loy = fsub(F, x.i.miny, x.i.oy);
+        y.s.hiy = fsub(F, x.i.maxy, x.i.oy);
+        y.s.loz = fsub(F, x.i.minz, x.i.oz);
+        y.s.hiz = fsub(F, x.i.maxz, x.i.oz);
+      end
+      2: begin
+        y.s.tlox = mul_tlox(x.s.lox, x.s.inv_dx);
+        y.s.thix = fmul(F, x.s.hix, x.s.inv_dx);
+        y.s.tloy = fmul(F, x.s.loy, x.s.inv_dy);
+        y.s.thiy = fmul(F, x.s.hiy, x.s.inv_dy);
+        y.s.tloz = fmul(F, x.s.loz, x.s.inv_dz);
+        y.s.thiz = fmul(F, x.s.hiz, x.s.inv_dz);
+      end
+      3: begin
+        y.s.negx = sign_of(F, x.s.inv_dx);
+        y.s.negy = sign_of(F, x.s.inv_dy);
+        y.s.negz = sign_of(F, x.s.inv_dz);
+        y.s.nearx = y.s.negx ? x.s.thix : x.s.tlox;
+        y.s.farx = y.s.negx ? x.s.tlox : x.s.thix;
+        y.s.neary = y.s.negy ? x.s.thiy : x.s.tloy;
+        y.s.fary = y.s.negy ? x.s.tloy : x.s.thiy;
+        y.s.nearz = y.s.negz ? x.s.thiz : x.s.tloz;
+        y.s.farz = y.s.negz ? x.s.tloz : x.s.thiz;
+      end
+      4: begin
+        y.s.tn_x = near_sel(x.i.tmin, x.s.nearx);
+        y.s.tn_xy = near_sel(y.s.tn_x, x.s.neary);
+        y.s.t_near = near_sel(y.s.tn_xy, x.s.nearz);
+        y.s.tf_x = far_sel(x.i.tmax, x.s.farx);
+        y.s.tf_xy = far_sel(y.s.tf_x, x.s.fary);
+        y.s.t_far = far_sel(y.s.tf_xy, x.s.farz);
+      end
+      5: begin
+        n = x.s.t_near;
+        f = x.s.t_far;
+        for (int j = 0; j < int'(SLAB_WIDEN_ULPS); j++) begin
+          n = next_down(F, n);
+          f = next_up(F, f);
+        end
+        y.s.near_w = n;
+        y.s.far_w = f;
+      end
+      default: y.s.hit = fle(F, x.s.near_w, x.s.far_w);
+    endcase
+    return y;
+  endfunction
+
+  // st[k] / v[k]: the state and valid bit after stage register k (0 = the input register);
+  // one always_ff per register (Verilator 5.006 has no delayed assignment to arrays in loops),
+  // and the last register a plain variable (Icarus 11 does not update continuous assigns from
+  // array words written by a generate loop)
+  state_t st [0:L-1];
+  logic v [0:L-1];
+  state_t last;
+  always_ff @(posedge clk) begin
+    v[0] <= rst_n & in_valid;
+    st[0] <= {in_row, {$bits(slab_stages_t){1'b0}}};
+  end
+  for (genvar k = 1; k < L; k++) begin : g_stage
+    always_ff @(posedge clk) begin
+      v[k] <= rst_n & v[k-1];
+      st[k] <= stage(k, st[k-1]);
+    end
+  end
+  always_ff @(posedge clk) begin
+    out_valid <= rst_n & v[L-1];
+    last <= stage(L, st[L-1]);
+  end
+
+  slab_expected_t o;
+  assign o.hit = last.s.hit;
+  assign o.t_near = last.s.near_w;
+  assign o.t_far = last.s.far_w;
+  assign out_row = o;
+  assign stg_row = last.s;
+endmodule
