@@ -95,8 +95,9 @@ fn sv_set_package(m: &crate::manifest::Manifest) -> String {
     s
 }
 
-/// The VHDL-2008 package `raypipe_<unit>_pkg`: a record per data file and a function that
-/// splits a row (`std_logic_vector(W-1 downto 0)`) into it.
+/// The VHDL-2008 package `raypipe_<unit>_pkg`: a record per data file, functions that split a
+/// row (`std_logic_vector(W-1 downto 0)`) into it and pack it again, the vector count and the
+/// contract parameters.
 pub fn vhdl_package(m: &Manifest) -> String {
     let pkg = format!("raypipe_{}_pkg", m.unit);
     let mut s = format!(
@@ -122,6 +123,33 @@ pub fn vhdl_package(m: &Manifest) -> String {
             body += &format!("    r.{} := row({} downto {});\n", ident(&fld.name), fld.lsb + fld.width - 1, fld.lsb);
         }
         body += "    return r;\n  end function;\n";
+        let diff = format!("first_diff_{t}");
+        s += &format!("  function {diff}(got, want : std_logic_vector({} downto 0)) return string;\n", f.width - 1);
+        body += &format!(
+            "  -- the first field (earliest stage first) where got and want differ, or \"none\"\n  function {diff}(got, want : std_logic_vector({} downto 0)) return string is\n  begin\n",
+            f.width - 1
+        );
+        for fld in &f.fields {
+            let at = fld.stage.map_or(String::new(), |k| format!(" (stage {k})"));
+            let (hi, lo) = (fld.lsb + fld.width - 1, fld.lsb);
+            body += &format!(
+                "    if got({hi} downto {lo}) /= want({hi} downto {lo}) then return \"{}{at}\"; end if;\n",
+                fld.name
+            );
+        }
+        body += "    return \"none\";\n  end function;\n";
+        let back = format!("from_{t}");
+        s += &format!("  function {back}(r : {t}) return std_logic_vector;\n");
+        let parts: Vec<String> = f.fields.iter().map(|fld| format!("r.{}", ident(&fld.name))).collect();
+        body += &format!(
+            "  function {back}(r : {t}) return std_logic_vector is\n  begin\n    return {};\n  end function;\n",
+            parts.join(" & ")
+        );
+    }
+    s += &format!("  constant N_VECTORS : natural := {};\n", m.files.first().map_or(0, |f| f.rows));
+    s += "  -- the contract and unit options (manifest.json \"params\"), as 64-bit words\n";
+    for (k, v) in &m.params {
+        s += &format!("  constant P_{} : std_logic_vector(63 downto 0) := x\"{v:016x}\";\n", k.to_uppercase());
     }
     s += &format!("end package {pkg};\n\n");
     body += &format!("end package body {pkg};\n");
