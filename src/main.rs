@@ -222,6 +222,18 @@ enum Cmd {
         /// Re-check an existing set against the models instead of writing one.
         #[arg(long)]
         check: Option<PathBuf>,
+        /// OBJ scene whose BVH the traverse unit uses (default: the built-in scene).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// First N leaves per ray (unit traverse, 1..=255).
+        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u64).range(1..=255))]
+        leaves: u64,
+        /// Triangles per leaf at most (unit traverse, 1..=255).
+        #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=255))]
+        leaf_size: u32,
+        /// Level pipelines the hardware has (unit traverse; the history holds 2 bits per level).
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
+        levels: u64,
         #[command(flatten)]
         rti: RtiArgs,
     },
@@ -377,15 +389,42 @@ fn run() -> Result<bool, String> {
             })?;
             Ok(true)
         }
-        Some(Cmd::Vectors { unit, format, out, count, seed, level, variant, check, rti }) => {
+        Some(Cmd::Vectors {
+            unit,
+            format,
+            out,
+            count,
+            seed,
+            level,
+            variant,
+            check,
+            scene,
+            leaves,
+            leaf_size,
+            levels,
+            rti,
+        }) => {
             if let Some(dir) = check {
                 let n = vectors::gen::check_set(&dir)?;
                 println!("{}: {n} vectors, every expected and stage row equals the model's bits", dir.display());
                 return Ok(true);
             }
             let out = out.ok_or("--out is required")?;
+            let unit: vectors::gen::Unit = unit.parse()?;
+            let tree = if unit == vectors::gen::Unit::Traverse {
+                let scene = load_scene(scene.as_deref())?;
+                let b = raypipe::bvh::build(&scene, leaf_size);
+                Some(vectors::traverse::TreeInput { name: scene.name.clone(), nodes: b.nodes, root: 0 })
+            } else if scene.is_some() {
+                return Err(format!("--scene is for unit traverse; unit {unit:?} draws its own cases"));
+            } else {
+                None
+            };
             let req = vectors::gen::Request {
-                unit: unit.parse()?,
+                unit,
+                tree,
+                leaves: leaves as usize,
+                max_levels: levels as usize,
                 format,
                 count: count as usize,
                 seed,

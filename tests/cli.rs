@@ -301,3 +301,33 @@ fn render_writes_the_image_and_the_diff() {
         "unknown slab variant",
     );
 }
+
+#[test]
+fn vectors_traverse_takes_a_scene_and_refuses_what_it_cannot_use() {
+    let obj = temp_file("two.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 2 1 1\nf 1 2 3\nf 4 5 6\n");
+    let out = std::env::temp_dir().join(format!("raypipe-cli-{}-travset", std::process::id()));
+    let o = raypipe(
+        &["vectors", "--unit", "traverse", "--count", "2", "--scene", obj.to_str().unwrap(), "--out"]
+            .into_iter()
+            .chain([out.to_str().unwrap()])
+            .collect::<Vec<_>>(),
+    );
+    let (stdout, err) = text(&o);
+    assert!(o.status.success(), "{stdout}\n{err}");
+    assert!(stdout.contains("unit traverse") && stdout.contains("primary 2"), "{stdout}");
+    let o = raypipe(&["vectors", "--check", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    // a scene for a unit that draws its own cases, a missing scene, a tree too deep
+    assert_clear_error(
+        &raypipe(&["vectors", "--unit", "rti", "--scene", obj.to_str().unwrap(), "--out", "/tmp/x"]),
+        "--scene is for unit traverse",
+    );
+    assert_clear_error(
+        &raypipe(&["vectors", "--unit", "traverse", "--scene", "/nonexistent.obj", "--out", "/tmp/x"]),
+        "nonexistent",
+    );
+    assert_clear_error(
+        &raypipe(&["vectors", "--unit", "traverse", "--levels", "1", "--out", "/tmp/x"]),
+        "level pipelines",
+    );
+}

@@ -4,6 +4,7 @@
 use datapath::rti::RtiConfig;
 use std::path::PathBuf;
 use vectors::gen::{check_set, generate, write_set, Request, Unit};
+use vectors::traverse::TreeInput;
 
 fn req(unit: Unit, format: &str, count: usize) -> Request {
     Request {
@@ -15,7 +16,17 @@ fn req(unit: Unit, format: &str, count: usize) -> Request {
         command: "test".into(),
         rti: RtiConfig::default(),
         slab_variant: "conservative".into(),
+        tree: (unit == Unit::Traverse).then(builtin_tree),
+        leaves: 8,
+        max_levels: 64,
     }
+}
+
+/// The built-in scene's BVH (leaf size 4).
+fn builtin_tree() -> TreeInput {
+    let scene = raypipe::scene::Scene::builtin();
+    let b = raypipe::bvh::build(&scene, 4);
+    TreeInput { name: scene.name.clone(), nodes: b.nodes, root: 0 }
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -26,7 +37,7 @@ fn tmp(name: &str) -> PathBuf {
 
 #[test]
 fn every_unit_and_format_round_trips() {
-    for unit in [Unit::Rti, Unit::Slab, Unit::Op] {
+    for unit in [Unit::Rti, Unit::Slab, Unit::Op, Unit::Traverse] {
         for format in ["f32", "fp16", "bf16", "e8m16", "q8.24:divide", "fp16:ftz"] {
             let set = generate(&req(unit, format, 6)).unwrap();
             let dir = tmp(&format!("{unit:?}-{}", format.replace(':', "_")));
@@ -53,7 +64,7 @@ fn every_unit_and_format_round_trips() {
 
 #[test]
 fn the_same_request_writes_the_same_bytes() {
-    for unit in [Unit::Rti, Unit::Slab, Unit::Op] {
+    for unit in [Unit::Rti, Unit::Slab, Unit::Op, Unit::Traverse] {
         let a = generate(&req(unit, "fp16", 5)).unwrap();
         let b = generate(&req(unit, "fp16", 5)).unwrap();
         assert_eq!(a.files, b.files);
@@ -115,7 +126,11 @@ fn a_flipped_bit_is_caught() {
 
 #[test]
 fn bad_requests_are_clear_errors() {
-    assert!("traverse".parse::<Unit>().unwrap_err().contains("no vector writer yet"));
+    assert!(generate(&Request { tree: None, ..req(Unit::Traverse, "f32", 1) }).unwrap_err().contains("BVH"));
+    assert!(generate(&Request { max_levels: 3, ..req(Unit::Traverse, "f32", 1) })
+        .unwrap_err()
+        .contains("level pipelines"));
+    assert!(generate(&Request { leaves: 0, ..req(Unit::Traverse, "f32", 1) }).unwrap_err().contains("--leaves"));
     assert!("bvh".parse::<Unit>().unwrap_err().contains("unknown unit"));
     assert!(generate(&req(Unit::Rti, "f32", 0)).unwrap_err().contains("at least 1"));
     assert!(generate(&Request { level: 2, ..req(Unit::Rti, "f32", 1) }).unwrap_err().contains("level 2"));
@@ -169,4 +184,89 @@ fn hdl_packages_match_the_manifest() {
     write_set(&set, &dir).unwrap();
     assert_eq!(std::fs::read_to_string(dir.join("raypipe_pkg.sv")).unwrap(), sv);
     assert!(dir.join("raypipe_pkg.vhd").is_file());
+}
+
+/// Two levels, four unit-cube leaves along x (ids 0..3 at x = 0, 2, 4, 6), root → (A, B),
+/// A → (leaf 0, leaf 1), B → (leaf 2, leaf 3).
+fn line_tree() -> TreeInput {
+    use datapath::bvh::NodeDesc;
+    let cube = |x: f64| ([x, 0.0, 0.0], [x + 1.0, 1.0, 1.0]);
+    let leaf =
+        |id: u32| NodeDesc { children: None, leaf: id, min: cube(2.0 * id as f64).0, max: cube(2.0 * id as f64).1 };
+    let inner = |l: u32, r: u32, lo: f64, hi: f64| NodeDesc {
+        children: Some([l, r]),
+        leaf: 0,
+        min: [lo, 0.0, 0.0],
+        max: [hi, 1.0, 1.0],
+    };
+    let nodes =
+        vec![inner(1, 2, 0.0, 7.0), inner(3, 4, 0.0, 3.0), inner(5, 6, 4.0, 7.0), leaf(0), leaf(1), leaf(2), leaf(3)];
+    TreeInput { name: "line".into(), nodes, root: 0 }
+}
+
+#[test]
+fn traverse_rows_match_a_hand_traced_history() {
+    // a ray along +x through all four leaves: passes 1..4 emit leaves 0, 1, 2, 3; pass 1 sets
+    // level 0 and level 1 to 10, pass 2 turns level 1 to 11 (leaf 1), pass 3 turns level 0 to
+    // 11 and restarts level 1 (B: 10, leaf 2), pass 4 turns it to 11 (leaf 3); no 10 is left.
+    // Box tests: the root once, then 2 per level per pass = 1 + 4 x 2 x 2.
+    let f: datapath::format::Ieee<datapath::format::F32Native> = match "f32".parse().unwrap() {
+        datapath::AnyFormat::F32(f) => f,
+        _ => unreachable!(),
+    };
+    let ray = [-1.0, 0.5, 0.5, 1.0, 0.0, 0.0, 0.0, f64::INFINITY];
+    let row = vectors::traverse::expected_for(f, "plain", &line_tree(), 8, 4, ray).unwrap();
+    assert_eq!(row, [4, 0, 1, 2, 3, 0, 0, 0, 0, 4, 17, 0b11, 0b11]);
+    // N = 2 stops after leaf 1 with level 0 still 10 (the far subtree unexplored)
+    let row = vectors::traverse::expected_for(f, "plain", &line_tree(), 2, 4, ray).unwrap();
+    assert_eq!(row, [2, 0, 1, 2, 9, 0b10, 0b11]);
+    // the opposite direction visits them in reverse
+    let back = [8.0, 0.5, 0.5, -1.0, 0.0, 0.0, 0.0, f64::INFINITY];
+    let row = vectors::traverse::expected_for(f, "plain", &line_tree(), 8, 4, back).unwrap();
+    assert_eq!(&row[..5], [4, 3, 2, 1, 0]);
+    // a ray that misses the root: one box test, no pass
+    let miss = [-1.0, 5.0, 0.5, 1.0, 0.0, 0.0, 0.0, f64::INFINITY];
+    let row = vectors::traverse::expected_for(f, "plain", &line_tree(), 8, 4, miss).unwrap();
+    assert_eq!(row, [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0]);
+    // one level pipeline cannot hold this tree
+    assert!(vectors::traverse::expected_for(f, "plain", &line_tree(), 8, 1, ray).unwrap_err().contains("2 levels"));
+}
+
+#[test]
+fn traverse_sets_cover_every_class_and_catch_bad_images() {
+    let set = generate(&req(Unit::Traverse, "f32", 3)).unwrap();
+    assert!(set.manifest.classes.iter().all(|c| c.count == 3), "{:?}", set.manifest.classes);
+    let levels = set.manifest.params["levels"] as usize;
+    // the root image, then a left and a right bank per level
+    let names: Vec<_> = set.manifest.files.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names.len(), 3 + 2 * levels);
+    assert!(names.contains(&"tree_root.hex") && names.contains(&format!("tree_l{}_right.hex", levels - 1).as_str()));
+    let dir = tmp("trav-bad");
+    write_set(&set, &dir).unwrap();
+    assert_eq!(check_set(&dir).unwrap(), 27);
+    // an address word of level 0 pointing past level 1's rows is a clear error, not a panic
+    let rewrite = |file: &str, f: &dyn Fn(&str) -> String| {
+        let path = dir.join(file);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let new: String =
+            text.lines().enumerate().map(|(i, l)| if i == 0 { f(l) } else { l.to_string() } + "\n").collect();
+        std::fs::write(&path, &new).unwrap();
+        let mut m: vectors::manifest::Manifest =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+        use sha2::Digest;
+        let e = m.files.iter_mut().find(|x| x.name == file).unwrap();
+        e.sha256 = sha2::Sha256::digest(new.as_bytes()).iter().map(|b| format!("{b:02x}")).collect();
+        std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&m).unwrap()).unwrap();
+    };
+    rewrite("tree_l0_left.hex", &|l| format!("{}7fffffff", &l[..l.len() - 8]));
+    let e = check_set(&dir).unwrap_err();
+    assert!(e.contains("malformed tree images") && e.contains("level 0"), "{e}");
+    write_set(&set, &dir).unwrap();
+    // a flipped history bit in the expected rows names the field
+    rewrite("traverse_expected.hex", &|l| {
+        let last = u8::from_str_radix(&l[l.len() - 1..], 16).unwrap() ^ 1;
+        format!("{}{last:x}", &l[..l.len() - 1])
+    });
+    let e = check_set(&dir).unwrap_err();
+    assert!(e.contains(&format!("field hist_{} differs", levels - 1)), "{e}");
 }

@@ -26,6 +26,8 @@ pub enum Unit {
     Slab,
     /// Single operations.
     Op,
+    /// BVH traversal (2-bit ray history) with the slab unit as box tester.
+    Traverse,
 }
 
 impl FromStr for Unit {
@@ -35,8 +37,8 @@ impl FromStr for Unit {
             "rti" => Ok(Unit::Rti),
             "slab" => Ok(Unit::Slab),
             "op" => Ok(Unit::Op),
-            "traverse" => Err("unit 'traverse' has no vector writer yet (units: rti, slab, op)".into()),
-            other => Err(format!("unknown unit '{other}' (units: rti, slab, op)")),
+            "traverse" => Ok(Unit::Traverse),
+            other => Err(format!("unknown unit '{other}' (units: rti, slab, op, traverse)")),
         }
     }
 }
@@ -47,6 +49,7 @@ impl Unit {
             Unit::Rti => "rti",
             Unit::Slab => "slab",
             Unit::Op => "op",
+            Unit::Traverse => "traverse",
         }
     }
 }
@@ -68,8 +71,14 @@ pub struct Request {
     pub command: String,
     /// RTI options.
     pub rti: RtiConfig,
-    /// Slab variant name.
+    /// Slab variant name (units slab and traverse).
     pub slab_variant: String,
+    /// The BVH (unit traverse).
+    pub tree: Option<crate::traverse::TreeInput>,
+    /// First N leaves per ray (unit traverse).
+    pub leaves: usize,
+    /// Level pipelines the hardware has (unit traverse).
+    pub max_levels: usize,
 }
 
 /// A generated set: the manifest (hashes filled on writing) and the file contents.
@@ -81,7 +90,7 @@ pub struct VectorSet {
     pub files: Vec<(String, String)>,
 }
 
-fn kind_of<F: Format>(f: &F) -> Kind {
+pub(crate) fn kind_of<F: Format>(f: &F) -> Kind {
     match f.kind() {
         FormatKind::Float(l) => Kind::Ieee { exp: l.exp_bits, man: l.man_bits },
         FormatKind::Fixed { int_bits, frac_bits } => Kind::Fixed { int: int_bits, frac: frac_bits },
@@ -89,7 +98,7 @@ fn kind_of<F: Format>(f: &F) -> Kind {
 }
 
 /// Field list builder: names, directions, kinds and widths, most significant first.
-struct Layout(Vec<(String, &'static str, Kind, u32, Option<u8>)>);
+pub(crate) struct Layout(pub(crate) Vec<(String, &'static str, Kind, u32, Option<u8>)>);
 
 impl Layout {
     fn fields(&self) -> Vec<Field> {
@@ -116,15 +125,21 @@ impl Layout {
 }
 
 /// Rows of one file.
-struct Rows {
+pub(crate) struct Rows {
     name: String,
-    role: &'static str,
+    role: String,
     layout: Layout,
     lines: Vec<String>,
 }
 
 impl Rows {
-    fn push(&mut self, values: &[u64]) {
+    /// An empty file.
+    pub(crate) fn new(name: &str, role: &str, layout: Layout) -> Self {
+        Rows { name: name.into(), role: role.into(), layout, lines: Vec::new() }
+    }
+
+    /// Appends one row.
+    pub(crate) fn push(&mut self, values: &[u64]) {
         let bits: Vec<Bits> =
             values.iter().zip(self.layout.widths()).map(|(&value, width)| Bits { value, width }).collect();
         self.lines.push(pack(&bits));
@@ -179,7 +194,7 @@ const OP_CLASSES: [(&str, &str); 2] = [
 /// Op codes of the `op` unit.
 pub const OPCODES: [&str; 6] = ["add", "sub", "mul", "div", "lt", "le"];
 
-fn is_float<F: Format>(f: &F) -> bool {
+pub(crate) fn is_float<F: Format>(f: &F) -> bool {
     matches!(f.kind(), FormatKind::Float(_))
 }
 
@@ -349,14 +364,19 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             );
             files.push(Rows {
                 name: "rti_inputs.hex".into(),
-                role: "inputs",
+                role: "inputs".into(),
                 layout: inputs_layout(&RTI_INPUTS, vec![]),
                 lines: vec![],
             });
-            files.push(Rows { name: "rti_expected.hex".into(), role: "expected outputs", layout: out, lines: vec![] });
+            files.push(Rows {
+                name: "rti_expected.hex".into(),
+                role: "expected outputs".into(),
+                layout: out,
+                lines: vec![],
+            });
             files.push(Rows {
                 name: "rti_stages.hex".into(),
-                role: "expected stage signals",
+                role: "expected stage signals".into(),
                 layout: st,
                 lines: vec![],
             });
@@ -434,14 +454,19 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             );
             files.push(Rows {
                 name: "slab_inputs.hex".into(),
-                role: "inputs (box already stored outward-rounded)",
+                role: "inputs (box already stored outward-rounded)".into(),
                 layout: inputs_layout(&names, vec![]),
                 lines: vec![],
             });
-            files.push(Rows { name: "slab_expected.hex".into(), role: "expected outputs", layout: out, lines: vec![] });
+            files.push(Rows {
+                name: "slab_expected.hex".into(),
+                role: "expected outputs".into(),
+                layout: out,
+                lines: vec![],
+            });
             files.push(Rows {
                 name: "slab_stages.hex".into(),
-                role: "expected stage signals",
+                role: "expected stage signals".into(),
                 layout: st,
                 lines: vec![],
             });
@@ -485,10 +510,10 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                 ("result".into(), "out", k.clone(), w, Some(1)),
                 ("cmp".into(), "out", Kind::Flag, 1, Some(1)),
             ]);
-            files.push(Rows { name: "op_inputs.hex".into(), role: "inputs", layout: inl, lines: vec![] });
+            files.push(Rows { name: "op_inputs.hex".into(), role: "inputs".into(), layout: inl, lines: vec![] });
             files.push(Rows {
                 name: "op_expected.hex".into(),
-                role: "expected outputs (result is 0 for compares, cmp is 0 for arithmetic)",
+                role: "expected outputs (result is 0 for compares, cmp is 0 for arithmetic)".into(),
                 layout: out,
                 lines: vec![],
             });
@@ -515,6 +540,26 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                 counts[c as usize] += 1;
             }
         }
+        Unit::Traverse => {
+            let tree = req.tree.as_ref().ok_or("unit traverse needs a scene's BVH")?;
+            classes = &crate::traverse::TRAVERSE_CLASSES;
+            latency = 0;
+            stages = Vec::new();
+            let parts = crate::traverse::generate(
+                f,
+                &req.slab_variant,
+                tree,
+                req.leaves,
+                req.max_levels,
+                req.count,
+                &mut r,
+                inputs_layout(&crate::traverse::RAY_INPUTS, vec![]),
+            )?;
+            files = parts.files;
+            counts = parts.counts;
+            params.extend(parts.params);
+            options.extend(parts.options);
+        }
     }
     let manifest = Manifest {
         schema: manifest::SCHEMA,
@@ -536,7 +581,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             .map(|fr| {
                 let fields = fr.layout.fields();
                 let width: u32 = fields.iter().map(|x| x.width).sum();
-                manifest::File { name: fr.name.clone(), role: fr.role.into(), rows: fr.lines.len(), width, digits: width.div_ceil(4), fields, sha256: String::new() }
+                manifest::File { name: fr.name.clone(), role: fr.role.clone(), rows: fr.lines.len(), width, digits: width.div_ceil(4), fields, sha256: String::new() }
             })
             .collect(),
         classes: classes.iter().enumerate().map(|(i, (n, c))| Class { id: i as u32, name: n.to_string(), covers: c.to_string(), count: counts[i] }).collect(),
@@ -753,6 +798,9 @@ pub fn check_set(dir: &Path) -> Result<usize, String> {
         contents.push(rows);
     }
     let unit: Unit = m.unit.parse()?;
+    if unit == Unit::Traverse {
+        return with_format!(any, |f| check_traverse(f, &m, &contents));
+    }
     with_format!(any, |f| {
         let n = contents[0].len();
         for (i, input) in contents[0].iter().enumerate() {
@@ -770,6 +818,7 @@ pub fn check_set(dir: &Path) -> Result<usize, String> {
                     let (res, cmp) = op_eval(&f, bits[0], f.from_bits(bits[1]), f.from_bits(bits[2]));
                     vec![vec![res, cmp]]
                 }
+                Unit::Traverse => unreachable!("checked above"),
             };
             for (k, w) in want.iter().enumerate() {
                 if &contents[k + 1][i] != w {
@@ -791,6 +840,40 @@ pub fn check_set(dir: &Path) -> Result<usize, String> {
         }
         Ok(n)
     })
+}
+
+/// The traverse unit's check: the tree comes from the set's own BRAM images.
+fn check_traverse<F: Format>(f: F, m: &Manifest, contents: &[Vec<Vec<u64>>]) -> Result<usize, String> {
+    let idx = |name: &str| m.files.iter().position(|x| x.name == name);
+    let levels = m.params.get("levels").copied().ok_or("manifest has no levels parameter")? as usize;
+    let n = m.params.get("leaves").copied().ok_or("manifest has no leaves parameter")? as usize;
+    let root = idx("tree_root.hex").and_then(|i| contents[i].first()).ok_or("set has no tree_root.hex row")?;
+    let mut banks = Vec::new();
+    for l in 0..levels {
+        let (a, b) = (idx(&format!("tree_l{l}_left.hex")), idx(&format!("tree_l{l}_right.hex")));
+        let (Some(a), Some(b)) = (a, b) else { return Err(format!("set lacks the level {l} bank images")) };
+        banks.push((contents[a].clone(), contents[b].clone()));
+    }
+    let variant = m.options.get("variant").map_or("plain", |s| s.as_str());
+    let want = crate::traverse::recheck(f, variant, n, root, &banks, &contents[0])?;
+    for (i, w) in want.iter().enumerate() {
+        if &contents[1][i] != w {
+            let fm = &m.files[1];
+            let bad = fm
+                .fields
+                .iter()
+                .zip(w.iter().zip(&contents[1][i]))
+                .find(|(_, (a, b))| a != b)
+                .map(|(x, _)| x.name.clone());
+            return Err(format!(
+                "{} line {}: field {} differs from the model",
+                fm.name,
+                i + 1,
+                bad.unwrap_or_default()
+            ));
+        }
+    }
+    Ok(want.len())
 }
 
 fn rti_config_from(m: &Manifest) -> Result<RtiConfig, String> {

@@ -7,6 +7,7 @@ pub mod gen;
 pub mod hdl;
 pub mod manifest;
 pub mod pack;
+pub mod traverse;
 
 pub use pack::{pack, unpack, Bits};
 

@@ -1,0 +1,413 @@
+//! The `traverse` unit: a BVH in the thesis's hardware layout as per-level, per-bank BRAM
+//! images, a ray stream, and per ray the expected first-N leaves, pass and box-test counts and
+//! the final 2-bit history of every level (the 2-bit ray history traversal with the slab unit
+//! as the box tester, cross-checked against the golden stack traversal when written).
+//!
+//! Coverage classes are *observed*: candidate rays come from named generators and a ray counts
+//! for a class only when its traversal shows the property (a tie between siblings, a leaf at
+//! the deepest level, three or more passes, the N limit reached, ...).
+
+use crate::gen::{is_float, Layout, Rows};
+use crate::manifest::Kind;
+use datapath::bvh::{hist, history_traverse, HwTree, Level, NodeDesc, StacklessResult, LEAF_FLAG};
+use datapath::rng::SplitMix64;
+use datapath::slab::{Aabb, Slab, SlabConfig};
+use datapath::Format;
+use std::collections::BTreeMap;
+
+/// A scene's BVH before hardware layout, as the vector writer takes it.
+#[derive(Clone, Debug)]
+pub struct TreeInput {
+    /// Scene name (recorded in the manifest).
+    pub name: String,
+    /// Nodes with exact f64 boxes.
+    pub nodes: Vec<NodeDesc>,
+    /// Root node index.
+    pub root: u32,
+}
+
+/// Coverage classes of the traverse unit.
+pub const TRAVERSE_CLASSES: [(&str, &str); 9] = [
+    ("primary", "camera rays from in front of the scene (looking +z)"),
+    ("random", "origin inside the scene bounds, uniform random direction"),
+    ("miss", "origin outside the root box, pointing away: the root test misses"),
+    ("tie", "both children of a pair hit with equal entry t (the left is taken first) on the ray's path"),
+    ("deepest", "a leaf at the tree's deepest level is emitted (the deepest path)"),
+    ("restarts", "three or more passes from the root"),
+    ("n_limit", "the traversal stops at N leaves"),
+    ("axis", "axis-parallel direction (two direction components +0 or -0)"),
+    ("inf_nan", "one ray input +inf, -inf or NaN (floats only)"),
+];
+
+/// Address word width of a bank entry.
+const ADDR_W: u32 = 32;
+
+fn depth_of(nodes: &[NodeDesc], root: u32) -> (Vec<u32>, u32) {
+    // depth of every node (root 0) and the depth of the deepest leaf
+    let mut depth = vec![0u32; nodes.len()];
+    let mut stack = vec![root];
+    let mut deepest = 0;
+    while let Some(i) = stack.pop() {
+        match nodes[i as usize].children {
+            Some(c) => {
+                for k in c {
+                    depth[k as usize] = depth[i as usize] + 1;
+                    stack.push(k);
+                }
+            }
+            None => deepest = deepest.max(depth[i as usize]),
+        }
+    }
+    (depth, deepest)
+}
+
+/// What one ray did.
+struct Observed {
+    result: StacklessResult,
+    tie: bool,
+    deepest: bool,
+}
+
+/// Runs one ray (format bits of o, d, tmin, tmax) through the history traversal.
+fn run<F: Format>(
+    s: &Slab<F>,
+    hw: &HwTree<Aabb<F::V>>,
+    n: usize,
+    bits: &[u64],
+    leaf_depth: &BTreeMap<u32, u32>,
+    deepest: u32,
+) -> Observed {
+    let f = &s.fmt;
+    let x = |i: usize| f.to_f64(f.from_bits(bits[i]));
+    let ray = s.prepare([x(0), x(1), x(2)], [x(3), x(4), x(5)], x(6), x(7));
+    let mut tie = false;
+    let mut calls = 0usize; // call 0 tests the root, then (left, right) pairs
+    let mut left: Option<F::V> = None;
+    let result = history_traverse(hw, n, |b| {
+        let o = s.test(&ray, b);
+        let t = o.hit.then_some(o.t_near);
+        if calls > 0 && calls % 2 == 1 {
+            left = t;
+        } else if let (true, Some(a), Some(b)) = (calls > 0, left, t) {
+            tie |= f.le(a, b) && f.le(b, a);
+        }
+        calls += 1;
+        t.map(|v| f.to_f64(v))
+    });
+    let deep = result.leaves.iter().any(|l| leaf_depth.get(l) == Some(&deepest));
+    Observed { result, tie, deepest: deep }
+}
+
+/// Candidate ray of a class (f64: o, d, tmin, tmax).
+fn candidate(class: usize, r: &mut SplitMix64, lo: [f64; 3], hi: [f64; 3], deep_box: ([f64; 3], [f64; 3])) -> [f64; 8] {
+    let c: [f64; 3] = std::array::from_fn(|a| (lo[a] + hi[a]) / 2.0);
+    let ext = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max).max(1e-6);
+    let inside = |r: &mut SplitMix64| -> [f64; 3] { std::array::from_fn(|a| r.range(lo[a], hi[a])) };
+    let sphere = |r: &mut SplitMix64| -> [f64; 3] {
+        let z = r.range(-1.0, 1.0);
+        let phi = r.range(0.0, std::f64::consts::TAU);
+        let s = (1.0 - z * z).sqrt();
+        [s * phi.cos(), s * phi.sin(), z]
+    };
+    let (o, d) = match class {
+        0 => {
+            let eye = [c[0], c[1], lo[2] - 1.5 * ext];
+            ([eye[0], eye[1], eye[2]], [r.range(-0.4, 0.4), r.range(-0.4, 0.4), 1.0])
+        }
+        2 => {
+            let dir = sphere(r);
+            let o: [f64; 3] = std::array::from_fn(|a| c[a] + dir[a] * 2.0 * ext);
+            (o, dir)
+        }
+        3 => {
+            // origin inside the scene: siblings that both contain it tie at t = tmin
+            (inside(r), sphere(r))
+        }
+        4 => {
+            let o = if r.below(2) == 0 { inside(r) } else { std::array::from_fn(|a| c[a] + sphere(r)[a] * 2.0 * ext) };
+            let target: [f64; 3] = std::array::from_fn(|a| r.range(deep_box.0[a], deep_box.1[a]));
+            (o, std::array::from_fn(|a| target[a] - o[a]))
+        }
+        7 => {
+            let mut d = [0.0f64; 3];
+            let a = r.below(3) as usize;
+            d[a] = if r.below(2) == 0 { 1.0 } else { -1.0 };
+            for (b, v) in d.iter_mut().enumerate() {
+                if b != a && r.below(2) == 0 {
+                    *v = -0.0;
+                }
+            }
+            (inside(r), d)
+        }
+        _ => (inside(r), sphere(r)),
+    };
+    let mut x = [o[0], o[1], o[2], d[0], d[1], d[2], 0.0, f64::INFINITY];
+    if class == 8 {
+        let i = r.below(8) as usize;
+        x[i] = [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][r.below(3) as usize];
+    }
+    x
+}
+
+fn keeps(class: usize, o: &Observed, n: usize) -> bool {
+    match class {
+        2 => o.result.passes == 0,
+        3 => o.tie,
+        4 => o.deepest,
+        5 => o.result.passes >= 3,
+        6 => o.result.leaves.len() == n,
+        _ => true,
+    }
+}
+
+/// The expected row of one ray.
+fn expected_row(o: &StacklessResult, n: usize, depth: usize) -> Vec<u64> {
+    let mut row = vec![o.leaves.len() as u64];
+    row.extend((0..n).map(|i| o.leaves.get(i).map_or(0, |&l| l as u64)));
+    row.push(o.passes.min(u16::MAX as u64));
+    row.push(o.box_tests.min(u32::MAX as u64));
+    row.extend((0..depth).map(|l| o.state.get(l).map_or(hist::NEW, |&s| s) as u64));
+    row
+}
+
+/// Layout of the expected file.
+pub(crate) fn expected_layout(n: usize, depth: usize) -> Layout {
+    let mut l = vec![("count".to_string(), "out", Kind::Uint, 8, None)];
+    l.extend((0..n).map(|i| (format!("leaf_{i}"), "out", Kind::Uint, 32, None)));
+    l.push(("passes".into(), "out", Kind::Uint, 16, None));
+    l.push(("box_tests".into(), "out", Kind::Uint, 32, None));
+    l.extend((0..depth).map(|i| (format!("hist_{i}"), "out", Kind::Uint, 2, None)));
+    Layout(l)
+}
+
+fn entry_layout(k: &Kind, w: u32) -> Layout {
+    let mut l: Vec<_> = ["minx", "miny", "minz", "maxx", "maxy", "maxz"]
+        .iter()
+        .map(|n| (n.to_string(), "in", k.clone(), w, None))
+        .collect();
+    l.push(("addr".into(), "in", Kind::Uint, ADDR_W, None));
+    Layout(l)
+}
+
+fn entry_bits<F: Format>(f: &F, b: &Aabb<F::V>, addr: u32) -> Vec<u64> {
+    let mut v: Vec<u64> = b.min.iter().chain(b.max.iter()).map(|&x| f.to_bits(x)).collect();
+    v.push(addr as u64);
+    v
+}
+
+/// Everything the traverse unit adds to a set.
+pub(crate) struct TraverseParts {
+    pub files: Vec<Rows>,
+    pub counts: Vec<usize>,
+    pub params: BTreeMap<String, u64>,
+    pub options: BTreeMap<String, String>,
+}
+
+/// Ray stream input names.
+pub(crate) const RAY_INPUTS: [&str; 8] = ["ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax"];
+
+/// Builds the traverse files for format `f`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn generate<F: Format>(
+    f: F,
+    variant: &str,
+    tree: &TreeInput,
+    n: usize,
+    max_levels: usize,
+    count: usize,
+    r: &mut SplitMix64,
+    rays_layout: Layout,
+) -> Result<TraverseParts, String> {
+    if n == 0 || n > 255 {
+        return Err(format!("--leaves must be 1..=255, got {n}"));
+    }
+    let sc = SlabConfig::named(variant)?;
+    if sc.directed {
+        return Err("the traverse unit's box tester supports plain, conservative, take-on-false and embree".into());
+    }
+    let s = Slab::new(f, sc);
+    let hw: HwTree<Aabb<F::V>> = HwTree::build(&tree.nodes, tree.root, max_levels, |_, nd| s.store_box(nd.min, nd.max))
+        .map_err(|e| e.to_string())?;
+    let depth = hw.depth();
+    let (node_depth, deepest) = depth_of(&tree.nodes, tree.root);
+    let leaf_depth: BTreeMap<u32, u32> = tree
+        .nodes
+        .iter()
+        .enumerate()
+        .filter(|(_, nd)| nd.children.is_none())
+        .map(|(i, nd)| (nd.leaf, node_depth[i]))
+        .collect();
+    let deep_node = (0..tree.nodes.len())
+        .find(|&i| tree.nodes[i].children.is_none() && node_depth[i] == deepest)
+        .ok_or("tree has no leaf")?;
+    let deep_box = (tree.nodes[deep_node].min, tree.nodes[deep_node].max);
+    let root = &tree.nodes[tree.root as usize];
+    let golden = golden_tree(tree);
+    let w = f.width();
+    let k = crate::gen::kind_of(&f);
+    let mut files = vec![
+        Rows::new("traverse_rays.hex", "inputs: the ray stream", rays_layout),
+        Rows::new("traverse_expected.hex", "expected outputs per ray", expected_layout(n, depth)),
+        Rows::new("tree_root.hex", "BRAM image: the root entry (box, address word)", entry_layout(&k, w)),
+    ];
+    files[2].push(&entry_bits(&f, &hw.root_box, hw.root_addr));
+    for (l, Level { left, right }) in hw.levels.iter().enumerate() {
+        for (side, bank) in [("left", left), ("right", right)] {
+            let mut rows = Rows::new(
+                &format!("tree_l{l}_{side}.hex"),
+                "BRAM image: one level's bank, row = pair index",
+                entry_layout(&k, w),
+            );
+            for (b, &a) in bank.boxes.iter().zip(&bank.addr) {
+                rows.push(&entry_bits(&f, b, a));
+            }
+            files.push(rows);
+        }
+    }
+    let mut counts = vec![0; TRAVERSE_CLASSES.len()];
+    for (c, count_c) in counts.iter_mut().enumerate() {
+        if c == 8 && !is_float(&f) {
+            continue;
+        }
+        let mut tries = 0;
+        while *count_c < count && tries < 400 * count {
+            tries += 1;
+            let x = candidate(c, r, root.min, root.max, deep_box);
+            let bits: Vec<u64> = x.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
+            let o = run(&s, &hw, n, &bits, &leaf_depth, deepest);
+            if !keeps(c, &o, n) {
+                continue;
+            }
+            // the hardware traversal must visit the stack traversal's leaves, in order
+            let xs = |i: usize| f.to_f64(f.from_bits(bits[i]));
+            let ray = s.prepare([xs(0), xs(1), xs(2)], [xs(3), xs(4), xs(5)], xs(6), xs(7));
+            let g = golden::bvh::stack_traverse(&golden, n, |i| {
+                let nd = &tree.nodes[i as usize];
+                let b = s.store_box(nd.min, nd.max).ok()?;
+                let out = s.test(&ray, &b);
+                out.hit.then(|| f.to_f64(out.t_near))
+            });
+            if g.leaves != o.result.leaves {
+                return Err(format!(
+                    "history traversal differs from the stack traversal (class {}, ray {bits:x?}): {:?} vs {:?}",
+                    TRAVERSE_CLASSES[c].0, o.result.leaves, g.leaves
+                ));
+            }
+            let mut row = vec![c as u64];
+            row.extend_from_slice(&bits);
+            files[0].push(&row);
+            files[1].push(&expected_row(&o.result, n, depth));
+            *count_c += 1;
+        }
+    }
+    let mut params = BTreeMap::new();
+    params.insert("leaves".into(), n as u64);
+    params.insert("levels".into(), depth as u64);
+    params.insert("max_levels".into(), max_levels as u64);
+    params.insert("slab_take_on_false".into(), (sc.nan == datapath::slab::SlabNan::TakeOnFalse) as u64);
+    params.insert("slab_embree".into(), (sc.prep == datapath::slab::DirPrep::Embree) as u64);
+    params.insert("slab_delta".into(), f.to_bits(s.delta()));
+    params.insert("slab_widen_ulps".into(), u64::try_from(sc.widen_ulps).map_err(|_| "negative widening")?);
+    let mut options = BTreeMap::new();
+    options.insert("scene".into(), tree.name.clone());
+    options.insert("variant".into(), variant.to_string());
+    options.insert(
+        "traversal".into(),
+        "2-bit ray history, restart from the root (raypipe README, 'Traversal'); the right child is nearer only when its entry t_near is less than the left's (format compare), ties and NaN go left".into(),
+    );
+    options.insert(
+        "address_word".into(),
+        "bit 31 set: a leaf, bits 30..0 its id; clear: the pair index of the child's children at the next level; the root entry's address word is pair 0 of level 0 (or a leaf)".into(),
+    );
+    options.insert(
+        "history".into(),
+        "hist_k: level k's final 2-bit state, 00 new, 01 one child hit, 10 both hit and the nearer being explored, 11 the farther taken".into(),
+    );
+    Ok(TraverseParts { files, counts, params, options })
+}
+
+fn golden_tree(t: &TreeInput) -> golden::bvh::Tree {
+    use golden::bvh::Node;
+    golden::bvh::Tree {
+        nodes: t
+            .nodes
+            .iter()
+            .map(|n| match n.children {
+                Some([l, r]) => Node::Inner { left: l, right: r },
+                None => Node::Leaf { leaf: n.leaf },
+            })
+            .collect(),
+        root: Some(t.root),
+    }
+}
+
+/// The unpacked rows of one level's (left, right) bank images.
+pub(crate) type BankRows = (Vec<Vec<u64>>, Vec<Vec<u64>>);
+
+/// Rebuilds the tree from a set's BRAM images (rows of unpacked fields) and re-runs every ray:
+/// the expected rows.
+pub(crate) fn recheck<F: Format>(
+    f: F,
+    variant: &str,
+    n: usize,
+    root: &[u64],
+    banks: &[BankRows],
+    rays: &[Vec<u64>],
+) -> Result<Vec<Vec<u64>>, String> {
+    let s = Slab::new(f, SlabConfig::named(variant)?);
+    let entry = |row: &[u64]| -> (Aabb<F::V>, u32) {
+        let v = |i: usize| f.from_bits(row[i]);
+        (Aabb { min: [v(0), v(1), v(2)], max: [v(3), v(4), v(5)] }, row[6] as u32)
+    };
+    let (root_box, root_addr) = entry(root);
+    let levels = banks
+        .iter()
+        .map(|(l, r)| {
+            let bank = |rows: &Vec<Vec<u64>>| {
+                let (boxes, addr) = rows.iter().map(|x| entry(x)).unzip();
+                datapath::bvh::Bank { boxes, addr }
+            };
+            Level { left: bank(l), right: bank(r) }
+        })
+        .collect();
+    let hw = HwTree { root_box, root_addr, levels };
+    // every address word must point at a row of the next level (or be a leaf)
+    let bad = |what: String| Err(format!("malformed tree images: {what}"));
+    if root_addr & LEAF_FLAG == 0 && (root_addr != 0 || hw.levels.is_empty()) {
+        return bad(format!("root address word {root_addr:#x} is neither a leaf nor pair 0 of level 0"));
+    }
+    for (l, lv) in hw.levels.iter().enumerate() {
+        if lv.left.addr.len() != lv.right.addr.len() {
+            return bad(format!("level {l}: the banks have different row counts"));
+        }
+        let next = hw.levels.get(l + 1).map_or(0, |x| x.left.addr.len());
+        for &a in lv.left.addr.iter().chain(&lv.right.addr) {
+            if a & LEAF_FLAG == 0 && a as usize >= next {
+                return bad(format!("level {l}: address word {a:#x} points past level {}'s {next} rows", l + 1));
+            }
+        }
+    }
+    let empty = BTreeMap::new();
+    Ok(rays
+        .iter()
+        .map(|ray| expected_row(&run(&s, &hw, n, &ray[1..], &empty, u32::MAX).result, n, hw.depth()))
+        .collect())
+}
+
+/// The expected `traverse_expected.hex` fields of one f64 ray on `tree` in format `f`: count,
+/// N leaf ids (0-padded), passes, box tests, and each level's final 2-bit history state.
+pub fn expected_for<F: Format>(
+    f: F,
+    variant: &str,
+    tree: &TreeInput,
+    n: usize,
+    max_levels: usize,
+    ray: [f64; 8],
+) -> Result<Vec<u64>, String> {
+    let s = Slab::new(f, SlabConfig::named(variant)?);
+    let hw: HwTree<Aabb<F::V>> = HwTree::build(&tree.nodes, tree.root, max_levels, |_, nd| s.store_box(nd.min, nd.max))
+        .map_err(|e| e.to_string())?;
+    let bits: Vec<u64> = ray.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
+    let empty = BTreeMap::new();
+    Ok(expected_row(&run(&s, &hw, n, &bits, &empty, u32::MAX).result, n, hw.depth()))
+}
