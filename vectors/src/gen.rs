@@ -376,7 +376,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             });
             files.push(Rows {
                 name: "rti_stages.hex".into(),
-                role: "expected stage signals".into(),
+                role: crate::hdl::STAGE_ROLE.into(),
                 layout: st,
                 lines: vec![],
             });
@@ -466,7 +466,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             });
             files.push(Rows {
                 name: "slab_stages.hex".into(),
-                role: "expected stage signals".into(),
+                role: crate::hdl::STAGE_ROLE.into(),
                 layout: st,
                 lines: vec![],
             });

@@ -57,6 +57,9 @@ pub fn sv_package(m: &Manifest) -> String {
 /// `raypipe_set_pkg`: the unit-independent view the kit's testbench and DUTs import: row
 /// widths, file names, vector count, latency, the contract parameters (`manifest.params`,
 /// upper-cased) and functions naming the first output / stage field that differs.
+/// The role of a file of per-stage expected signals.
+pub const STAGE_ROLE: &str = "expected stage signals";
+
 fn sv_set_package(m: &crate::manifest::Manifest) -> String {
     let mut s = String::from("// Unit-independent parameters of this set for the HDL kit (hdl/sv/raypipe_tb.sv).\n");
     if m.params.get("recip_mul") == Some(&1) {
@@ -66,12 +69,42 @@ fn sv_set_package(m: &crate::manifest::Manifest) -> String {
     s += &format!("  localparam UNIT = \"{}\";\n  localparam int LATENCY = {};\n", m.unit, m.latency);
     let n = m.files.first().map_or(0, |f| f.rows);
     s += &format!("  localparam int N = {n};\n");
-    let get = |i: usize| m.files.get(i);
+    // inputs and expected outputs are the first two files; the stage file is found by its role
+    let stage_file = m.files.iter().position(|f| f.role == STAGE_ROLE);
+    let get = |i: usize| match i {
+        2 => stage_file.and_then(|k| m.files.get(k)),
+        _ => m.files.get(i),
+    };
     for (i, tag) in ["IN", "OUT", "STG"].iter().enumerate() {
         let (w, name) = get(i).map_or((1, String::new()), |f| (f.width, f.name.clone()));
         s += &format!("  localparam int {tag}_W = {w};\n  localparam {tag}_FILE = \"{name}\";\n");
     }
-    s += &format!("  localparam bit HAS_STAGES = {};\n", u8::from(m.files.len() > 2));
+    s += &format!("  localparam bit HAS_STAGES = {};\n", u8::from(stage_file.is_some()));
+    if let Some(root) = m.files.iter().find(|f| f.name == "tree_root.hex") {
+        // the traverse unit's BRAM images: entry width and rows per level (both banks alike)
+        let levels = m.params.get("levels").copied().unwrap_or(0) as usize;
+        let rows: Vec<usize> = (0..levels)
+            .map(|l| m.files.iter().find(|f| f.name == format!("tree_l{l}_left.hex")).map_or(0, |f| f.rows))
+            .collect();
+        s += &format!(
+            "  localparam int ENTRY_W = {};\n  localparam int TOTAL_ROWS = {};\n",
+            root.width,
+            rows.iter().sum::<usize>().max(1)
+        );
+        s += "  // rows of level l's banks, and their first row in a memory holding every level in order\n";
+        s += "  function automatic int level_rows(int l);\n    case (l)\n";
+        for (l, r) in rows.iter().enumerate() {
+            s += &format!("      {l}: return {r};\n");
+        }
+        s += "      default: return 0;\n    endcase\n  endfunction\n";
+        s += "  function automatic int level_base(int l);\n    case (l)\n";
+        let mut base = 0;
+        for (l, r) in rows.iter().enumerate() {
+            s += &format!("      {l}: return {base};\n");
+            base += r;
+        }
+        s += &format!("      default: return {base};\n    endcase\n  endfunction\n");
+    }
     for (k, v) in &m.params {
         s += &format!("  localparam logic [63:0] {} = 64'h{v:x};\n", k.to_uppercase());
     }

@@ -3,11 +3,13 @@
 // the three reciprocals; 1: six subtracts; 2: six multiplies; 3: near/far by the sign of
 // 1/d; 4: the compare-select chains from tmin/tmax in axis order x, y, z; 5: widening by
 // SLAB_WIDEN_ULPS grid steps; 6: hit = near_w <= far_w). Latency 7.
+// The conversion, preparation and compare-select rules come from raypipe_box.sv.
 // Every stage signal is carried to the end of the pipeline and presented on stg_row.
 // Define RAYPIPE_INJECT_FAULT to make the tlox multiplier truncate instead of rounding to
 // nearest (the kit's negative check: the testbench must fail, naming stage signal tlox).
 module raypipe_slab_ref
   import raypipe_fp::*;
+  import raypipe_box::*;
   import raypipe_set_pkg::*;
   import raypipe_slab_pkg::*;
 (
@@ -19,35 +21,12 @@ module raypipe_slab_ref
   output logic [OUT_W-1:0] out_row,
   output logic [STG_W-1:0] stg_row
 );
-  localparam logic [$bits(fmt_t)-1:0] F = {EXP[7:0], MAN[7:0], FTZ[0], NAN_PROPAGATE[0]};  // an fmt_t
   localparam int L = raypipe_set_pkg::LATENCY;
 
   typedef struct packed {
     slab_inputs_t i;
     slab_stages_t s;
   } state_t;
-
-  // The ray's input conversion: a NaN becomes the canonical NaN, under FTZ a subnormal zero.
-  function automatic word_t conv(word_t a);
-    if (is_nan(F, a)) return canonical_nan(F);
-    return rd(F, a);
-  endfunction
-
-  // Embree's preparation: |d| < delta becomes +-delta by the sign bit of d.
-  function automatic word_t prep(word_t d);
-    if (!SLAB_EMBREE[0] || !flt(F, fabs(F, d), SLAB_DELTA)) return d;
-    return sign_of(F, d) ? fsub(F, zero_of(F, 1'b0), SLAB_DELTA) : SLAB_DELTA;
-  endfunction
-
-  function automatic word_t near_sel(word_t acc, word_t x);
-    if (SLAB_TAKE_ON_FALSE[0]) return fle(F, x, acc) ? acc : x;
-    return flt(F, acc, x) ? x : acc;
-  endfunction
-
-  function automatic word_t far_sel(word_t acc, word_t x);
-    if (SLAB_TAKE_ON_FALSE[0]) return fle(F, acc, x) ? acc : x;
-    return flt(F, x, acc) ? x : acc;
-  endfunction
 
   // the tlox multiplier: the negative check's injected fault goes here
   function automatic word_t mul_tlox(word_t a, word_t b);
@@ -61,7 +40,6 @@ module raypipe_slab_ref
   // Table stage k - 1 applied to the state registered by stage k - 1.
   function automatic state_t stage(int k, state_t x);
     state_t y = x;
-    word_t n, f;
     case (k - 1)
       0: begin
         y.s.dx = conv(x.i.dx);
@@ -75,9 +53,9 @@ module raypipe_slab_ref
         y.s.pdx = prep(y.s.dx);
         y.s.pdy = prep(y.s.dy);
         y.s.pdz = prep(y.s.dz);
-        y.s.inv_dx = fdivide(F, RECIP_MUL[0], one_of(F), y.s.pdx);
-        y.s.inv_dy = fdivide(F, RECIP_MUL[0], one_of(F), y.s.pdy);
-        y.s.inv_dz = fdivide(F, RECIP_MUL[0], one_of(F), y.s.pdz);
+        y.s.inv_dx = recip(y.s.pdx);
+        y.s.inv_dy = recip(y.s.pdy);
+        y.s.inv_dz = recip(y.s.pdz);
       end
       1: begin
         y.s.lox = fsub(F, x.i.minx, x.i.ox);
@@ -115,14 +93,8 @@ module raypipe_slab_ref
         y.s.t_far = far_sel(y.s.tf_xy, x.s.farz);
       end
       5: begin
-        n = x.s.t_near;
-        f = x.s.t_far;
-        for (int j = 0; j < int'(SLAB_WIDEN_ULPS); j++) begin
-          n = next_down(F, n);
-          f = next_up(F, f);
-        end
-        y.s.near_w = n;
-        y.s.far_w = f;
+        y.s.near_w = widen(x.s.t_near, 1'b0);
+        y.s.far_w = widen(x.s.t_far, 1'b1);
       end
       default: y.s.hit = fle(F, x.s.near_w, x.s.far_w);
     endcase

@@ -1,0 +1,114 @@
+// raypipe HDL kit: the testbench of the traverse unit.
+//
+// Writes the set's tree images (tree_root.hex, tree_l<k>_left/right.hex) into the DUT through
+// its write port, streams the rays of traverse_rays.hex with a valid/ready handshake, and
+// compares each result (in ray order) with traverse_expected.hex: the first-N leaf ids, their
+// count, the passes, the box tests and each level's final history state. Prints
+// `N passed, M failed`; any failure or a missing result ends the run with $fatal.
+// The DUT is the module named by the DUT macro (default raypipe_traverse_ref), with the ports
+// of hdl/sv/ref/traverse_ref.sv. Plusargs: +set=DIR, +maxerrors=K, +timeout=CYCLES (per ray).
+`ifndef DUT
+`define DUT raypipe_traverse_ref
+`endif
+module raypipe_traverse_tb;
+  import raypipe_set_pkg::*;
+
+  logic clk = 1'b0;
+  logic rst_n = 1'b0;
+  logic wr_en = 1'b0;
+  logic [7:0] wr_level = '0;
+  logic wr_right = 1'b0;
+  logic [31:0] wr_row = '0;
+  logic [ENTRY_W-1:0] wr_data = '0;
+  logic ray_valid = 1'b0;
+  logic ray_ready;
+  logic [IN_W-1:0] ray_row = '0;
+  logic res_valid;
+  logic [OUT_W-1:0] res_row;
+
+  logic [IN_W-1:0] ins [0:N-1];
+  logic [OUT_W-1:0] outs [0:N-1];
+  logic [ENTRY_W-1:0] img [0:TOTAL_ROWS-1];
+
+  `DUT dut (.clk(clk), .rst_n(rst_n), .wr_en(wr_en), .wr_level(wr_level), .wr_right(wr_right), .wr_row(wr_row),
+            .wr_data(wr_data), .ray_valid(ray_valid), .ray_ready(ray_ready), .ray_row(ray_row), .res_valid(res_valid),
+            .res_row(res_row));
+
+  always #5 clk = ~clk;
+
+  string dir;
+  int max_errors = 10;
+  int timeout = 100000;
+  int sent = 0;
+  int got = 0;
+  int passed = 0;
+  int failed = 0;
+  int idle = 0;
+  logic took = 1'b0;
+
+  task automatic write_entry(input logic [7:0] level, input logic right, input int row, input logic [ENTRY_W-1:0] e);
+    @(negedge clk);
+    wr_en = 1'b1;
+    wr_level = level;
+    wr_right = right;
+    wr_row = row;
+    wr_data = e;
+  endtask
+
+  initial begin
+    if (!$value$plusargs("set=%s", dir)) dir = "set";
+    if ($value$plusargs("maxerrors=%d", max_errors)) ;
+    if ($value$plusargs("timeout=%d", timeout)) ;
+    $readmemh($sformatf("%0s/%0s", dir, IN_FILE), ins);
+    $readmemh($sformatf("%0s/%0s", dir, OUT_FILE), outs);
+    $display("raypipe_traverse_tb: %0d rays from %0s, %0d levels, first %0d leaves", N, dir, LEVELS, LEAVES);
+    repeat (2) @(negedge clk);
+    rst_n = 1'b1;
+    $readmemh($sformatf("%0s/tree_root.hex", dir), img, 0, 0);
+    write_entry(8'hff, 1'b0, 0, img[0]);
+    for (int l = 0; l < int'(LEVELS); l++) begin
+      for (int side = 0; side < 2; side++) begin
+        $readmemh($sformatf("%0s/tree_l%0d_%0s.hex", dir, l, side ? "right" : "left"), img, 0, level_rows(l) - 1);
+        for (int k = 0; k < level_rows(l); k++) write_entry(l[7:0], side[0], k, img[k]);
+      end
+    end
+    @(negedge clk);
+    wr_en = 1'b0;
+    // stream the rays: a ray driven while ray_ready is high is taken at the next rising edge
+    while (got < N && idle < timeout) begin
+      if (ray_valid && took) sent = sent + 1;
+      if (sent < N) begin
+        ray_valid = 1'b1;
+        ray_row = ins[sent];
+        took = ray_ready;
+      end else ray_valid = 1'b0;
+      @(negedge clk);
+    end
+    if (got < N) begin
+      $display("FAIL: no result for ray %0d (line %0d) within %0d cycles", got, got + 1, timeout);
+      failed += N - got;
+    end
+    $display("%0d passed, %0d failed", passed, failed);
+    if (failed > 0) $fatal(1, "raypipe_traverse_tb: %0d of %0d rays failed", failed, N);
+    $finish;
+  end
+
+  always @(negedge clk) begin
+    idle = idle + 1;
+    if (rst_n && res_valid) begin
+      idle = 0;
+      if (got >= N) begin
+        $display("FAIL: a result with no ray outstanding");
+        failed++;
+      end else begin
+        if (diff_out(res_row, outs[got]) != "none") begin
+          failed++;
+          if (failed <= max_errors)
+            $display("FAIL ray %0d (line %0d, class %0d): first field to differ: %0s", got, got + 1,
+                     ins[got][IN_W-1 -: 8], diff_out(res_row, outs[got]));
+        end else passed++;
+        got++;
+      end
+    end
+  end
+endmodule
