@@ -213,9 +213,12 @@ enum Cmd {
         /// Seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Coverage level (1: every class on its own).
+        /// Coverage level: 1 (every class on its own) or 2 (level 1 plus crossed classes).
         #[arg(long, default_value_t = 1)]
         level: u32,
+        /// Worker threads (default: every core); the files do not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
         /// Slab variant (unit slab).
         #[arg(long, default_value = "plain")]
         variant: String,
@@ -396,6 +399,7 @@ fn run() -> Result<bool, String> {
             count,
             seed,
             level,
+            threads,
             variant,
             check,
             scene,
@@ -425,6 +429,7 @@ fn run() -> Result<bool, String> {
                 tree,
                 leaves: leaves as usize,
                 max_levels: levels as usize,
+                threads: threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
                 format,
                 count: count as usize,
                 seed,

@@ -19,6 +19,7 @@ fn req(unit: Unit, format: &str, count: usize) -> Request {
         tree: (unit == Unit::Traverse).then(builtin_tree),
         leaves: 8,
         max_levels: 64,
+        threads: 1,
     }
 }
 
@@ -133,7 +134,8 @@ fn bad_requests_are_clear_errors() {
     assert!(generate(&Request { leaves: 0, ..req(Unit::Traverse, "f32", 1) }).unwrap_err().contains("--leaves"));
     assert!("bvh".parse::<Unit>().unwrap_err().contains("unknown unit"));
     assert!(generate(&req(Unit::Rti, "f32", 0)).unwrap_err().contains("at least 1"));
-    assert!(generate(&Request { level: 2, ..req(Unit::Rti, "f32", 1) }).unwrap_err().contains("level 2"));
+    assert!(generate(&Request { level: 3, ..req(Unit::Rti, "f32", 1) }).unwrap_err().contains("level 3"));
+    assert!(generate(&Request { level: 0, ..req(Unit::Rti, "f32", 1) }).unwrap_err().contains("level 0"));
     assert!(generate(&Request { slab_variant: "directed".into(), ..req(Unit::Slab, "f32", 1) })
         .unwrap_err()
         .contains("directed"));
@@ -269,4 +271,51 @@ fn traverse_sets_cover_every_class_and_catch_bad_images() {
     });
     let e = check_set(&dir).unwrap_err();
     assert!(e.contains(&format!("field hist_{} differs", levels - 1)), "{e}");
+}
+
+#[test]
+fn one_and_two_threads_write_the_same_bytes() {
+    for unit in [Unit::Rti, Unit::Slab, Unit::Op, Unit::Traverse] {
+        for level in [1, 2] {
+            let one = generate(&Request { level, threads: 1, ..req(unit, "f32", 5) }).unwrap();
+            let two = generate(&Request { level, threads: 2, ..req(unit, "f32", 5) }).unwrap();
+            assert_eq!(one.files, two.files, "{unit:?} level {level}");
+            assert_eq!(one.manifest.classes, two.manifest.classes);
+        }
+    }
+}
+
+#[test]
+fn level_2_crosses_the_classes() {
+    // rti: the 12 level-1 classes, then 6 placements x 5 modifiers, every one filled in a float format
+    let set = generate(&Request { level: 2, ..req(Unit::Rti, "fp16", 2) }).unwrap();
+    let c = &set.manifest.classes;
+    assert_eq!(c.len(), 12 + 6 * 5);
+    assert!(c.iter().all(|c| c.count == 2), "{c:?}");
+    assert!(c.iter().any(|c| c.name == "edge+subnormal") && c.iter().any(|c| c.name == "needle+huge"));
+    // level 1's classes keep their ids and names
+    let l1 = generate(&req(Unit::Rti, "fp16", 2)).unwrap();
+    assert_eq!(
+        l1.manifest.classes.iter().map(|c| &c.name).collect::<Vec<_>>(),
+        c[..12].iter().map(|c| &c.name).collect::<Vec<_>>()
+    );
+    // in fixed point the crossings with subnormal and inf/NaN do not apply
+    let fx = generate(&Request { level: 2, ..req(Unit::Rti, "q8.24:divide", 2) }).unwrap();
+    let empty: Vec<_> = fx.manifest.classes.iter().filter(|c| c.count == 0).map(|c| c.name.clone()).collect();
+    assert_eq!(empty.len(), 2 + 2 * 6, "{empty:?}");
+    assert!(empty.iter().all(|n| n.contains("subnormal") || n.contains("inf_nan")));
+    // slab and op gain crossed classes; the set still checks bit for bit
+    let slab = generate(&Request { level: 2, ..req(Unit::Slab, "f32", 3) }).unwrap();
+    assert_eq!(slab.manifest.classes.len(), 6 + 7);
+    assert!(slab.manifest.classes.iter().all(|c| c.count == 3), "{:?}", slab.manifest.classes);
+    let op = generate(&Request { level: 2, ..req(Unit::Op, "fp16", 8) }).unwrap();
+    assert!(op.manifest.classes[2].count > 0);
+    let trav = generate(&Request { level: 2, ..req(Unit::Traverse, "f32", 2) }).unwrap();
+    assert_eq!(trav.manifest.classes.len(), 9 + 5 * 4 - 1);
+    assert!(trav.manifest.classes.iter().any(|c| c.name == "axis+tie" && c.count == 2), "{:?}", trav.manifest.classes);
+    for (i, set) in [slab, op, trav].iter().enumerate() {
+        let dir = tmp(&format!("level2-{i}"));
+        write_set(set, &dir).unwrap();
+        assert!(check_set(&dir).is_ok());
+    }
 }

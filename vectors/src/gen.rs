@@ -65,8 +65,10 @@ pub struct Request {
     pub count: usize,
     /// Seed.
     pub seed: u64,
-    /// Coverage level (1).
+    /// Coverage level: 1 (each class on its own) or 2 (level 1 plus crossed classes).
     pub level: u32,
+    /// Worker threads (the output does not depend on it).
+    pub threads: usize,
     /// The command line, recorded in the manifest.
     pub command: String,
     /// RTI options.
@@ -162,33 +164,201 @@ fn contract_map<F: Format>(f: &F) -> BTreeMap<String, String> {
     .collect()
 }
 
-const RTI_CLASSES: [(&str, &str); 12] = [
-    ("random", "ray aimed at a random barycentric point in [-0.3, 1.3]^2 of a random triangle in [-1, 1]^3"),
-    ("edge", "aimed exactly at a point of an edge (one barycentric 0)"),
-    ("vertex", "aimed exactly at a vertex"),
-    ("near_parallel", "direction within ~1e-3 of the triangle's plane (|det| -> 0)"),
-    ("degenerate", "collinear vertices (zero area)"),
-    ("needle", "long triangle 1e-3 wide"),
-    ("huge", "coordinates scaled by 2^12"),
-    ("tiny", "coordinates scaled by 2^-12"),
-    ("t_near_zero", "origin on the triangle's plane (t = 0)"),
-    ("signed_zero", "some coordinates +0 or -0"),
-    ("subnormal", "some inputs the format's smallest subnormals (floats only)"),
-    ("inf_nan", "some inputs +inf, -inf or NaN (floats only)"),
+/// Geometric RTI classes (level 1 ids 0-5 and 8): how the triangle and ray are placed.
+const RTI_GEOMETRY: [(usize, &str, &str); 7] = [
+    (0, "random", "ray aimed at a random barycentric point in [-0.3, 1.3]^2 of a random triangle in [-1, 1]^3"),
+    (1, "edge", "aimed exactly at a point of an edge (one barycentric 0)"),
+    (2, "vertex", "aimed exactly at a vertex"),
+    (3, "near_parallel", "direction within ~1e-3 of the triangle's plane (|det| -> 0)"),
+    (4, "degenerate", "collinear vertices (zero area)"),
+    (5, "needle", "long triangle 1e-3 wide"),
+    (8, "t_near_zero", "origin on the triangle's plane (t = 0)"),
 ];
 
-const SLAB_CLASSES: [(&str, &str); 6] = [
+/// Value modifiers of the RTI classes (level 1 ids 6, 7, 9, 10, 11), applied after placement.
+const RTI_MODIFIERS: [(usize, &str, &str); 5] = [
+    (6, "huge", "coordinates scaled by 2^12"),
+    (7, "tiny", "coordinates scaled by 2^-12"),
+    (9, "signed_zero", "some coordinates +0 or -0"),
+    (10, "subnormal", "some inputs the format's smallest subnormals (floats only)"),
+    (11, "inf_nan", "some inputs +inf, -inf or NaN (floats only)"),
+];
+
+/// Special input values injected into a case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Special {
+    Subnormal,
+    InfNan,
+}
+
+/// One RTI coverage class: a placement plus at most one modifier.
+#[derive(Clone, Copy, Debug)]
+struct RtiCross {
+    geom: usize,
+    scale: f64,
+    signed_zero: bool,
+    special: Option<Special>,
+    /// Index into RTI_GEOMETRY and RTI_MODIFIERS (None: plain placement).
+    names: (usize, Option<usize>),
+}
+
+impl RtiCross {
+    fn describe(&self) -> (String, String) {
+        let (g, m) = self.names;
+        match (g, m) {
+            (0, Some(m)) => (RTI_MODIFIERS[m].1.into(), RTI_MODIFIERS[m].2.into()),
+            (g, None) => (RTI_GEOMETRY[g].1.into(), RTI_GEOMETRY[g].2.into()),
+            (g, Some(m)) => (
+                format!("{}+{}", RTI_GEOMETRY[g].1, RTI_MODIFIERS[m].1),
+                format!("{}; and {}", RTI_GEOMETRY[g].2, RTI_MODIFIERS[m].2),
+            ),
+        }
+    }
+}
+
+/// The RTI classes of a level, in class-id order: level 1 as the twelve named classes (ids
+/// 0-11), level 2 adds every placement other than random crossed with every modifier.
+fn rti_crosses(level: u32) -> Vec<RtiCross> {
+    let cross = |g: usize, m: Option<usize>| {
+        let id = m.map(|m| RTI_MODIFIERS[m].0);
+        RtiCross {
+            geom: RTI_GEOMETRY[g].0,
+            scale: match id {
+                Some(6) => 4096.0,
+                Some(7) => 1.0 / 4096.0,
+                _ => 1.0,
+            },
+            signed_zero: id == Some(9),
+            special: match id {
+                Some(10) => Some(Special::Subnormal),
+                Some(11) => Some(Special::InfNan),
+                _ => None,
+            },
+            names: (g, m),
+        }
+    };
+    let mut v: Vec<RtiCross> = (0..12)
+        .map(|id| match RTI_GEOMETRY.iter().position(|g| g.0 == id) {
+            Some(g) => cross(g, None),
+            None => cross(0, RTI_MODIFIERS.iter().position(|m| m.0 == id)),
+        })
+        .collect();
+    if level >= 2 {
+        for g in 1..RTI_GEOMETRY.len() {
+            for m in 0..RTI_MODIFIERS.len() {
+                v.push(cross(g, Some(m)));
+            }
+        }
+    }
+    v
+}
+
+/// Slab ray placements (level 1 ids 0-3).
+const SLAB_RAYS: [(&str, &str); 4] = [
     ("random", "random ray and box in [-1, 1]^3"),
     ("face_signed_zero", "origin on a face plane, one direction component +0 or -0"),
     ("grazing", "aimed at a face, edge or corner point of the box"),
     ("inside", "origin inside the box"),
-    ("zero_extent", "box of zero extent on one or more axes"),
-    ("inf_nan", "ray inputs +inf, -inf or NaN (floats only)"),
 ];
+const SLAB_ZERO: (&str, &str) = ("zero_extent", "box of zero extent on one or more axes");
+const SLAB_SPECIAL: (&str, &str) = ("inf_nan", "ray inputs +inf, -inf or NaN (floats only)");
 
-const OP_CLASSES: [(&str, &str); 2] = [
+/// One slab coverage class: a ray placement, a zero-extent box, special inputs.
+#[derive(Clone, Copy, Debug)]
+struct SlabCross {
+    ray: usize,
+    zero_box: bool,
+    special: bool,
+}
+
+impl SlabCross {
+    fn describe(&self) -> (String, String) {
+        let mut parts: Vec<(&str, &str)> = Vec::new();
+        if self.ray > 0 || (!self.zero_box && !self.special) {
+            parts.push(SLAB_RAYS[self.ray]);
+        }
+        if self.zero_box {
+            parts.push(SLAB_ZERO);
+        }
+        if self.special {
+            parts.push(SLAB_SPECIAL);
+        }
+        (
+            parts.iter().map(|p| p.0).collect::<Vec<_>>().join("+"),
+            parts.iter().map(|p| p.1).collect::<Vec<_>>().join("; and "),
+        )
+    }
+}
+
+/// The slab classes of a level: level 1 the six named classes (ids 0-5), level 2 adds each
+/// special placement with a zero-extent box and with special inputs, and the two together.
+fn slab_crosses(level: u32) -> Vec<SlabCross> {
+    let c = |ray, zero_box, special| SlabCross { ray, zero_box, special };
+    let mut v = vec![c(0, false, false), c(1, false, false), c(2, false, false), c(3, false, false)];
+    v.push(c(0, true, false));
+    v.push(c(0, false, true));
+    if level >= 2 {
+        for ray in 1..4 {
+            v.push(c(ray, true, false));
+            v.push(c(ray, false, true));
+        }
+        v.push(c(0, true, true));
+    }
+    v
+}
+
+/// Rows of every class, each class drawn from its own random stream (seed, class id), classes
+/// in parallel on the current rayon pool and collected in class order: the output does not
+/// depend on the number of threads. `case` returns the rows of one vector (None: the class
+/// does not apply to the format).
+pub(crate) type ClassRows = Vec<Vec<Vec<u64>>>;
+pub(crate) fn per_class_rows(
+    seed: u64,
+    classes: usize,
+    count: usize,
+    case: impl Fn(usize, &mut SplitMix64) -> Result<Option<Vec<Vec<u64>>>, String> + Sync,
+) -> Result<Vec<ClassRows>, String> {
+    use rayon::prelude::*;
+    (0..classes)
+        .into_par_iter()
+        .map(|c| {
+            let mut r = SplitMix64::new(class_seed(seed, c));
+            let mut rows = Vec::new();
+            for _ in 0..count {
+                match case(c, &mut r)? {
+                    Some(row) => rows.push(row),
+                    None => break,
+                }
+            }
+            Ok(rows)
+        })
+        .collect()
+}
+
+/// The seed of class `c`'s random stream.
+pub(crate) fn class_seed(seed: u64, c: usize) -> u64 {
+    SplitMix64::new(seed ^ (c as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)).next_u64()
+}
+
+/// Appends per-class rows to the files (row k of a vector goes to file k); the counts.
+pub(crate) fn push_rows(files: &mut [Rows], per_class: Vec<ClassRows>) -> Vec<usize> {
+    per_class
+        .into_iter()
+        .map(|rows| {
+            for row in &rows {
+                for (file, vals) in files.iter_mut().zip(row) {
+                    file.push(vals);
+                }
+            }
+            rows.len()
+        })
+        .collect()
+}
+
+const OP_CLASSES: [(&str, &str); 3] = [
     ("special", "TestFloat level 1: every pair of special operands (zeros, subnormals, min/max normal, one, all-ones significands, inf, NaN; fixed: extremes and one)"),
     ("random", "uniform random operand bits"),
+    ("special_x_random", "level 2: each special operand against random operands, on either side"),
 ];
 
 /// Op codes of the `op` unit.
@@ -198,7 +368,8 @@ pub(crate) fn is_float<F: Format>(f: &F) -> bool {
     matches!(f.kind(), FormatKind::Float(_))
 }
 
-fn rti_case(class: usize, r: &mut SplitMix64) -> ([f64; 17], bool) {
+fn rti_case(cross: RtiCross, r: &mut SplitMix64) -> [f64; 17] {
+    let class = cross.geom;
     let p = |r: &mut SplitMix64| [r.range(-1.0, 1.0), r.range(-1.0, 1.0), r.range(-1.0, 1.0)];
     let mut v = [p(r), p(r), p(r)];
     let o = p(r);
@@ -243,11 +414,7 @@ fn rti_case(class: usize, r: &mut SplitMix64) -> ([f64; 17], bool) {
         o = target;
         d = p(r);
     }
-    let scale = match class {
-        6 => 4096.0,
-        7 => 1.0 / 4096.0,
-        _ => 1.0,
-    };
+    let scale = cross.scale;
     let mut x = [0.0; 17];
     for a in 0..3 {
         x[a] = o[a] * scale;
@@ -258,14 +425,14 @@ fn rti_case(class: usize, r: &mut SplitMix64) -> ([f64; 17], bool) {
     }
     x[6] = 0.0;
     x[7] = if r.below(4) == 0 { r.range(0.0, 3.0) * scale } else { f64::INFINITY };
-    if class == 9 {
+    if cross.signed_zero {
         for xi in x.iter_mut() {
             if r.below(3) == 0 {
                 *xi = if r.below(2) == 0 { 0.0 } else { -0.0 };
             }
         }
     }
-    (x, class >= 10)
+    x
 }
 
 fn specials_for<F: Format>(f: &F) -> Vec<u64> {
@@ -302,8 +469,11 @@ pub fn generate(req: &Request) -> Result<VectorSet, String> {
     if req.count == 0 {
         return Err("--count must be at least 1".into());
     }
-    if req.level != 1 {
-        return Err(format!("coverage level {} is not available yet (level 1 only)", req.level));
+    if !(1..=2).contains(&req.level) {
+        return Err(format!(
+            "coverage level {} does not exist (1: each class on its own, 2: classes crossed)",
+            req.level
+        ));
     }
     with_format!(req.format, |f| generate_in(f, req))
 }
@@ -314,7 +484,8 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
     let mut r = SplitMix64::new(req.seed);
     let mut options = BTreeMap::new();
     let mut params = format_params(&f);
-    let (classes, latency, stages): (&[(&str, &str)], u32, Vec<Stage>);
+    let (classes, latency, stages): (Vec<(String, String)>, u32, Vec<Stage>);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(req.threads.max(1)).build().map_err(|e| e.to_string())?;
     let unit = req.unit.name();
     let mut files: Vec<Rows> = Vec::new();
     let mut counts: Vec<usize>;
@@ -337,7 +508,8 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             params.insert("det_thr".into(), f.to_bits(rti.det_thr));
             params.insert("tie_last".into(), (req.rti.tie == datapath::rti::TieRule::Last) as u64);
             let table = stage_table(f.div_mode());
-            classes = &RTI_CLASSES;
+            let crosses = rti_crosses(req.level);
+            classes = crosses.iter().map(|c| c.describe()).collect();
             latency = stage_count(f.div_mode()) as u32;
             stages = table
                 .iter()
@@ -380,17 +552,18 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                 layout: st,
                 lines: vec![],
             });
-            counts = vec![0; classes.len()];
-            for (c, _) in classes.iter().enumerate() {
-                if c >= 10 && !is_float(&f) {
-                    continue;
-                }
-                for _ in 0..req.count {
-                    let (mut x, special) = rti_case(c, &mut r);
-                    if special {
+            let float = is_float(&f);
+            let per_class = pool.install(|| {
+                per_class_rows(req.seed, crosses.len(), req.count, |c, r| {
+                    let cross = crosses[c];
+                    if cross.special.is_some() && !float {
+                        return Ok(None);
+                    }
+                    let mut x = rti_case(cross, r);
+                    if let Some(sp) = cross.special {
                         for _ in 0..1 + r.below(3) {
                             let i = r.below(17) as usize;
-                            x[i] = if c == 10 {
+                            x[i] = if sp == Special::Subnormal {
                                 let sub = f.to_f64(f.from_bits(1 + r.below(3)));
                                 if r.below(2) == 0 {
                                     sub
@@ -403,13 +576,10 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                         }
                     }
                     let bits: Vec<u64> = x.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
-                    let row = rti_rows(&rti, c as u64, &bits);
-                    for (file, vals) in files.iter_mut().zip(row) {
-                        file.push(&vals);
-                    }
-                    counts[c] += 1;
-                }
-            }
+                    Ok(Some(rti_rows(&rti, c as u64, &bits).to_vec()))
+                })
+            })?;
+            counts = push_rows(&mut files, per_class);
         }
         Unit::Slab => {
             let sc = SlabConfig::named(&req.slab_variant)?;
@@ -426,7 +596,8 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                 "slab_widen_ulps".into(),
                 u64::try_from(sc.widen_ulps).map_err(|_| "vectors support only non-negative widening")?,
             );
-            classes = &SLAB_CLASSES;
+            let crosses = slab_crosses(req.level);
+            classes = crosses.iter().map(|c| c.describe()).collect();
             latency = 7;
             stages = SLAB_TABLE
                 .iter()
@@ -470,26 +641,27 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                 layout: st,
                 lines: vec![],
             });
-            counts = vec![0; classes.len()];
-            for (c, _) in classes.iter().enumerate() {
-                if c == 5 && !is_float(&f) {
-                    continue;
-                }
-                for _ in 0..req.count {
-                    let x = slab_case(c, &mut r);
+            let float = is_float(&f);
+            let per_class = pool.install(|| {
+                per_class_rows(req.seed, crosses.len(), req.count, |c, r| {
+                    let cross = crosses[c];
+                    if cross.special && !float {
+                        return Ok(None);
+                    }
+                    let x = slab_case(cross, r);
                     let b = slab.store_box([x[8], x[9], x[10]], [x[11], x[12], x[13]]).map_err(|e| e.to_string())?;
                     let mut bits: Vec<u64> = x[..8].iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
                     bits.extend(b.min.iter().chain(b.max.iter()).map(|&v| f.to_bits(v)));
-                    let row = slab_rows(&slab, c as u64, &bits);
-                    for (file, vals) in files.iter_mut().zip(row) {
-                        file.push(&vals);
-                    }
-                    counts[c] += 1;
-                }
-            }
+                    Ok(Some(slab_rows(&slab, c as u64, &bits).to_vec()))
+                })
+            })?;
+            counts = push_rows(&mut files, per_class);
         }
         Unit::Op => {
-            classes = &OP_CLASSES;
+            classes = OP_CLASSES[..if req.level >= 2 { 3 } else { 2 }]
+                .iter()
+                .map(|(n, c)| (n.to_string(), c.to_string()))
+                .collect();
             latency = 1;
             stages = OPCODES
                 .iter()
@@ -517,7 +689,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                 layout: out,
                 lines: vec![],
             });
-            counts = vec![0; 2];
+            counts = vec![0; classes.len()];
             let sp = specials_for(&f);
             let mask = if w >= 64 { u64::MAX } else { (1u64 << w) - 1 };
             let mut pairs: Vec<(u64, u64, u64)> = Vec::new();
@@ -529,6 +701,14 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                 }
                 for _ in 0..req.count {
                     pairs.push((1, r.next_u64() & mask, (r.next_u64() & mask) | (op << 60)));
+                }
+                if req.level >= 2 {
+                    for &s in &sp {
+                        for _ in 0..req.count.div_ceil(8) {
+                            pairs.push((2, s, (r.next_u64() & mask) | (op << 60)));
+                            pairs.push((2, r.next_u64() & mask, s | (op << 60)));
+                        }
+                    }
                 }
             }
             for (c, a, bop) in pairs {
@@ -542,19 +722,22 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
         }
         Unit::Traverse => {
             let tree = req.tree.as_ref().ok_or("unit traverse needs a scene's BVH")?;
-            classes = &crate::traverse::TRAVERSE_CLASSES;
+            classes = crate::traverse::classes(req.level);
             latency = 0;
             stages = Vec::new();
-            let parts = crate::traverse::generate(
-                f,
-                &req.slab_variant,
-                tree,
-                req.leaves,
-                req.max_levels,
-                req.count,
-                &mut r,
-                inputs_layout(&crate::traverse::RAY_INPUTS, vec![]),
-            )?;
+            let parts = pool.install(|| {
+                crate::traverse::generate(
+                    f,
+                    &req.slab_variant,
+                    tree,
+                    req.leaves,
+                    req.max_levels,
+                    req.count,
+                    req.seed,
+                    req.level,
+                    inputs_layout(&crate::traverse::RAY_INPUTS, vec![]),
+                )
+            })?;
             files = parts.files;
             counts = parts.counts;
             params.extend(parts.params);
@@ -584,7 +767,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                 manifest::File { name: fr.name.clone(), role: fr.role.clone(), rows: fr.lines.len(), width, digits: width.div_ceil(4), fields, sha256: String::new() }
             })
             .collect(),
-        classes: classes.iter().enumerate().map(|(i, (n, c))| Class { id: i as u32, name: n.to_string(), covers: c.to_string(), count: counts[i] }).collect(),
+        classes: classes.iter().enumerate().map(|(i, (n, c))| Class { id: i as u32, name: n.clone(), covers: c.clone(), count: counts[i] }).collect(),
     };
     Ok(VectorSet { manifest, files: files.into_iter().map(|fr| (fr.name, fr.lines.join("\n") + "\n")).collect() })
 }
@@ -657,18 +840,18 @@ fn signals<F: Format>(f: &F, rec: &Recorder<F::V>) -> Vec<u64> {
         .collect()
 }
 
-fn slab_case(class: usize, r: &mut SplitMix64) -> [f64; 14] {
+fn slab_case(cross: SlabCross, r: &mut SplitMix64) -> [f64; 14] {
     let mut lo = [0.0; 3];
     let mut hi = [0.0; 3];
     for a in 0..3 {
         let c = r.range(-1.0, 1.0);
-        let e = if class == 4 && r.below(2) == 0 { 0.0 } else { r.range(0.01, 0.5) };
+        let e = if cross.zero_box && r.below(2) == 0 { 0.0 } else { r.range(0.01, 0.5) };
         lo[a] = c - e;
         hi[a] = c + e;
     }
     let mut o: [f64; 3] = std::array::from_fn(|_| r.range(-2.0, 2.0));
     let mut d: [f64; 3] = std::array::from_fn(|_| r.range(-1.0, 1.0));
-    match class {
+    match cross.ray {
         1 => {
             let a = r.below(3) as usize;
             o[a] = if r.below(2) == 0 { lo[a] } else { hi[a] };
@@ -688,16 +871,16 @@ fn slab_case(class: usize, r: &mut SplitMix64) -> [f64; 14] {
             d = std::array::from_fn(|a| p[a] - o[a]);
         }
         3 => o = std::array::from_fn(|a| r.range(lo[a], hi[a])),
-        5 => {
-            let i = r.below(6) as usize;
-            let v = [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][r.below(3) as usize];
-            if i < 3 {
-                o[i] = v;
-            } else {
-                d[i - 3] = v;
-            }
-        }
         _ => {}
+    }
+    if cross.special {
+        let i = r.below(6) as usize;
+        let v = [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][r.below(3) as usize];
+        if i < 3 {
+            o[i] = v;
+        } else {
+            d[i - 3] = v;
+        }
     }
     let tmax = if r.below(4) == 0 { r.range(0.0, 3.0) } else { f64::INFINITY };
     [o[0], o[1], o[2], d[0], d[1], d[2], 0.0, tmax, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]]

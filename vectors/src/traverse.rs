@@ -39,6 +39,40 @@ pub const TRAVERSE_CLASSES: [(&str, &str); 9] = [
     ("inf_nan", "one ray input +inf, -inf or NaN (floats only)"),
 ];
 
+/// Level 2: rays of generator `g` (a level-1 class) that also show property `k`.
+const CROSS_GENERATORS: [usize; 5] = [0, 1, 4, 7, 8];
+const CROSS_PROPERTIES: [usize; 4] = [3, 4, 5, 6];
+
+/// The classes of a level as (generator, extra property): level 1 each class on its own,
+/// level 2 adds every generator crossed with every observed property.
+fn crosses(level: u32) -> Vec<(usize, Option<usize>)> {
+    let mut v: Vec<_> = (0..TRAVERSE_CLASSES.len()).map(|c| (c, None)).collect();
+    if level >= 2 {
+        for g in CROSS_GENERATORS {
+            for k in CROSS_PROPERTIES {
+                if g != k {
+                    v.push((g, Some(k)));
+                }
+            }
+        }
+    }
+    v
+}
+
+/// Class names and descriptions of a level, in class-id order.
+pub(crate) fn classes(level: u32) -> Vec<(String, String)> {
+    crosses(level)
+        .into_iter()
+        .map(|(g, k)| match k {
+            None => (TRAVERSE_CLASSES[g].0.into(), TRAVERSE_CLASSES[g].1.into()),
+            Some(k) => (
+                format!("{}+{}", TRAVERSE_CLASSES[g].0, TRAVERSE_CLASSES[k].0),
+                format!("{}; and {}", TRAVERSE_CLASSES[g].1, TRAVERSE_CLASSES[k].1),
+            ),
+        })
+        .collect()
+}
+
 /// Address word width of a bank entry.
 const ADDR_W: u32 = 32;
 
@@ -215,7 +249,8 @@ pub(crate) fn generate<F: Format>(
     n: usize,
     max_levels: usize,
     count: usize,
-    r: &mut SplitMix64,
+    seed: u64,
+    level: u32,
     rays_layout: Layout,
 ) -> Result<TraverseParts, String> {
     if n == 0 || n > 255 {
@@ -264,18 +299,18 @@ pub(crate) fn generate<F: Format>(
             files.push(rows);
         }
     }
-    let mut counts = vec![0; TRAVERSE_CLASSES.len()];
-    for (c, count_c) in counts.iter_mut().enumerate() {
-        if c == 8 && !is_float(&f) {
-            continue;
+    let crosses = crosses(level);
+    let float = is_float(&f);
+    let per_class = crate::gen::per_class_rows(seed, crosses.len(), count, |c, r| {
+        let (gen, keep) = crosses[c];
+        if gen == 8 && !float {
+            return Ok(None);
         }
-        let mut tries = 0;
-        while *count_c < count && tries < 400 * count {
-            tries += 1;
-            let x = candidate(c, r, root.min, root.max, deep_box);
+        for _ in 0..400 {
+            let x = candidate(gen, r, root.min, root.max, deep_box);
             let bits: Vec<u64> = x.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
             let o = run(&s, &hw, n, &bits, &leaf_depth, deepest);
-            if !keeps(c, &o, n) {
+            if !keeps(gen, &o, n) || !keep.is_none_or(|k| keeps(k, &o, n)) {
                 continue;
             }
             // the hardware traversal must visit the stack traversal's leaves, in order
@@ -289,17 +324,17 @@ pub(crate) fn generate<F: Format>(
             });
             if g.leaves != o.result.leaves {
                 return Err(format!(
-                    "history traversal differs from the stack traversal (class {}, ray {bits:x?}): {:?} vs {:?}",
-                    TRAVERSE_CLASSES[c].0, o.result.leaves, g.leaves
+                    "history traversal differs from the stack traversal (class {c}, ray {bits:x?}): {:?} vs {:?}",
+                    o.result.leaves, g.leaves
                 ));
             }
             let mut row = vec![c as u64];
             row.extend_from_slice(&bits);
-            files[0].push(&row);
-            files[1].push(&expected_row(&o.result, n, depth));
-            *count_c += 1;
+            return Ok(Some(vec![row, expected_row(&o.result, n, depth)]));
         }
-    }
+        Ok(None) // the class is rare or impossible on this tree: its count says so
+    })?;
+    let counts = crate::gen::push_rows(&mut files[..2], per_class);
     let mut params = BTreeMap::new();
     params.insert("leaves".into(), n as u64);
     params.insert("levels".into(), depth as u64);
