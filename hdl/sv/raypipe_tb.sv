@@ -15,7 +15,8 @@
 //   output logic             out_valid
 //   output logic [OUT_W-1:0] out_row     one line of <unit>_expected.hex
 //   output logic [STG_W-1:0] stg_row     one line of <unit>_stages.hex (tie to 0 and run +nostages if you have no probes)
-// Plusargs: +set=DIR (default "set"), +gap=K, +nostages, +maxerrors=K (default 10).
+// Plusargs: +set=DIR (default "set"), +gap=K, +nostages, +maxerrors=K (default 10), +latency=K
+// (your DUT's latency, when it is not the manifest's one stage per table stage).
 `ifndef DUT
 `define DUT raypipe_ref
 `endif
@@ -44,6 +45,7 @@ module raypipe_tb;
   int gap = 5;
   int check_stages = 1;
   int max_errors = 10;
+  int lat = LATENCY;
   int cycle = 0;
   int sent = 0;
   int got = 0;
@@ -58,11 +60,12 @@ module raypipe_tb;
     if (!$value$plusargs("set=%s", dir)) dir = "set";
     if ($value$plusargs("gap=%d", gap)) ;
     if ($value$plusargs("maxerrors=%d", max_errors)) ;
+    if ($value$plusargs("latency=%d", lat)) ;
     if ($test$plusargs("nostages") || !HAS_STAGES) check_stages = 0;
     $readmemh($sformatf("%0s/%0s", dir, IN_FILE), ins);
     $readmemh($sformatf("%0s/%0s", dir, OUT_FILE), outs);
     if (HAS_STAGES) $readmemh($sformatf("%0s/%0s", dir, STG_FILE), stgs);
-    $display("raypipe_tb: unit %s, %0d vectors from %s, latency %0d, stages %0s", UNIT, N, dir, LATENCY,
+    $display("raypipe_tb: unit %s, %0d vectors from %s, latency %0d, stages %0s", UNIT, N, dir, lat,
              check_stages ? "checked" : "not checked");
     repeat (2) @(negedge clk);
     rst_n = 1'b1;
@@ -82,7 +85,7 @@ module raypipe_tb;
     @(negedge clk);
     in_valid = 1'b0;
     in_row = '0;
-    repeat (LATENCY + 4) @(negedge clk);
+    repeat (lat + 4) @(negedge clk);
     if (got < N) begin
       $display("FAIL: %0d vectors gave no result (the first: vector %0d, line %0d)", N - got, got, got + 1);
       failed += N - got;
@@ -99,11 +102,11 @@ module raypipe_tb;
         $display("FAIL: out_valid with no vector outstanding at cycle %0d", cycle);
         failed++;
       end else begin
-        if (cycle != sent_at[got] + LATENCY) begin
+        if (cycle != sent_at[got] + lat) begin
           failed++;
           if (failed <= max_errors)
             $display("FAIL vector %0d (line %0d, class %0d): result at edge %0d, expected at edge %0d (latency %0d)",
-                     got, got + 1, ins[got][IN_W-1 -: 8], cycle, sent_at[got] + LATENCY, LATENCY);
+                     got, got + 1, ins[got][IN_W-1 -: 8], cycle, sent_at[got] + lat, lat);
         end else if (diff_out(out_row, outs[got]) != "none" || (check_stages && diff_stg(stg_row, stgs[got]) != "none"))
         begin
           failed++;
