@@ -7,6 +7,7 @@
 pub mod bvh;
 pub mod explain;
 pub mod judge;
+pub mod plan;
 pub mod render;
 pub mod scene;
 pub mod stats;

@@ -240,6 +240,33 @@ enum Cmd {
         #[command(flatten)]
         rti: RtiArgs,
     },
+    /// What a scene needs: tree depth and history bits, culling, and the narrowest format within an error budget.
+    Plan {
+        /// OBJ scene (default: the built-in scene).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Candidate formats, comma-separated.
+        #[arg(long, value_delimiter = ',', value_parser = parse_format, default_value = "fp16,bf16,e8m16,f32,q8.24:divide")]
+        format: Vec<AnyFormat>,
+        /// RTI pipelines of the design (the recommended leaf size follows from it).
+        #[arg(long, default_value_t = 4)]
+        pipelines: u32,
+        /// Largest acceptable rate of hit/miss disagreements with the golden, per test.
+        #[arg(long, default_value_t = 1e-4)]
+        budget: f64,
+        /// Rays of the measurement.
+        #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u64).range(1..))]
+        rays: u64,
+        /// Seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Level pipelines the hardware has.
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
+        levels: u64,
+        /// Print the plan as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Print the RTI stage table (markdown).
     Stages {
         /// Unit: rti or slab.
@@ -434,7 +461,7 @@ fn run() -> Result<bool, String> {
                 count: count as usize,
                 seed,
                 level,
-                command: std::env::args().collect::<Vec<_>>().join(" "),
+                command: command_without_threads(),
                 rti: rti.config()?,
                 slab_variant: variant,
             };
@@ -452,6 +479,20 @@ fn run() -> Result<bool, String> {
             );
             Ok(true)
         }
+        Some(Cmd::Plan { scene, format, pipelines, budget, rays, seed, levels, json }) => {
+            let scene = load_scene(scene.as_deref())?;
+            let cfg = raypipe::plan::PlanConfig {
+                formats: format,
+                pipelines,
+                budget,
+                rays: rays as usize,
+                seed,
+                max_levels: levels as usize,
+            };
+            let p = raypipe::plan::plan(&cfg, &scene)?;
+            emit(json, &p, raypipe::plan::render)?;
+            Ok(true)
+        }
         Some(Cmd::Stages { unit, div }) => {
             let d = match div.as_str() {
                 "recip" => DivMode::RecipMul,
@@ -466,6 +507,21 @@ fn run() -> Result<bool, String> {
             Ok(true)
         }
     }
+}
+
+/// The command line as recorded in a vector set's manifest: without `--threads`, which does
+/// not change a single byte of the set.
+fn command_without_threads() -> String {
+    let mut out = Vec::new();
+    let mut args = std::env::args();
+    while let Some(a) = args.next() {
+        if a == "--threads" {
+            args.next();
+        } else if !a.starts_with("--threads=") {
+            out.push(a);
+        }
+    }
+    out.join(" ")
 }
 
 fn main() -> ExitCode {

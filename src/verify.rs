@@ -123,6 +123,17 @@ fn median(v: &mut [f64]) -> f64 {
     v[v.len() / 2]
 }
 
+/// One ray's share of a format report: counts (tests, decisive, golden hits, model hits,
+/// false misses, false hits, violations, shared hits, closest-hit disagreements), t errors and
+/// the first violation.
+#[derive(Default)]
+struct RayAcc {
+    c: [u64; 9],
+    ulps: Vec<f64>,
+    rels: Vec<f64>,
+    first_violation: Option<String>,
+}
+
 fn run_format<F: Format>(
     fmt: F,
     cfg: &VerifyConfig,
@@ -151,9 +162,10 @@ fn run_format<F: Format>(
         mtests_per_s: 0.0,
         first_violation: None,
     };
-    let (mut ulps, mut rels) = (Vec::new(), Vec::new());
     let faces = crate::judge::faces(&rti);
-    for ((ray, _), list) in rays.iter().zip(lists) {
+    // rays in parallel, merged in ray order: the report does not depend on the thread count
+    let per_ray = |(ray, _): &(Ray64, usize), list: &Vec<usize>| {
+        let mut acc = RayAcc::default();
         let mray = rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
         let mut cap = Capture::default();
         let (rq, _) = crate::judge::quantise(&rti, ray, &scene.tris[0]);
@@ -161,22 +173,22 @@ fn run_format<F: Format>(
         for (k, &ti) in list.iter().enumerate() {
             let tri = &scene.tris[ti];
             let j: Judged = judge(&rti, ray, tri);
-            rep.tests += 1;
-            rep.decisive += j.decisive as u64;
-            rep.golden_hits += j.golden.hit as u64;
-            rep.model_hits += j.hit as u64;
-            rep.false_misses += (j.golden.hit && !j.hit) as u64;
-            rep.false_hits += (!j.golden.hit && j.hit) as u64;
+            acc.c[0] += 1;
+            acc.c[1] += j.decisive as u64;
+            acc.c[2] += j.golden.hit as u64;
+            acc.c[3] += j.hit as u64;
+            acc.c[4] += (j.golden.hit && !j.hit) as u64;
+            acc.c[5] += (!j.golden.hit && j.hit) as u64;
             if let Some(why) = j.violation() {
-                rep.violations += 1;
-                if rep.first_violation.is_none() {
-                    rep.first_violation = Some(format!("{why}: {}", explain_cmd(&name, ray, tri, scene.scale)));
+                acc.c[6] += 1;
+                if acc.first_violation.is_none() {
+                    acc.first_violation = Some(format!("{why}: {}", explain_cmd(&name, ray, tri, scene.scale)));
                 }
             }
             if j.hit && j.golden.hit {
-                rep.shared_hits += 1;
-                ulps.push(j.t_error() / j.ulp);
-                rels.push(j.t_error() / j.golden.t.abs().max(f64::MIN_POSITIVE));
+                acc.c[7] += 1;
+                acc.ulps.push(j.t_error() / j.ulp);
+                acc.rels.push(j.t_error() / j.golden.t.abs().max(f64::MIN_POSITIVE));
             }
             let out = rti.test(&mray, &rti.tri(tri.v));
             rti.capture(&mut cap, &out, k as u32);
@@ -188,8 +200,36 @@ fn run_format<F: Format>(
             (Some((gi, _)), true) => list[gi] == list[cap.id as usize],
             _ => false,
         };
-        rep.closest_disagreements += !same as u64;
+        acc.c[8] += !same as u64;
+        acc
+    };
+    let parts: Vec<RayAcc> = {
+        use rayon::prelude::*;
+        rays.par_iter().zip(lists.par_iter()).map(|(r, l)| per_ray(r, l)).collect()
+    };
+    let (mut ulps, mut rels) = (Vec::new(), Vec::new());
+    let mut c = [0u64; 9];
+    for p in parts {
+        for (a, b) in c.iter_mut().zip(p.c) {
+            *a += b;
+        }
+        ulps.extend(p.ulps);
+        rels.extend(p.rels);
+        if rep.first_violation.is_none() {
+            rep.first_violation = p.first_violation;
+        }
     }
+    [
+        rep.tests,
+        rep.decisive,
+        rep.golden_hits,
+        rep.model_hits,
+        rep.false_misses,
+        rep.false_hits,
+        rep.violations,
+        rep.shared_hits,
+        rep.closest_disagreements,
+    ] = c;
     rep.t_err_ulps_max = ulps.iter().copied().fold(0.0, f64::max);
     rep.t_err_rel_max = rels.iter().copied().fold(0.0, f64::max);
     rep.t_err_ulps_median = median(&mut ulps);
@@ -391,29 +431,44 @@ fn slab_one<F: Format>(
         exact_calls: 0,
         mtests_per_s: 0.0,
     };
-    let (mut rs, mut bs) = (SlabRaysSoa::default(), BoxesSoa::default());
-    for ((ray, _), list) in rays.iter().zip(lists) {
+    // decisions per ray in parallel (the exact rational test is the slow part), summed in order
+    let per_ray = |(ray, _): &(Ray64, usize), list: &Vec<usize>| {
+        let mut c = [0u64; 5]; // tests, exact hits, false misses, false hits, exact calls
         let sr = s.prepare(ray.o, ray.d, ray.tmin, ray.tmax);
         let q = |x: f64| f.to_f64(f.from_f64(x));
         let (oq, dq) = (ray.o.map(q), ray.d.map(q));
         for &i in list {
             let (lo, hi) = boxes[i];
             let hit = s.test(&sr, &stored[i]).hit;
-            rs.push(&sr);
-            bs.push(&stored[i]);
             let g = golden::slab_f64(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi);
             let scale = 1.0f64.max(g.t_near.abs()).max(if g.t_far.is_finite() { g.t_far.abs() } else { 0.0 });
             let close = (g.t_far - g.t_near).abs() <= 1e-9 * scale;
             let exact = if close || g.hit != hit {
-                rep.exact_calls += 1;
+                c[4] += 1;
                 golden::slab_exact(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi)
             } else {
                 g.hit
             };
-            rep.tests += 1;
-            rep.exact_hits += exact as u64;
-            rep.false_misses += (exact && !hit) as u64;
-            rep.false_hits += (!exact && hit) as u64;
+            c[0] += 1;
+            c[1] += exact as u64;
+            c[2] += (exact && !hit) as u64;
+            c[3] += (!exact && hit) as u64;
+        }
+        c
+    };
+    let parts: Vec<[u64; 5]> = {
+        use rayon::prelude::*;
+        rays.par_iter().zip(lists.par_iter()).map(|(r, l)| per_ray(r, l)).collect()
+    };
+    let c = parts.iter().fold([0u64; 5], |a, p| std::array::from_fn(|k| a[k] + p[k]));
+    [rep.tests, rep.exact_hits, rep.false_misses, rep.false_hits, rep.exact_calls] = c;
+    // the timed single-thread batch over the same pairs
+    let (mut rs, mut bs) = (SlabRaysSoa::default(), BoxesSoa::default());
+    for ((ray, _), list) in rays.iter().zip(lists) {
+        let sr = s.prepare(ray.o, ray.d, ray.tmin, ray.tmax);
+        for &i in list {
+            rs.push(&sr);
+            bs.push(&stored[i]);
         }
     }
     let mut out = SlabOutSoa::with_len(rs.tmin.len());

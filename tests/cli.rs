@@ -331,3 +331,40 @@ fn vectors_traverse_takes_a_scene_and_refuses_what_it_cannot_use() {
         "level pipelines",
     );
 }
+
+#[test]
+fn vectors_do_not_depend_on_the_thread_count() {
+    let out = std::env::temp_dir().join(format!("raypipe-cli-{}-threads", std::process::id()));
+    let mut sets = Vec::new();
+    for t in ["1", "2"] {
+        let _ = std::fs::remove_dir_all(&out);
+        let o = raypipe(&[
+            "vectors",
+            "--unit",
+            "rti",
+            "--format",
+            "fp16",
+            "--level",
+            "2",
+            "--count",
+            "3",
+            "--threads",
+            t,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{:?}", text(&o));
+        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| {
+                let e = e.unwrap();
+                (e.file_name().to_string_lossy().into_owned(), std::fs::read(e.path()).unwrap())
+            })
+            .collect();
+        files.sort();
+        sets.push(files);
+    }
+    assert_eq!(sets[0], sets[1]);
+    let manifest = String::from_utf8(sets[0].iter().find(|f| f.0 == "manifest.json").unwrap().1.clone()).unwrap();
+    assert!(!manifest.contains("--threads"), "the thread count is not part of the recorded command");
+}

@@ -1,0 +1,44 @@
+//! Multi-core runs give the same results as one thread (rayon pools of 1 and 2 threads).
+
+use raypipe::scene::Scene;
+use raypipe::verify::{verify, verify_slab, VerifyConfig};
+
+fn pool(n: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap()
+}
+
+/// The report as JSON without the timing fields.
+fn untimed<T: serde::Serialize>(r: &T) -> serde_json::Value {
+    fn strip(v: &mut serde_json::Value) {
+        match v {
+            serde_json::Value::Object(m) => {
+                m.remove("mtests_per_s");
+                m.values_mut().for_each(strip);
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    let mut v = serde_json::to_value(r).unwrap();
+    strip(&mut v);
+    v
+}
+
+#[test]
+fn verify_is_the_same_on_one_and_two_threads() {
+    let scene = Scene::builtin();
+    let cfg = VerifyConfig {
+        formats: ["f32", "fp16", "q8.24:divide"].iter().map(|f| f.parse().unwrap()).collect(),
+        rays: 64,
+        seed: 5,
+        rti: Default::default(),
+        sample: 512,
+    };
+    let one = pool(1).install(|| verify(&cfg, &scene));
+    let two = pool(2).install(|| verify(&cfg, &scene));
+    assert_eq!(untimed(&one), untimed(&two));
+    assert!(one.formats.iter().all(|f| f.tests > 0));
+    let s1 = pool(1).install(|| verify_slab(&cfg, &scene));
+    let s2 = pool(2).install(|| verify_slab(&cfg, &scene));
+    assert_eq!(untimed(&s1), untimed(&s2));
+}
