@@ -11,5 +11,6 @@ pub mod plan;
 pub mod render;
 pub mod scene;
 pub mod stats;
+pub mod stress;
 pub mod traverse;
 pub mod verify;

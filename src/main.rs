@@ -267,6 +267,24 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// The numerical stability stress suite: failures against the exact decision per class, format and variant.
+    Stress {
+        /// Formats, comma-separated.
+        #[arg(long, value_delimiter = ',', value_parser = parse_format, default_value = "f32,fp16,bf16,q8.24:divide")]
+        format: Vec<AnyFormat>,
+        /// Slab variants, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "plain,conservative,directed,embree")]
+        variant: Vec<String>,
+        /// Cases per class.
+        #[arg(long, default_value_t = 500, value_parser = clap::value_parser!(u64).range(1..))]
+        count: u64,
+        /// Seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Print the results as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Print the RTI stage table (markdown).
     Stages {
         /// Unit: rti or slab.
@@ -491,6 +509,12 @@ fn run() -> Result<bool, String> {
             };
             let p = raypipe::plan::plan(&cfg, &scene)?;
             emit(json, &p, raypipe::plan::render)?;
+            Ok(true)
+        }
+        Some(Cmd::Stress { format, variant, count, seed, json }) => {
+            let cfg = raypipe::stress::StressConfig { formats: format, variants: variant, count: count as usize, seed };
+            let rep = raypipe::stress::stress(&cfg)?;
+            emit(json, &rep, raypipe::stress::render)?;
             Ok(true)
         }
         Some(Cmd::Stages { unit, div }) => {

@@ -6,5 +6,5 @@ pub mod bvh;
 pub mod mt;
 pub mod slab;
 
-pub use mt::{closest_hit, intersect, Faces, MtResult, Ray64, Tri64};
+pub use mt::{closest_hit, intersect, intersect_exact, Faces, MtResult, Ray64, Tri64};
 pub use slab::{slab_exact, slab_f64, SlabResult};

@@ -94,6 +94,53 @@ pub fn intersect(ray: &Ray64, tri: &Tri64, faces: Faces) -> MtResult {
     MtResult { hit, t, u, v, det, det_rel, bary_margin, edge_dist }
 }
 
+/// The exact Möller–Trumbore decision in rational arithmetic (no rounding anywhere): the ray
+/// hits when `|det| > threshold` (culling: `det > threshold`), the barycentrics are in the closed
+/// triangle and `tmin <= t <= tmax`, all decided on det-scaled quantities
+/// (u' = s·p, v' = d·q, t' = e2·q against 0 and det). `None` when an input is not finite
+/// (tmax may be +∞).
+pub fn intersect_exact(ray: &Ray64, tri: &Tri64, faces: Faces) -> Option<bool> {
+    use num_rational::BigRational;
+    use num_traits::{Signed, Zero};
+    let finite = ray.o.iter().chain(&ray.d).chain(tri.v.iter().flatten()).all(|x| x.is_finite())
+        && ray.tmin.is_finite()
+        && !ray.tmax.is_nan()
+        && faces.det_threshold.is_finite();
+    if !finite {
+        return None;
+    }
+    let q = |x: f64| BigRational::from_float(x).expect("finite");
+    let v3 = |p: [f64; 3]| p.map(q);
+    let sub3 =
+        |a: &[BigRational; 3], b: &[BigRational; 3]| -> [BigRational; 3] { std::array::from_fn(|i| &a[i] - &b[i]) };
+    let cross3 = |a: &[BigRational; 3], b: &[BigRational; 3]| -> [BigRational; 3] {
+        [&a[1] * &b[2] - &a[2] * &b[1], &a[2] * &b[0] - &a[0] * &b[2], &a[0] * &b[1] - &a[1] * &b[0]]
+    };
+    let dot3 =
+        |a: &[BigRational; 3], b: &[BigRational; 3]| -> BigRational { &a[0] * &b[0] + &a[1] * &b[1] + &a[2] * &b[2] };
+    let [v0, v1, v2] = tri.v.map(v3);
+    let (o, d) = (v3(ray.o), v3(ray.d));
+    let e1 = sub3(&v1, &v0);
+    let e2 = sub3(&v2, &v0);
+    let p = cross3(&d, &e2);
+    let det = dot3(&e1, &p);
+    let s = sub3(&o, &v0);
+    let qv = cross3(&s, &e1);
+    let (u, v, t) = (dot3(&s, &p), dot3(&d, &qv), dot3(&e2, &qv));
+    let thr = q(faces.det_threshold);
+    let face_ok = if faces.cull { det > thr } else { det.abs() > thr };
+    if !face_ok || det.is_zero() {
+        return Some(false);
+    }
+    // divide through by det's sign: compare u, v, u + v, t against 0, det and the t interval
+    let sgn =
+        if det.is_positive() { BigRational::from_integer(1.into()) } else { BigRational::from_integer((-1).into()) };
+    let (u, v, t, det) = (&u * &sgn, &v * &sgn, &t * &sgn, &det * &sgn);
+    let zero = BigRational::zero();
+    let in_t = t >= q(ray.tmin) * &det && (ray.tmax.is_infinite() || t <= q(ray.tmax) * &det);
+    Some(u >= zero && v >= zero && &u + &v <= det && in_t)
+}
+
 /// Nearest hit of `ray` over `tris`: (index, t); on equal t the lower index wins.
 pub fn closest_hit(ray: &Ray64, tris: &[Tri64], faces: Faces) -> Option<(usize, f64)> {
     let mut best: Option<(usize, f64)> = None;
@@ -123,6 +170,30 @@ mod tests {
         assert_eq!(r.bary_margin, 0.25);
         assert_eq!(r.edge_dist, 0.25);
         assert_eq!(r.det_rel, 1.0);
+    }
+
+    #[test]
+    fn the_exact_decision_includes_edges_and_decides_what_f64_cannot() {
+        let t = unit_tri();
+        let down = |x: f64, y: f64| Ray64 { o: [x, y, 2.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY };
+        let f = Faces::default();
+        // on the hypotenuse u + v = 1 exactly, on a vertex, just outside
+        assert_eq!(intersect_exact(&down(0.5, 0.5), &t, f), Some(true));
+        assert_eq!(intersect_exact(&down(0.0, 1.0), &t, f), Some(true));
+        assert_eq!(intersect_exact(&down(0.5, 0.5 + f64::EPSILON), &t, f), Some(false));
+        // a point 2^-54 outside the hypotenuse (one ulp of 0.25): f64 computes w = (1 - u) - v
+        // with 1 - u = 0.75 - 2^-54 a tie that rounds to 0.75, so w = 0 and it reports a hit
+        let e = (-54f64).exp2();
+        assert!(intersect(&down(0.25 + e, 0.75), &t, f).hit, "f64 rounds it in");
+        assert_eq!(intersect_exact(&down(0.25 + e, 0.75), &t, f), Some(false));
+        // t interval, culling, threshold, non-finite input
+        assert_eq!(intersect_exact(&Ray64 { tmax: 2.0, ..down(0.2, 0.2) }, &t, f), Some(true));
+        assert_eq!(intersect_exact(&Ray64 { tmax: 1.5, ..down(0.2, 0.2) }, &t, f), Some(false));
+        let below = Ray64 { o: [0.25, 0.25, -2.0], d: [0.0, 0.0, 1.0], tmin: 0.0, tmax: f64::INFINITY };
+        assert_eq!(intersect_exact(&below, &t, f), Some(true));
+        assert_eq!(intersect_exact(&below, &t, Faces { cull: true, det_threshold: 0.0 }), Some(false));
+        assert_eq!(intersect_exact(&down(0.2, 0.2), &t, Faces { cull: false, det_threshold: 1.0 }), Some(false));
+        assert_eq!(intersect_exact(&down(f64::NAN, 0.2), &t, f), None);
     }
 
     #[test]

@@ -1,0 +1,433 @@
+//! The numerical stability stress suite: named, seeded generators of hard cases, and per class
+//! and format (and slab variant) the failures against the exact decision — the rational
+//! Möller–Trumbore and slab tests on the same quantised inputs the model sees.
+//!
+//! Watertightness classes (rays at shared edges and vertices of a closed icosphere, rays from
+//! inside it) also count *cracks*: cases where the exact decision hits the mesh but the model
+//! hits none of the candidate triangles.
+
+use crate::scene::icosphere;
+use datapath::rng::SplitMix64;
+use datapath::rti::{Rti, RtiConfig};
+use datapath::slab::{Slab, SlabConfig};
+use datapath::{with_format, AnyFormat, Format};
+use golden::{Faces, Ray64, Tri64};
+use serde::Serialize;
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct StressConfig {
+    /// Formats.
+    pub formats: Vec<AnyFormat>,
+    /// Slab variants.
+    pub variants: Vec<String>,
+    /// Cases per class.
+    pub count: usize,
+    /// Seed (each class draws from its own stream derived from it).
+    pub seed: u64,
+}
+
+/// RTI stress classes.
+pub const RTI_STRESS: [(&str, &str); 13] = [
+    ("shared_edge", "from outside at a point of an edge shared by two triangles of a closed icosphere; must hit one"),
+    ("shared_vertex", "from outside at a vertex of a closed icosphere, against its fan; must hit one"),
+    ("inside_closed", "from inside a closed icosphere, random direction; must hit it"),
+    ("near_parallel", "direction within ~1e-4 of the triangle's plane (|det| -> 0)"),
+    ("tiny", "triangle of size 2^-20 near the origin"),
+    ("needle", "triangle 1e-4 wide and 1 long"),
+    ("far_from_origin", "triangle of size 2^-6 at distance ~2^9 from the origin, ray from near it"),
+    ("t_near_zero", "origin within 2^-20 of the triangle's plane (self-intersection)"),
+    ("axis_parallel", "axis-parallel direction (two components 0)"),
+    ("subnormal", "coordinates around the format's smallest normal (subnormal operands and products)"),
+    ("huge", "coordinates around max/2^8 of the format (overflowing products)"),
+    ("signed_zero", "a third of the coordinates replaced by +0 or -0"),
+    ("inf_nan", "one input +inf, -inf or NaN (no exact decision; the model's hits are counted)"),
+];
+
+/// Slab stress classes.
+pub const SLAB_STRESS: [(&str, &str); 8] = [
+    ("origin_on_face", "origin on a face plane, a direction component +0 or -0"),
+    ("grazing", "aimed at a face, edge or corner point of the box"),
+    ("inside", "origin inside the box"),
+    ("zero_extent", "box of zero extent on one or more axes"),
+    ("far_from_origin", "box of size 2^-6 at distance ~2^9"),
+    ("tiny", "box of size 2^-20"),
+    ("axis_parallel", "axis-parallel direction"),
+    ("inf_nan", "one ray input +inf, -inf or NaN (no exact decision; the model's hits are counted)"),
+];
+
+/// Failures of one RTI class in one format.
+#[derive(Clone, Debug, Serialize)]
+pub struct RtiStressRow {
+    /// Class.
+    pub class: String,
+    /// Format.
+    pub format: String,
+    /// Ray–triangle tests.
+    pub tests: u64,
+    /// Tests with a non-finite input after quantisation (no exact decision).
+    pub undecided: u64,
+    /// Exact hit, model miss.
+    pub false_misses: u64,
+    /// Exact miss, model hit.
+    pub false_hits: u64,
+    /// Model hits among the undecided tests.
+    pub undecided_hits: u64,
+    /// Watertightness cases whose exact decision hits the mesh but the model hits nothing.
+    pub cracks: u64,
+}
+
+/// Failures of one slab class in one format and variant.
+#[derive(Clone, Debug, Serialize)]
+pub struct SlabStressRow {
+    /// Class.
+    pub class: String,
+    /// Format.
+    pub format: String,
+    /// Variant.
+    pub variant: String,
+    /// Ray–box tests.
+    pub tests: u64,
+    /// Non-finite ray input (no exact decision).
+    pub undecided: u64,
+    /// Exact hit of the unrounded box, model miss.
+    pub false_misses: u64,
+    /// Exact miss, model hit.
+    pub false_hits: u64,
+    /// Model hits among the undecided tests.
+    pub undecided_hits: u64,
+}
+
+/// The whole suite.
+#[derive(Clone, Debug, Serialize)]
+pub struct StressReport {
+    /// Seed.
+    pub seed: u64,
+    /// Cases per class.
+    pub count: usize,
+    /// RTI rows, class-major.
+    pub rti: Vec<RtiStressRow>,
+    /// Slab rows, class-major.
+    pub slab: Vec<SlabStressRow>,
+}
+
+/// One RTI case: a ray and candidate triangles; `mesh` marks a watertightness case.
+struct Case {
+    ray: Ray64,
+    tris: Vec<Tri64>,
+    mesh: bool,
+}
+
+fn unit(r: &mut SplitMix64) -> [f64; 3] {
+    let z = r.range(-1.0, 1.0);
+    let phi = r.range(0.0, std::f64::consts::TAU);
+    let s = (1.0 - z * z).sqrt();
+    [s * phi.cos(), s * phi.sin(), z]
+}
+
+fn ray(o: [f64; 3], d: [f64; 3]) -> Ray64 {
+    Ray64 { o, d, tmin: 0.0, tmax: f64::INFINITY }
+}
+
+/// A ray from `o` through the point with barycentrics (b1, b2) of `t`.
+fn aimed(o: [f64; 3], t: &Tri64, b1: f64, b2: f64) -> Ray64 {
+    let p: [f64; 3] = std::array::from_fn(|a| t.v[0][a] + b1 * (t.v[1][a] - t.v[0][a]) + b2 * (t.v[2][a] - t.v[0][a]));
+    ray(o, std::array::from_fn(|a| p[a] - o[a]))
+}
+
+fn random_tri(r: &mut SplitMix64, center: [f64; 3], size: f64) -> Tri64 {
+    Tri64 { v: std::array::from_fn(|_| std::array::from_fn(|a| center[a] + size * r.range(-1.0, 1.0))) }
+}
+
+fn rti_case(class: usize, r: &mut SplitMix64, sphere: &[Tri64], min_normal: f64, max: f64) -> Case {
+    let outside = |r: &mut SplitMix64| unit(r).map(|x| 3.0 * x);
+    let single = |ray: Ray64, t: Tri64| Case { ray, tris: vec![t], mesh: false };
+    match class {
+        0 => {
+            let (i, k) = (r.below(sphere.len() as u64) as usize, r.below(3) as usize);
+            let t = &sphere[i];
+            let (a, b) = (t.v[k], t.v[(k + 1) % 3]);
+            let s = r.range(0.0, 1.0);
+            let p: [f64; 3] = std::array::from_fn(|x| a[x] + s * (b[x] - a[x]));
+            let o = outside(r);
+            let tris = sphere.iter().filter(|u| u.v.contains(&a) && u.v.contains(&b)).copied().collect();
+            Case { ray: ray(o, std::array::from_fn(|x| p[x] - o[x])), tris, mesh: true }
+        }
+        1 => {
+            let p = sphere[r.below(sphere.len() as u64) as usize].v[r.below(3) as usize];
+            let o = outside(r);
+            let tris = sphere.iter().filter(|u| u.v.contains(&p)).copied().collect();
+            Case { ray: ray(o, std::array::from_fn(|x| p[x] - o[x])), tris, mesh: true }
+        }
+        2 => Case { ray: ray(unit(r).map(|x| 0.5 * x), unit(r)), tris: sphere.to_vec(), mesh: true },
+        3 => {
+            let t = random_tri(r, [0.0; 3], 1.0);
+            let e1: [f64; 3] = std::array::from_fn(|a| t.v[1][a] - t.v[0][a]);
+            let e2: [f64; 3] = std::array::from_fn(|a| t.v[2][a] - t.v[0][a]);
+            let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+            let (b1, b2) = (r.range(0.0, 0.5), r.range(0.0, 0.5));
+            let p: [f64; 3] = std::array::from_fn(|a| t.v[0][a] + b1 * e1[a] + b2 * e2[a]);
+            // along the plane (from an in-plane direction), lifted by ~1e-4 of the normal
+            let (s, u) = (r.range(-2.0, 2.0), r.range(-2.0, 2.0));
+            let eps = 1e-4 * r.range(-1.0, 1.0);
+            let o: [f64; 3] = std::array::from_fn(|a| p[a] + s * e1[a] + u * e2[a] + eps * n[a]);
+            single(ray(o, std::array::from_fn(|a| p[a] - o[a])), t)
+        }
+        4 => {
+            let t = random_tri(r, [0.0; 3], (-20f64).exp2());
+            single(aimed(unit(r), &t, r.range(-0.2, 1.0), r.range(-0.2, 1.0)), t)
+        }
+        5 => {
+            let a = unit(r);
+            let b: [f64; 3] = std::array::from_fn(|k| a[k] + unit(r)[k]);
+            let c: [f64; 3] = std::array::from_fn(|k| b[k] + 1e-4 * r.range(-1.0, 1.0));
+            let t = Tri64 { v: [a, b, c] };
+            single(aimed(outside(r), &t, r.range(-0.1, 1.0), r.range(-0.1, 1.0)), t)
+        }
+        6 => {
+            let c = unit(r).map(|x| 512.0 * x);
+            let t = random_tri(r, c, (-6f64).exp2());
+            let o: [f64; 3] = std::array::from_fn(|a| c[a] + unit(r)[a]);
+            single(aimed(o, &t, r.range(-0.2, 1.0), r.range(-0.2, 1.0)), t)
+        }
+        7 => {
+            let t = random_tri(r, [0.0; 3], 1.0);
+            let mut rr = aimed([0.0; 3], &t, r.range(-0.2, 1.0), r.range(-0.2, 1.0));
+            // origin = the aimed point plus a tiny offset, direction random
+            rr.o = std::array::from_fn(|a| rr.d[a] + (-20f64).exp2() * r.range(-1.0, 1.0));
+            rr.d = unit(r);
+            single(rr, t)
+        }
+        8 => {
+            let t = random_tri(r, [0.0; 3], 1.0);
+            let a = r.below(3) as usize;
+            let mut d = [0.0; 3];
+            d[a] = if r.below(2) == 0 { 1.0 } else { -1.0 };
+            let mut o: [f64; 3] = std::array::from_fn(|_| r.range(-0.5, 0.5));
+            o[a] = -3.0 * d[a];
+            single(ray(o, d), t)
+        }
+        9 | 10 => {
+            let s = if class == 9 { min_normal * 4.0 } else { max / 256.0 };
+            let t = random_tri(r, [0.0; 3], s);
+            let o = unit(r).map(|x| 3.0 * s * x);
+            single(aimed(o, &t, r.range(-0.2, 1.0), r.range(-0.2, 1.0)), t)
+        }
+        11 => {
+            let t = random_tri(r, [0.0; 3], 1.0);
+            let mut c = single(aimed(outside(r), &t, r.range(-0.2, 1.0), r.range(-0.2, 1.0)), t);
+            let zap = |x: &mut f64, r: &mut SplitMix64| {
+                if r.below(3) == 0 {
+                    *x = if r.below(2) == 0 { 0.0 } else { -0.0 };
+                }
+            };
+            c.ray.o.iter_mut().chain(c.ray.d.iter_mut()).for_each(|x| zap(x, r));
+            c.tris[0].v.iter_mut().flatten().for_each(|x| zap(x, r));
+            c
+        }
+        _ => {
+            let t = random_tri(r, [0.0; 3], 1.0);
+            let mut c = single(aimed(outside(r), &t, r.range(-0.2, 1.0), r.range(-0.2, 1.0)), t);
+            let v = [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][r.below(3) as usize];
+            let i = r.below(15) as usize;
+            if i < 3 {
+                c.ray.o[i] = v;
+            } else if i < 6 {
+                c.ray.d[i - 3] = v;
+            } else {
+                c.tris[0].v[(i - 6) / 3][(i - 6) % 3] = v;
+            }
+            c
+        }
+    }
+}
+
+fn class_rng(seed: u64, unit: u64, class: usize) -> SplitMix64 {
+    SplitMix64::new(SplitMix64::new(seed ^ (unit << 32) ^ class as u64).next_u64())
+}
+
+fn rti_rows<F: Format>(f: F, cfg: &StressConfig) -> Vec<RtiStressRow> {
+    use rayon::prelude::*;
+    let rti = Rti::new(f, RtiConfig::default());
+    let sphere = icosphere([0.0; 3], 1.0, 2);
+    let em = f.error_model();
+    let min_normal = match f.kind() {
+        datapath::format::FormatKind::Float(l) => l.min_normal(),
+        datapath::format::FormatKind::Fixed { .. } => em.eta,
+    };
+    let q = |x: f64| f.to_f64(f.from_f64(x));
+    (0..RTI_STRESS.len())
+        .into_par_iter()
+        .map(|class| {
+            let mut r = class_rng(cfg.seed, 1, class);
+            let mut row = RtiStressRow {
+                class: RTI_STRESS[class].0.into(),
+                format: f.name(),
+                tests: 0,
+                undecided: 0,
+                false_misses: 0,
+                false_hits: 0,
+                undecided_hits: 0,
+                cracks: 0,
+            };
+            for _ in 0..cfg.count {
+                let c = rti_case(class, &mut r, &sphere, min_normal, em.max);
+                let mray = rti.ray(c.ray.o, c.ray.d, c.ray.tmin, c.ray.tmax);
+                let qray = Ray64 { o: c.ray.o.map(q), d: c.ray.d.map(q), tmin: q(c.ray.tmin), tmax: q(c.ray.tmax) };
+                let (mut exact_any, mut model_any) = (false, false);
+                for t in &c.tris {
+                    let hit = rti.test(&mray, &rti.tri(t.v)).hit;
+                    let qt = Tri64 { v: t.v.map(|p| p.map(q)) };
+                    row.tests += 1;
+                    model_any |= hit;
+                    match golden::intersect_exact(&qray, &qt, Faces::default()) {
+                        None => {
+                            row.undecided += 1;
+                            row.undecided_hits += hit as u64;
+                        }
+                        Some(e) => {
+                            exact_any |= e;
+                            row.false_misses += (e && !hit) as u64;
+                            row.false_hits += (!e && hit) as u64;
+                        }
+                    }
+                }
+                row.cracks += (c.mesh && exact_any && !model_any) as u64;
+            }
+            row
+        })
+        .collect()
+}
+
+fn slab_case(class: usize, r: &mut SplitMix64) -> ([f64; 8], [f64; 3], [f64; 3]) {
+    let (scale, center) = match class {
+        4 => ((-6f64).exp2(), unit(r).map(|x| 512.0 * x)),
+        5 => ((-20f64).exp2(), [0.0; 3]),
+        _ => (1.0, [0.0; 3]),
+    };
+    let mut lo = [0.0; 3];
+    let mut hi = [0.0; 3];
+    for a in 0..3 {
+        let c = center[a] + scale * r.range(-1.0, 1.0);
+        let e = if class == 3 && r.below(2) == 0 { 0.0 } else { scale * r.range(0.01, 0.5) };
+        lo[a] = c - e;
+        hi[a] = c + e;
+    }
+    let mut o: [f64; 3] = std::array::from_fn(|a| center[a] + scale * r.range(-2.0, 2.0));
+    let mut d = unit(r);
+    match class {
+        0 => {
+            let a = r.below(3) as usize;
+            o[a] = if r.below(2) == 0 { lo[a] } else { hi[a] };
+            for b in (0..3).filter(|&b| b != a) {
+                o[b] = r.range(lo[b], hi[b]);
+            }
+            d[r.below(3) as usize] = if r.below(2) == 0 { 0.0 } else { -0.0 };
+        }
+        1 => {
+            let mut p: [f64; 3] = std::array::from_fn(|a| r.range(lo[a], hi[a]));
+            for a in 0..1 + r.below(3) as usize {
+                p[a] = if r.below(2) == 0 { lo[a] } else { hi[a] };
+            }
+            d = std::array::from_fn(|a| p[a] - o[a]);
+        }
+        2 => o = std::array::from_fn(|a| r.range(lo[a], hi[a])),
+        6 => {
+            d = [0.0; 3];
+            let a = r.below(3) as usize;
+            d[a] = if r.below(2) == 0 { 1.0 } else { -1.0 };
+            for b in (0..3).filter(|&b| b != a) {
+                o[b] = r.range(lo[b] - 0.1 * scale, hi[b] + 0.1 * scale);
+            }
+        }
+        7 => {
+            let i = r.below(6) as usize;
+            let v = [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][r.below(3) as usize];
+            if i < 3 {
+                o[i] = v;
+            } else {
+                d[i - 3] = v;
+            }
+        }
+        _ => {}
+    }
+    ([o[0], o[1], o[2], d[0], d[1], d[2], 0.0, f64::INFINITY], lo, hi)
+}
+
+fn slab_rows<F: Format>(f: F, variant: &str, cfg: &StressConfig) -> Result<Vec<SlabStressRow>, String> {
+    use rayon::prelude::*;
+    let s = Slab::new(f, SlabConfig::named(variant)?);
+    let q = |x: f64| f.to_f64(f.from_f64(x));
+    Ok((0..SLAB_STRESS.len())
+        .into_par_iter()
+        .map(|class| {
+            let mut r = class_rng(cfg.seed, 2, class);
+            let mut row = SlabStressRow {
+                class: SLAB_STRESS[class].0.into(),
+                format: f.name(),
+                variant: variant.into(),
+                tests: 0,
+                undecided: 0,
+                false_misses: 0,
+                false_hits: 0,
+                undecided_hits: 0,
+            };
+            for _ in 0..cfg.count {
+                let (x, lo, hi) = slab_case(class, &mut r);
+                // the box corners as the format holds them, so that a point on a face (origin
+                // or aim) stays on it after quantisation; store_box keeps them exactly
+                let (lo, hi) = (lo.map(q), hi.map(q));
+                let Ok(b) = s.store_box(lo, hi) else { continue };
+                let sr = s.prepare([x[0], x[1], x[2]], [x[3], x[4], x[5]], x[6], x[7]);
+                let hit = s.test(&sr, &b).hit;
+                row.tests += 1;
+                let (oq, dq) = ([q(x[0]), q(x[1]), q(x[2])], [q(x[3]), q(x[4]), q(x[5])]);
+                if oq.iter().chain(&dq).any(|v| !v.is_finite()) {
+                    row.undecided += 1;
+                    row.undecided_hits += hit as u64;
+                    continue;
+                }
+                let e = golden::slab_exact(oq, dq, q(x[6]), q(x[7]), lo, hi);
+                row.false_misses += (e && !hit) as u64;
+                row.false_hits += (!e && hit) as u64;
+            }
+            row
+        })
+        .collect())
+}
+
+/// Runs the suite.
+pub fn stress(cfg: &StressConfig) -> Result<StressReport, String> {
+    if cfg.count == 0 {
+        return Err("--count must be at least 1".into());
+    }
+    let mut rti = Vec::new();
+    let mut slab = Vec::new();
+    for f in &cfg.formats {
+        rti.extend(with_format!(*f, |f| rti_rows(f, cfg)));
+        for v in &cfg.variants {
+            slab.extend(with_format!(*f, |f| slab_rows(f, v, cfg))?);
+        }
+    }
+    Ok(StressReport { seed: cfg.seed, count: cfg.count, rti, slab })
+}
+
+/// The report as markdown tables.
+pub fn render(r: &StressReport) -> String {
+    let mut s = format!("raypipe stress: {} cases per class, seed {}\n\n", r.count, r.seed);
+    s += "| RTI class | format | tests | false misses | false hits | cracks | undecided (model hits) |\n|---|---|---:|---:|---:|---:|---:|\n";
+    for x in &r.rti {
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {} | {} ({}) |\n",
+            x.class, x.format, x.tests, x.false_misses, x.false_hits, x.cracks, x.undecided, x.undecided_hits
+        );
+    }
+    s += "\n| slab class | format | variant | tests | false misses | false hits | undecided (model hits) |\n|---|---|---|---:|---:|---:|---:|\n";
+    for x in &r.slab {
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {} | {} ({}) |\n",
+            x.class, x.format, x.variant, x.tests, x.false_misses, x.false_hits, x.undecided, x.undecided_hits
+        );
+    }
+    s
+}
