@@ -9,6 +9,7 @@ pub mod explain;
 pub mod judge;
 pub mod plan;
 pub mod render;
+pub mod report;
 pub mod scene;
 pub mod stats;
 pub mod stress;

@@ -267,6 +267,33 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// Run time against error for every variant on the same inputs: markdown, JSON and SVG with the Pareto front.
+    Report {
+        /// OBJ scenes (repeatable; the built-in scene is always included).
+        #[arg(long)]
+        scene: Vec<PathBuf>,
+        /// Formats, comma-separated.
+        #[arg(long, value_delimiter = ',', value_parser = parse_format, default_value = "f32,fp16,bf16,e8m16,q8.24:divide,f32:ftz+divide")]
+        format: Vec<AnyFormat>,
+        /// Slab variants, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "plain,conservative,directed,take-on-false,embree")]
+        variant: Vec<String>,
+        /// Rays per scene.
+        #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u64).range(1..))]
+        rays: u64,
+        /// Stress cases per class.
+        #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(1..))]
+        stress_count: u64,
+        /// Seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Directory for report.md, report.json and the SVG plots.
+        #[arg(long, default_value = "report-out")]
+        out: PathBuf,
+        /// Print JSON instead of markdown.
+        #[arg(long)]
+        json: bool,
+    },
     /// The numerical stability stress suite: failures against the exact decision per class, format and variant.
     Stress {
         /// Formats, comma-separated.
@@ -509,6 +536,26 @@ fn run() -> Result<bool, String> {
             };
             let p = raypipe::plan::plan(&cfg, &scene)?;
             emit(json, &p, raypipe::plan::render)?;
+            Ok(true)
+        }
+        Some(Cmd::Report { scene, format, variant, rays, stress_count, seed, out, json }) => {
+            let mut scenes = vec![Scene::builtin()];
+            for p in &scene {
+                scenes.push(load_scene(Some(p))?);
+            }
+            let cfg = raypipe::report::ReportConfig {
+                formats: format,
+                variants: variant,
+                rays: rays as usize,
+                stress_count: stress_count as usize,
+                seed,
+            };
+            let rep = raypipe::report::report(&cfg, &scenes)?;
+            let files = raypipe::report::write(&rep, &out)?;
+            emit(json, &rep, raypipe::report::markdown)?;
+            for f in files {
+                eprintln!("wrote {}", f.display());
+            }
             Ok(true)
         }
         Some(Cmd::Stress { format, variant, count, seed, json }) => {

@@ -1,0 +1,322 @@
+//! `raypipe report`: every variant on the same inputs — random rays on the scenes and the
+//! stress classes — as run time per test against error, with the Pareto front marked.
+//!
+//! RTI error: hit/miss disagreements with the exact rational decision on the quantised inputs
+//! (scene rays against their target and sampled triangles, plus the decided stress tests), and
+//! the t error (ulps, relative) on shared hits from `verify`. Slab error: false misses and
+//! false hits against the exact decision (`verify`'s slab table plus the stress classes).
+//! Time: the single-thread batch paths' ns per test, weighted over the scenes.
+
+use crate::scene::Scene;
+use crate::stress::{stress, StressConfig};
+use crate::verify::{verify, verify_slab, VerifyConfig};
+use datapath::rng::SplitMix64;
+use datapath::rti::{Rti, RtiConfig};
+use datapath::{with_format, AnyFormat, Format};
+use golden::{Faces, Ray64, Tri64};
+use serde::Serialize;
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct ReportConfig {
+    /// Formats.
+    pub formats: Vec<AnyFormat>,
+    /// Slab variants.
+    pub variants: Vec<String>,
+    /// Rays per scene.
+    pub rays: usize,
+    /// Stress cases per class.
+    pub stress_count: usize,
+    /// Seed.
+    pub seed: u64,
+}
+
+/// One variant's point.
+#[derive(Clone, Debug, Serialize)]
+pub struct Point {
+    /// "rti" or "slab".
+    pub unit: String,
+    /// Format (and slab variant).
+    pub variant: String,
+    /// Bits per value.
+    pub width: u32,
+    /// Mean single-thread time per test, ns.
+    pub ns_per_test: f64,
+    /// Decided tests (scenes and stress).
+    pub tests: u64,
+    /// Exact hit, model miss.
+    pub false_misses: u64,
+    /// Exact miss, model hit.
+    pub false_hits: u64,
+    /// (false misses + false hits) / tests.
+    pub error_rate: f64,
+    /// RTI: median t error on shared hits, ulps of the format (largest over the scenes).
+    pub t_err_ulps_median: f64,
+    /// RTI: largest t error, ulps.
+    pub t_err_ulps_max: f64,
+    /// RTI: largest relative t error.
+    pub t_err_rel_max: f64,
+    /// No other variant of the unit is at least as fast and at least as accurate, and better in one.
+    pub pareto: bool,
+}
+
+/// The report.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Scenes.
+    pub scenes: Vec<String>,
+    /// Rays per scene.
+    pub rays: usize,
+    /// Stress cases per class.
+    pub stress_count: usize,
+    /// Seed.
+    pub seed: u64,
+    /// Points, RTI first.
+    pub points: Vec<Point>,
+}
+
+/// Scene rays against their target and 31 sampled triangles: (tests, false misses, false hits)
+/// against the exact decision on the quantised inputs.
+fn exact_rti<F: Format>(f: F, scene: &Scene, rays: usize, seed: u64) -> (u64, u64, u64) {
+    use rayon::prelude::*;
+    let rti = Rti::new(f, RtiConfig::default());
+    let q = |x: f64| f.to_f64(f.from_f64(x));
+    let list = scene.rays(rays, seed);
+    let n = scene.tris.len() as u64;
+    let parts: Vec<(u64, u64, u64)> = list
+        .par_iter()
+        .enumerate()
+        .map(|(i, (ray, target))| {
+            let mut r = SplitMix64::new(seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+            let mut ids = vec![*target];
+            ids.extend((0..31.min(n as usize - 1)).map(|_| r.below(n) as usize));
+            let mray = rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
+            let qray = Ray64 { o: ray.o.map(q), d: ray.d.map(q), tmin: q(ray.tmin), tmax: q(ray.tmax) };
+            let mut c = (0, 0, 0);
+            for &t in &ids {
+                let tri = &scene.tris[t];
+                let hit = rti.test(&mray, &rti.tri(tri.v)).hit;
+                let Some(e) = golden::intersect_exact(&qray, &Tri64 { v: tri.v.map(|p| p.map(q)) }, Faces::default())
+                else {
+                    continue;
+                };
+                c.0 += 1;
+                c.1 += (e && !hit) as u64;
+                c.2 += (!e && hit) as u64;
+            }
+            c
+        })
+        .collect();
+    parts.iter().fold((0, 0, 0), |a, p| (a.0 + p.0, a.1 + p.1, a.2 + p.2))
+}
+
+fn mark_pareto(points: &mut [Point]) {
+    let snapshot: Vec<(String, f64, f64)> =
+        points.iter().map(|p| (p.unit.clone(), p.ns_per_test, p.error_rate)).collect();
+    for p in points.iter_mut() {
+        p.pareto = !snapshot.iter().any(|(u, t, e)| {
+            *u == p.unit && *t <= p.ns_per_test && *e <= p.error_rate && (*t < p.ns_per_test || *e < p.error_rate)
+        });
+    }
+}
+
+/// Runs every variant on every scene and the stress classes.
+pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
+    if scenes.is_empty() || cfg.rays == 0 {
+        return Err("report needs at least one scene and one ray".into());
+    }
+    let st = stress(&StressConfig {
+        formats: cfg.formats.clone(),
+        variants: cfg.variants.clone(),
+        count: cfg.stress_count.max(1),
+        seed: cfg.seed,
+    })?;
+    let vcfg = VerifyConfig {
+        formats: cfg.formats.clone(),
+        rays: cfg.rays,
+        seed: cfg.seed,
+        rti: RtiConfig::default(),
+        sample: 512,
+    };
+    let mut points = Vec::new();
+    for f in &cfg.formats {
+        let name = f.name();
+        let mut p = Point {
+            unit: "rti".into(),
+            variant: name.clone(),
+            width: with_format!(*f, |f| f.width()),
+            ns_per_test: 0.0,
+            tests: 0,
+            false_misses: 0,
+            false_hits: 0,
+            error_rate: 0.0,
+            t_err_ulps_median: 0.0,
+            t_err_ulps_max: 0.0,
+            t_err_rel_max: 0.0,
+            pareto: false,
+        };
+        let (mut time, mut timed) = (0.0, 0u64);
+        for s in scenes {
+            let v = verify(&VerifyConfig { formats: vec![*f], ..vcfg.clone() }, s);
+            let r = &v.formats[0];
+            time += r.tests as f64 * 1e3 / r.mtests_per_s.max(1e-9);
+            timed += r.tests;
+            p.t_err_ulps_median = p.t_err_ulps_median.max(r.t_err_ulps_median);
+            p.t_err_ulps_max = p.t_err_ulps_max.max(r.t_err_ulps_max);
+            p.t_err_rel_max = p.t_err_rel_max.max(r.t_err_rel_max);
+            let (t, fm, fh) = with_format!(*f, |f| exact_rti(f, s, cfg.rays, cfg.seed));
+            p.tests += t;
+            p.false_misses += fm;
+            p.false_hits += fh;
+        }
+        for x in st.rti.iter().filter(|x| x.format == name) {
+            p.tests += x.tests - x.undecided;
+            p.false_misses += x.false_misses;
+            p.false_hits += x.false_hits;
+        }
+        p.ns_per_test = time / timed.max(1) as f64;
+        p.error_rate = (p.false_misses + p.false_hits) as f64 / p.tests.max(1) as f64;
+        points.push(p);
+    }
+    for f in &cfg.formats {
+        let name = f.name();
+        for v in &cfg.variants {
+            datapath::slab::SlabConfig::named(v)?;
+            let mut p = Point {
+                unit: "slab".into(),
+                variant: format!("{name} {v}"),
+                width: with_format!(*f, |f| f.width()),
+                ns_per_test: 0.0,
+                tests: 0,
+                false_misses: 0,
+                false_hits: 0,
+                error_rate: 0.0,
+                t_err_ulps_median: 0.0,
+                t_err_ulps_max: 0.0,
+                t_err_rel_max: 0.0,
+                pareto: false,
+            };
+            let (mut time, mut timed) = (0.0, 0u64);
+            for s in scenes {
+                let rows = verify_slab(&VerifyConfig { formats: vec![*f], ..vcfg.clone() }, s);
+                for r in rows.iter().filter(|r| &r.variant == v) {
+                    time += r.tests as f64 * 1e3 / r.mtests_per_s.max(1e-9);
+                    timed += r.tests;
+                    p.tests += r.tests;
+                    p.false_misses += r.false_misses;
+                    p.false_hits += r.false_hits;
+                }
+            }
+            for x in st.slab.iter().filter(|x| x.format == name && &x.variant == v) {
+                p.tests += x.tests - x.undecided;
+                p.false_misses += x.false_misses;
+                p.false_hits += x.false_hits;
+            }
+            p.ns_per_test = time / timed.max(1) as f64;
+            p.error_rate = (p.false_misses + p.false_hits) as f64 / p.tests.max(1) as f64;
+            points.push(p);
+        }
+    }
+    mark_pareto(&mut points);
+    Ok(Report {
+        scenes: scenes.iter().map(|s| s.name.clone()).collect(),
+        rays: cfg.rays,
+        stress_count: cfg.stress_count,
+        seed: cfg.seed,
+        points,
+    })
+}
+
+/// The report as README-ready markdown.
+pub fn markdown(r: &Report) -> String {
+    let mut s = format!(
+        "Scenes: {}; {} rays per scene, {} stress cases per class, seed {}. Pareto: ★.\n\n",
+        r.scenes.join(", "),
+        r.rays,
+        r.stress_count,
+        r.seed
+    );
+    s += "| unit | variant | bits | ns/test | tests | false misses | false hits | error rate | t err median / max (ulps) | t err rel max | Pareto |\n";
+    s += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|:-:|\n";
+    for p in &r.points {
+        let terr = if p.unit == "rti" {
+            format!("{:.2} / {:.3e}", p.t_err_ulps_median, p.t_err_ulps_max)
+        } else {
+            "–".into()
+        };
+        let rel = if p.unit == "rti" { format!("{:.2e}", p.t_err_rel_max) } else { "–".into() };
+        s += &format!(
+            "| {} | {} | {} | {:.1} | {} | {} | {} | {:.2e} | {} | {} | {} |\n",
+            p.unit,
+            p.variant,
+            p.width,
+            p.ns_per_test,
+            p.tests,
+            p.false_misses,
+            p.false_hits,
+            p.error_rate,
+            terr,
+            rel,
+            if p.pareto { "★" } else { "" }
+        );
+    }
+    s
+}
+
+/// Writes `report.md`, `report.json`, `report_rti.svg` and `report_slab.svg` into `dir`.
+pub fn write(r: &Report, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, String> {
+    use plotters::prelude::*;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let mut out = Vec::new();
+    let md = dir.join("report.md");
+    std::fs::write(&md, markdown(r)).map_err(|e| format!("{}: {e}", md.display()))?;
+    out.push(md);
+    let js = dir.join("report.json");
+    std::fs::write(&js, serde_json::to_string_pretty(r).map_err(|e| e.to_string())? + "\n")
+        .map_err(|e| format!("{}: {e}", js.display()))?;
+    out.push(js);
+    for unit in ["rti", "slab"] {
+        let pts: Vec<&Point> = r.points.iter().filter(|p| p.unit == unit).collect();
+        if pts.is_empty() {
+            continue;
+        }
+        let path = dir.join(format!("report_{unit}.svg"));
+        // error on a log scale, with exact zero drawn at the floor
+        let floor = 1e-7f64;
+        let y = |p: &Point| p.error_rate.max(floor).log10();
+        let xmax = pts.iter().map(|p| p.ns_per_test).fold(0.0, f64::max) * 1.15 + 1e-9;
+        let ymax = pts.iter().map(|p| y(p)).fold(floor.log10(), f64::max) + 0.5;
+        {
+            let root = SVGBackend::new(&path, (760, 480)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| err(&e))?;
+            let mut chart = ChartBuilder::on(&root)
+                .caption(format!("{unit}: time per test vs error (Pareto front in red)"), ("sans-serif", 18))
+                .margin(14)
+                .x_label_area_size(40)
+                .y_label_area_size(64)
+                .build_cartesian_2d(0.0..xmax, (floor.log10() - 0.3)..ymax)
+                .map_err(|e| err(&e))?;
+            chart
+                .configure_mesh()
+                .x_desc("ns per test (one thread)")
+                .y_desc("log10 error rate (1e-7 = none seen)")
+                .draw()
+                .map_err(|e| err(&e))?;
+            let mut front: Vec<(f64, f64)> = pts.iter().filter(|p| p.pareto).map(|p| (p.ns_per_test, y(p))).collect();
+            front.sort_by(|a, b| a.0.total_cmp(&b.0));
+            chart.draw_series(LineSeries::new(front, RED.stroke_width(2))).map_err(|e| err(&e))?;
+            for p in &pts {
+                let c = if p.pareto { RED } else { BLUE };
+                let at = (p.ns_per_test, y(p));
+                chart.draw_series(std::iter::once(Circle::new(at, 4, c.filled()))).map_err(|e| err(&e))?;
+                chart
+                    .draw_series(std::iter::once(Text::new(p.variant.clone(), at, ("sans-serif", 11))))
+                    .map_err(|e| err(&e))?;
+            }
+            root.present().map_err(|e| err(&e))?;
+        }
+        out.push(path);
+    }
+    Ok(out)
+}
