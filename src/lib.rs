@@ -11,6 +11,7 @@ pub mod plan;
 pub mod render;
 pub mod report;
 pub mod scene;
+pub mod speed;
 pub mod stats;
 pub mod stress;
 pub mod traverse;

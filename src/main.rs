@@ -294,6 +294,18 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// This machine's no-FMA FP peak and each RTI / slab implementation's throughput as a fraction of it.
+    Speed {
+        /// Ray–triangle pairs per call (the default 512 keeps the 15 input columns in L1).
+        #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u64).range(8..))]
+        pairs: u64,
+        /// Seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Print the results as JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// The numerical stability stress suite: failures against the exact decision per class, format and variant.
     Stress {
         /// Formats, comma-separated.
@@ -556,6 +568,11 @@ fn run() -> Result<bool, String> {
             for f in files {
                 eprintln!("wrote {}", f.display());
             }
+            Ok(true)
+        }
+        Some(Cmd::Speed { pairs, seed, json }) => {
+            let rep = raypipe::speed::speed(pairs as usize, seed);
+            emit(json, &rep, raypipe::speed::render)?;
             Ok(true)
         }
         Some(Cmd::Stress { format, variant, count, seed, json }) => {

@@ -9,6 +9,7 @@ pub mod format;
 pub mod probe;
 pub mod rng;
 pub mod rti;
+pub mod simd;
 pub mod slab;
 
 pub use format::{AnyFormat, Format};

@@ -1,0 +1,285 @@
+//! SIMD batch kernels of the RTI model, bit-identical to the scalar model, with runtime dispatch.
+//!
+//! One kernel body (the `rti_kernel!` macro) is instantiated for binary32 and binary16 on
+//! AVX2 (+ F16C for binary16), eight tests per vector, in the stage table's exact operation
+//! order with separate multiplies and adds (no FMA). binary16 computes every operation in
+//! binary32 and rounds it to binary16 at once (`vcvtps2ph` nearest-even, then back): binary32's
+//! 24 bits are at least 2·11 + 2, so this double rounding is innocuous for + − × ÷ and the
+//! result is the correctly rounded binary16 operation, subnormals and overflow included.
+//! NaN payloads never influence a non-NaN result or a compare, so the kernels canonicalise NaN
+//! only where a value leaves them (t, u, v). Eligible formats: IEEE subnormals and canonical
+//! NaN (either division mode, either culling); others, and machines without AVX2, run the
+//! scalar model. Columns are processed in chunks of 8 lanes straight from the SoA inputs.
+
+use crate::format::{DivMode, F16Half, F32Native, Ieee, NanMode, Subnormals};
+use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
+use half::f16;
+
+/// Which implementation ran.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    /// AVX2 (binary32) or AVX2 + F16C (binary16), 8 lanes.
+    Avx2,
+    /// The scalar model.
+    Scalar,
+}
+
+fn eligible<B: crate::format::IeeeBackend>(f: &Ieee<B>) -> bool {
+    f.opts.subnormals == Subnormals::Ieee && f.opts.nan == NanMode::Canonical
+}
+
+/// The kernel `rti_batch_f32` uses for this unit on this machine.
+pub fn kernel_f32(rti: &Rti<Ieee<F32Native>>) -> Kernel {
+    #[cfg(target_arch = "x86_64")]
+    if eligible(&rti.fmt) && std::arch::is_x86_feature_detected!("avx2") {
+        return Kernel::Avx2;
+    }
+    let _ = rti;
+    Kernel::Scalar
+}
+
+/// The kernel `rti_batch_f16` uses for this unit on this machine.
+pub fn kernel_f16(rti: &Rti<Ieee<F16Half>>) -> Kernel {
+    #[cfg(target_arch = "x86_64")]
+    if eligible(&rti.fmt) && std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("f16c")
+    {
+        return Kernel::Avx2;
+    }
+    let _ = rti;
+    Kernel::Scalar
+}
+
+/// [`Rti::batch`] for binary32 on the fastest kernel available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn rti_batch_f32(
+    rti: &Rti<Ieee<F32Native>>,
+    rays: &RaysSoa<f32>,
+    tris: &TrisSoa<f32>,
+    out: &mut HitsSoa<f32>,
+) -> Kernel {
+    let n = rays.len();
+    assert!(tris.len() == n && out.len() == n, "batch lengths differ");
+    match kernel_f32(rti) {
+        #[cfg(target_arch = "x86_64")]
+        Kernel::Avx2 => {
+            let full = n / 8 * 8;
+            // SAFETY: AVX2 was detected at run time; the kernel reads and writes lanes
+            // 0..full of columns whose lengths were checked above.
+            unsafe { avx2::rti_f32(rti, rays, tris, out, full) };
+            tail(rti, rays, tris, out, full);
+            Kernel::Avx2
+        }
+        _ => {
+            rti.batch(rays, tris, out);
+            Kernel::Scalar
+        }
+    }
+}
+
+/// [`Rti::batch`] for binary16 on the fastest kernel available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn rti_batch_f16(
+    rti: &Rti<Ieee<F16Half>>,
+    rays: &RaysSoa<f16>,
+    tris: &TrisSoa<f16>,
+    out: &mut HitsSoa<f16>,
+) -> Kernel {
+    let n = rays.len();
+    assert!(tris.len() == n && out.len() == n, "batch lengths differ");
+    match kernel_f16(rti) {
+        #[cfg(target_arch = "x86_64")]
+        Kernel::Avx2 => {
+            let full = n / 8 * 8;
+            // SAFETY: AVX2 and F16C were detected at run time; lanes 0..full are in bounds.
+            unsafe { avx2::rti_f16(rti, rays, tris, out, full) };
+            tail(rti, rays, tris, out, full);
+            Kernel::Avx2
+        }
+        _ => {
+            rti.batch(rays, tris, out);
+            Kernel::Scalar
+        }
+    }
+}
+
+/// The lanes after the last full vector, on the scalar model.
+fn tail<F: crate::Format>(
+    rti: &Rti<F>,
+    rays: &RaysSoa<F::V>,
+    tris: &TrisSoa<F::V>,
+    out: &mut HitsSoa<F::V>,
+    from: usize,
+) {
+    for i in from..rays.len() {
+        let o = rti.test(&rays.get(i), &tris.get(i));
+        out.hit[i] = o.hit;
+        out.valid[i] = o.valid;
+        out.t[i] = o.t;
+        out.u[i] = o.u;
+        out.v[i] = o.v;
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::*;
+    use std::arch::x86_64::*;
+
+    /// The RTI stage table on 8 lanes. `$load(column, i)` gives 8 binary32 lanes,
+    /// `$round(x)` rounds a binary32 result to the format, `$store(column, i, x)` writes 8
+    /// canonical-NaN results, `$thr` is the det threshold as binary32.
+    macro_rules! rti_kernel {
+        ($rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr) => {{
+            let (rti, rays, tris, out) = ($rti, $rays, $tris, $out);
+            let load = $load;
+            let rd = $round;
+            let store = $store;
+            let sub = |a, b| rd(_mm256_sub_ps(a, b));
+            let add = |a, b| rd(_mm256_add_ps(a, b));
+            let mul = |a, b| rd(_mm256_mul_ps(a, b));
+            let div = |a, b| rd(_mm256_div_ps(a, b));
+            let le = |a, b| _mm256_cmp_ps::<_CMP_LE_OQ>(a, b);
+            let lt = |a, b| _mm256_cmp_ps::<_CMP_LT_OQ>(a, b);
+            let thr = _mm256_set1_ps($thr);
+            let zero = _mm256_setzero_ps();
+            let one = _mm256_set1_ps(1.0);
+            let sign = _mm256_set1_ps(-0.0);
+            let mut i = 0;
+            while i < $full {
+                let [ox, oy, oz] = [0, 1, 2].map(|a| load(&rays.o[a], i));
+                let [dx, dy, dz] = [0, 1, 2].map(|a| load(&rays.d[a], i));
+                let v = |k: usize, a: usize| load(&tris.v[k][a], i);
+                let (v0x, v0y, v0z) = (v(0, 0), v(0, 1), v(0, 2));
+                // stage 1
+                let (e1x, e1y, e1z) = (sub(v(1, 0), v0x), sub(v(1, 1), v0y), sub(v(1, 2), v0z));
+                let (e2x, e2y, e2z) = (sub(v(2, 0), v0x), sub(v(2, 1), v0y), sub(v(2, 2), v0z));
+                let (sx, sy, sz) = (sub(ox, v0x), sub(oy, v0y), sub(oz, v0z));
+                // stages 2, 3: p = d x e2, q = s x e1
+                let px = sub(mul(dy, e2z), mul(dz, e2y));
+                let py = sub(mul(dz, e2x), mul(dx, e2z));
+                let pz = sub(mul(dx, e2y), mul(dy, e2x));
+                let qx = sub(mul(sy, e1z), mul(sz, e1y));
+                let qy = sub(mul(sz, e1x), mul(sx, e1z));
+                let qz = sub(mul(sx, e1y), mul(sy, e1x));
+                // stages 4-6: (x + y) + z
+                let det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
+                let up = add(add(mul(sx, px), mul(sy, py)), mul(sz, pz));
+                let vp = add(add(mul(dx, qx), mul(dy, qy)), mul(dz, qz));
+                let tp = add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz));
+                // stage 7
+                let uv = add(up, vp);
+                let det_ok = match rti.cull {
+                    Cull::TwoSided => lt(thr, _mm256_andnot_ps(sign, det)),
+                    Cull::Backface => lt(thr, det),
+                };
+                let pos = lt(zero, det);
+                let side = |a, b| _mm256_blendv_ps(le(b, a), le(a, b), pos); // pos ? a <= b : b <= a
+                let valid = _mm256_and_ps(
+                    _mm256_and_ps(det_ok, side(zero, up)),
+                    _mm256_and_ps(_mm256_and_ps(side(zero, vp), side(uv, det)), side(zero, tp)),
+                );
+                // the division last
+                let (t, u, w) = match rti.fmt.opts.div {
+                    DivMode::RecipMul => {
+                        let inv = div(one, det);
+                        (mul(tp, inv), mul(up, inv), mul(vp, inv))
+                    }
+                    DivMode::Divide => (div(tp, det), div(up, det), div(vp, det)),
+                };
+                let tmin = load(&rays.tmin, i);
+                let tmax = load(&rays.tmax, i);
+                let hit = _mm256_and_ps(valid, _mm256_and_ps(le(tmin, t), le(t, tmax)));
+                let (hm, vm) = (_mm256_movemask_ps(hit) as usize, _mm256_movemask_ps(valid) as usize);
+                // SAFETY: lanes i..i + 8 are in bounds (checked by the caller); every byte
+                // written is 0 or 1, a valid bool.
+                unsafe {
+                    (out.hit.as_mut_ptr().add(i) as *mut u64).write_unaligned(SPREAD[hm]);
+                    (out.valid.as_mut_ptr().add(i) as *mut u64).write_unaligned(SPREAD[vm]);
+                }
+                store(&mut out.t, i, t);
+                store(&mut out.u, i, u);
+                store(&mut out.v, i, w);
+                i += 8;
+            }
+        }};
+    }
+
+    /// An 8-bit lane mask spread to 8 bytes of 0 / 1 (lane k in byte k).
+    const SPREAD: [u64; 256] = {
+        let mut t = [0u64; 256];
+        let mut m = 0;
+        while m < 256 {
+            let mut k = 0;
+            while k < 8 {
+                if m >> k & 1 == 1 {
+                    t[m] |= 1 << (8 * k);
+                }
+                k += 1;
+            }
+            m += 1;
+        }
+        t
+    };
+
+    /// Replaces NaN lanes by `canonical`.
+    #[target_feature(enable = "avx2")]
+    fn canon(x: __m256, canonical: __m256) -> __m256 {
+        _mm256_blendv_ps(x, canonical, _mm256_cmp_ps::<_CMP_UNORD_Q>(x, x))
+    }
+
+    #[target_feature(enable = "avx2")]
+    pub(super) fn rti_f32(
+        rti: &Rti<Ieee<F32Native>>,
+        rays: &RaysSoa<f32>,
+        tris: &TrisSoa<f32>,
+        out: &mut HitsSoa<f32>,
+        full: usize,
+    ) {
+        let nan = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fc0_0000));
+        // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
+        rti_kernel!(
+            rti,
+            rays,
+            tris,
+            out,
+            full,
+            |c: &Vec<f32>, i: usize| unsafe { _mm256_loadu_ps(c.as_ptr().add(i)) },
+            |x: __m256| x,
+            |c: &mut Vec<f32>, i: usize, x: __m256| unsafe { _mm256_storeu_ps(c.as_mut_ptr().add(i), canon(x, nan)) },
+            rti.det_thr
+        );
+    }
+
+    #[target_feature(enable = "avx2,f16c")]
+    pub(super) fn rti_f16(
+        rti: &Rti<Ieee<F16Half>>,
+        rays: &RaysSoa<f16>,
+        tris: &TrisSoa<f16>,
+        out: &mut HitsSoa<f16>,
+        full: usize,
+    ) {
+        let nan = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fc0_0000)); // becomes 0x7e00 in binary16
+                                                                       // SAFETY (loads and stores): the caller checked that every column holds `full` lanes;
+                                                                       // f16 is a 2-byte plain value.
+        rti_kernel!(
+            rti,
+            rays,
+            tris,
+            out,
+            full,
+            |c: &Vec<f16>, i: usize| unsafe { _mm256_cvtph_ps(_mm_loadu_si128(c.as_ptr().add(i) as *const __m128i)) },
+            |x: __m256| _mm256_cvtph_ps(_mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x)),
+            |c: &mut Vec<f16>, i: usize, x: __m256| unsafe {
+                _mm_storeu_si128(
+                    c.as_mut_ptr().add(i) as *mut __m128i,
+                    _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(canon(x, nan)),
+                )
+            },
+            rti.det_thr.to_f32()
+        );
+    }
+}

@@ -1,0 +1,261 @@
+//! `raypipe speed`: this machine's no-FMA floating-point peak (vector adds and multiplies per
+//! second) and each RTI / slab implementation's throughput as a fraction of it, for its op
+//! count (51 for RTI, 12 for the slab test) — one thread, one run, the seed and sizes printed.
+
+use datapath::format::{F16Half, F32Native, FpOpts, Ieee};
+use datapath::rng::SplitMix64;
+use datapath::rti::{HitsSoa, RaysSoa, Rti, RtiConfig, TrisSoa};
+use datapath::simd::{rti_batch_f16, rti_batch_f32, Kernel};
+use serde::Serialize;
+use std::hint::black_box;
+use std::time::Instant;
+
+/// Floating-point operations of one RTI test as the fraction of peak counts them: 51 (the stage
+/// table has 48 + a reciprocal and 3 multiplies, or 48 + 3 divides; a divide is not one add's
+/// cost, so the figure is a throughput yardstick, not an exact op count).
+pub const RTI_OPS: f64 = 51.0;
+/// Floating-point operations of one slab test (6 subtracts, 6 multiplies).
+pub const SLAB_OPS: f64 = 12.0;
+
+/// One measured implementation.
+#[derive(Clone, Debug, Serialize)]
+pub struct SpeedRow {
+    /// What ran.
+    pub name: String,
+    /// Million tests per second.
+    pub mtests_per_s: f64,
+    /// Floating-point ops per test.
+    pub ops: f64,
+    /// Throughput × ops / the peak of its precision.
+    pub fraction_of_peak: f64,
+}
+
+/// The measurement.
+#[derive(Clone, Debug, Serialize)]
+pub struct SpeedReport {
+    /// Pairs per run.
+    pub pairs: usize,
+    /// Seed of the inputs.
+    pub seed: u64,
+    /// Which kernel the f32 / fp16 dispatch chose.
+    pub kernels: [String; 2],
+    /// Measured no-FMA peak, giga lane-ops per second (binary32, widest vector unit found).
+    pub peak_gops: f64,
+    /// Rows.
+    pub rows: Vec<SpeedRow>,
+}
+
+/// Adds and multiplies on independent accumulators: lane-ops per second.
+fn peak() -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: AVX2 detected.
+        return unsafe { peak_avx2() };
+    }
+    peak_scalar()
+}
+
+fn peak_scalar() -> f64 {
+    let (a, m) = (black_box(-1e-7f32), black_box(1.000_000_1f32));
+    let mut acc = [1.0f32; 12];
+    let iters = 20_000_000u64;
+    let t0 = Instant::now();
+    for _ in 0..iters {
+        for x in acc.iter_mut() {
+            *x = (*x + a) * m;
+        }
+    }
+    black_box(acc);
+    (iters * 12 * 2) as f64 / t0.elapsed().as_secs_f64()
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn peak_avx2() -> f64 {
+    use std::arch::x86_64::*;
+    let a = _mm256_set1_ps(black_box(-1e-7));
+    let m = _mm256_set1_ps(black_box(1.000_000_1));
+    let mut acc = [_mm256_set1_ps(1.0); 12];
+    let iters = 20_000_000u64;
+    let t0 = Instant::now();
+    for _ in 0..iters {
+        for x in acc.iter_mut() {
+            *x = _mm256_mul_ps(_mm256_add_ps(*x, a), m);
+        }
+    }
+    black_box(acc);
+    (iters * 12 * 2 * 8) as f64 / t0.elapsed().as_secs_f64()
+}
+
+/// Best of `reps` timings of `f` over `n` tests, each timing repeating `f` for at least 20 ms
+/// (a small working set stays in cache): million tests per second.
+fn rate(n: usize, reps: usize, mut f: impl FnMut()) -> f64 {
+    let mut best = 0.0f64;
+    for _ in 0..reps {
+        let (t0, mut calls) = (Instant::now(), 0u64);
+        while calls == 0 || t0.elapsed().as_secs_f64() < 0.02 {
+            f();
+            calls += 1;
+        }
+        best = best.max((n as u64 * calls) as f64 / t0.elapsed().as_secs_f64() / 1e6);
+    }
+    best
+}
+
+/// Million RTI tests per second of a format's fastest bit-identical implementation (the SIMD
+/// kernels for binary32 and binary16 where they apply, the scalar batch otherwise), over
+/// `pairs` pairs of the built-in scene that stay in cache.
+pub fn rti_rate(any: datapath::AnyFormat, pairs: usize, seed: u64) -> f64 {
+    use datapath::{with_format, AnyFormat, Format};
+    let scene = crate::scene::Scene::builtin();
+    let cases = scene.rays(pairs, seed);
+    fn columns<F: Format>(
+        rti: &Rti<F>,
+        scene: &crate::scene::Scene,
+        cases: &[(golden::Ray64, usize)],
+    ) -> (RaysSoa<F::V>, TrisSoa<F::V>) {
+        let (mut rays, mut tris) = (RaysSoa::default(), TrisSoa::default());
+        for (ray, t) in cases {
+            rays.push(&rti.ray(ray.o, ray.d, ray.tmin, ray.tmax));
+            tris.push(&rti.tri(scene.tris[*t].v));
+        }
+        (rays, tris)
+    }
+    match any {
+        AnyFormat::F32(f) => {
+            let rti = Rti::new(f, RtiConfig::default());
+            let (rays, tris) = columns(&rti, &scene, &cases);
+            let mut out = HitsSoa::with_len(pairs);
+            rate(pairs, 3, || {
+                rti_batch_f32(&rti, &rays, &tris, &mut out);
+            })
+        }
+        AnyFormat::F16(f) => {
+            let rti = Rti::new(f, RtiConfig::default());
+            let (rays, tris) = columns(&rti, &scene, &cases);
+            let mut out = HitsSoa::with_len(pairs);
+            rate(pairs, 3, || {
+                rti_batch_f16(&rti, &rays, &tris, &mut out);
+            })
+        }
+        other => with_format!(other, |f| {
+            let rti = Rti::new(f, RtiConfig::default());
+            let (rays, tris) = columns(&rti, &scene, &cases);
+            let mut out = HitsSoa::with_len(pairs);
+            rate(pairs, 3, || rti.batch(&rays, &tris, &mut out))
+        }),
+    }
+}
+
+/// Measures.
+pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
+    let scene = crate::scene::Scene::builtin();
+    let mut r = SplitMix64::new(seed);
+    let cases: Vec<_> = scene
+        .rays(pairs, seed)
+        .into_iter()
+        .map(|(ray, t)| {
+            let i = if r.below(2) == 0 { t } else { r.below(scene.tris.len() as u64) as usize };
+            (ray, scene.tris[i])
+        })
+        .collect();
+    let peak = peak();
+    let mut rows = Vec::new();
+    let f32f = Ieee::new(F32Native, FpOpts::default());
+    let f16f = Ieee::new(F16Half, FpOpts::default());
+    let r32 = Rti::new(f32f, RtiConfig::default());
+    let r16 = Rti::new(f16f, RtiConfig::default());
+    let (mut rays32, mut tris32) = (RaysSoa::default(), TrisSoa::default());
+    let (mut rays16, mut tris16) = (RaysSoa::default(), TrisSoa::default());
+    for (ray, tri) in &cases {
+        rays32.push(&r32.ray(ray.o, ray.d, ray.tmin, ray.tmax));
+        tris32.push(&r32.tri(tri.v));
+        rays16.push(&r16.ray(ray.o, ray.d, ray.tmin, ray.tmax));
+        tris16.push(&r16.tri(tri.v));
+    }
+    let mut o32 = HitsSoa::with_len(pairs);
+    let mut o16 = HitsSoa::with_len(pairs);
+    let mut k = [Kernel::Scalar; 2];
+    let row = |name: &str, m: f64, ops: f64| SpeedRow {
+        name: name.into(),
+        mtests_per_s: m,
+        ops,
+        fraction_of_peak: m * 1e6 * ops / peak,
+    };
+    rows.push(row(
+        "rti f32 kernel (dispatch)",
+        rate(pairs, 5, || k[0] = rti_batch_f32(&r32, &rays32, &tris32, &mut o32)),
+        RTI_OPS,
+    ));
+    rows.push(row("rti f32 scalar model", rate(pairs, 3, || r32.batch(&rays32, &tris32, &mut o32)), RTI_OPS));
+    rows.push(row(
+        "rti fp16 kernel (dispatch)",
+        rate(pairs, 5, || k[1] = rti_batch_f16(&r16, &rays16, &tris16, &mut o16)),
+        RTI_OPS,
+    ));
+    rows.push(row("rti fp16 scalar model", rate(pairs, 3, || r16.batch(&rays16, &tris16, &mut o16)), RTI_OPS));
+    let c16: Vec<([half::f16; 6], [half::f16; 9])> = cases
+        .iter()
+        .map(|(r, t)| {
+            let ray = [r.o[0], r.o[1], r.o[2], r.d[0], r.d[1], r.d[2]].map(|x| half::f16::from_f64(x));
+            let v: Vec<half::f16> = t.v.iter().flatten().map(|&x| half::f16::from_f64(x)).collect();
+            (ray, v.try_into().expect("nine coordinates"))
+        })
+        .collect();
+    rows.push(row(
+        "half-crate scalar fp16 MT (baseline)",
+        rate(pairs, 3, || {
+            black_box(c16.iter().filter(|(r, t)| half_mt(black_box(r), black_box(t))).count());
+        }),
+        RTI_OPS,
+    ));
+    // the slab unit's scalar batch over boxes of the same triangles
+    {
+        use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa};
+        let s = Slab::new(f32f, SlabConfig::default());
+        let (mut rs, mut bs) = (SlabRaysSoa::default(), BoxesSoa::default());
+        for (ray, tri) in &cases {
+            rs.push(&s.prepare(ray.o, ray.d, ray.tmin, ray.tmax));
+            let lo = std::array::from_fn(|a| tri.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min));
+            let hi = std::array::from_fn(|a| tri.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max));
+            bs.push(&s.store_box(lo, hi).unwrap_or_else(|_| s.empty_box()));
+        }
+        let mut out = SlabOutSoa::with_len(pairs);
+        rows.push(row("slab f32 scalar model (plain)", rate(pairs, 3, || s.batch(&rs, &bs, &mut out)), SLAB_OPS));
+    }
+    SpeedReport { pairs, seed, kernels: k.map(|k| format!("{k:?}")), peak_gops: peak / 1e9, rows }
+}
+
+/// Textbook Möller–Trumbore in `half`'s f16 (every operation rounded by the crate).
+fn half_mt(r: &[half::f16; 6], v: &[half::f16; 9]) -> bool {
+    use half::f16;
+    let sub = |a: [f16; 3], b: [f16; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross =
+        |a: [f16; 3], b: [f16; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    let dot = |a: [f16; 3], b: [f16; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (o, d) = ([r[0], r[1], r[2]], [r[3], r[4], r[5]]);
+    let (v0, v1, v2) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]);
+    let (e1, e2) = (sub(v1, v0), sub(v2, v0));
+    let p = cross(d, e2);
+    let det = dot(e1, p);
+    let inv = f16::ONE / det;
+    let s = sub(o, v0);
+    let u = dot(s, p) * inv;
+    let q = cross(s, e1);
+    let w = dot(d, q) * inv;
+    let t = dot(e2, q) * inv;
+    u >= f16::ZERO && w >= f16::ZERO && u + w <= f16::ONE && t >= f16::ZERO
+}
+
+/// The measurement as a markdown table.
+pub fn render(s: &SpeedReport) -> String {
+    let mut out = format!(
+        "raypipe speed: {} pairs (built-in scene, seed {}), one thread; kernels: f32 {}, fp16 {}; measured no-FMA peak {:.1} G lane-ops/s (binary32)\n\n",
+        s.pairs, s.seed, s.kernels[0], s.kernels[1], s.peak_gops
+    );
+    out += "| implementation | M tests/s | ops/test | fraction of peak |\n|---|---:|---:|---:|\n";
+    for r in &s.rows {
+        out += &format!("| {} | {:.1} | {} | {:.3} |\n", r.name, r.mtests_per_s, r.ops, r.fraction_of_peak);
+    }
+    out
+}
