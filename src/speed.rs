@@ -197,7 +197,7 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     let c16: Vec<([half::f16; 6], [half::f16; 9])> = cases
         .iter()
         .map(|(r, t)| {
-            let ray = [r.o[0], r.o[1], r.o[2], r.d[0], r.d[1], r.d[2]].map(|x| half::f16::from_f64(x));
+            let ray = [r.o[0], r.o[1], r.o[2], r.d[0], r.d[1], r.d[2]].map(half::f16::from_f64);
             let v: Vec<half::f16> = t.v.iter().flatten().map(|&x| half::f16::from_f64(x)).collect();
             (ray, v.try_into().expect("nine coordinates"))
         })
