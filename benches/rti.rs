@@ -44,6 +44,27 @@ fn bench_models(c: &mut Criterion) {
             });
         });
     }
+    // the SIMD kernels with runtime dispatch (bit-identical to the models above)
+    {
+        use datapath::format::{F16Half, F32Native, FpOpts, Ieee};
+        let r32 = Rti::new(Ieee::new(F32Native, FpOpts::default()), RtiConfig::default());
+        let r16 = Rti::new(Ieee::new(F16Half, FpOpts::default()), RtiConfig::default());
+        let (mut rays32, mut tris32, mut rays16, mut tris16) =
+            (RaysSoa::default(), TrisSoa::default(), RaysSoa::default(), TrisSoa::default());
+        for (ray, tri) in &cases {
+            rays32.push(&r32.ray(ray.o, ray.d, ray.tmin, ray.tmax));
+            tris32.push(&r32.tri(tri.v));
+            rays16.push(&r16.ray(ray.o, ray.d, ray.tmin, ray.tmax));
+            tris16.push(&r16.tri(tri.v));
+        }
+        let (mut o32, mut o16) = (HitsSoa::with_len(N), HitsSoa::with_len(N));
+        g.bench_function("simd_f32_dispatch", |b| {
+            b.iter(|| datapath::simd::rti_batch_f32(&r32, black_box(&rays32), black_box(&tris32), &mut o32))
+        });
+        g.bench_function("simd_fp16_dispatch", |b| {
+            b.iter(|| datapath::simd::rti_batch_f16(&r16, black_box(&rays16), black_box(&tris16), &mut o16))
+        });
+    }
     g.bench_function("golden_f64", |b| {
         b.iter(|| {
             cases
