@@ -368,3 +368,36 @@ fn vectors_do_not_depend_on_the_thread_count() {
     let manifest = String::from_utf8(sets[0].iter().find(|f| f.0 == "manifest.json").unwrap().1.clone()).unwrap();
     assert!(!manifest.contains("--threads"), "the thread count is not part of the recorded command");
 }
+
+#[test]
+fn plan_stress_report_and_speed_refuse_bad_input_clearly() {
+    assert_clear_error(&raypipe(&["stress", "--count", "0"]), "--count");
+    assert_clear_error(
+        &raypipe(&["stress", "--count", "1", "--format", "f32", "--variant", "nope"]),
+        "unknown slab variant",
+    );
+    assert_clear_error(&raypipe(&["stress", "--count", "1", "--format", "f77"]), "f77");
+    assert_clear_error(
+        &raypipe(&["report", "--rays", "1", "--stress-count", "1", "--format", "f32", "--variant", "nope"]),
+        "unknown slab variant",
+    );
+    assert_clear_error(&raypipe(&["report", "--scene", "/nonexistent.obj"]), "nonexistent");
+    assert_clear_error(&raypipe(&["plan", "--pipelines", "0"]), "--pipelines");
+    assert_clear_error(&raypipe(&["plan", "--budget=-1"]), "--budget");
+    assert_clear_error(&raypipe(&["plan", "--scene", "/nonexistent.obj"]), "nonexistent");
+    assert_clear_error(&raypipe(&["speed", "--pairs", "4"]), "--pairs");
+}
+
+#[test]
+fn plan_and_stress_print_json() {
+    let o = raypipe(&["plan", "--rays", "8", "--format", "f32,fp16", "--json"]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["formats"].as_array().unwrap().len(), 2);
+    assert_eq!(v["history_bits"].as_u64().unwrap(), 2 * v["level_pipelines"].as_u64().unwrap());
+    let o = raypipe(&["stress", "--count", "3", "--format", "fp16", "--variant", "directed", "--json"]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["slab"].as_array().unwrap().iter().all(|r| r["false_misses"] == 0));
+    assert_eq!(v["seed"], 1);
+}
