@@ -61,6 +61,17 @@ pub struct StatsReport {
 
 const BACK_BINS: usize = 11;
 
+/// One ray's share of the figures.
+struct RayStats {
+    visited: Vec<u32>,
+    hit: bool,
+    wasted: u64,
+    hist_tests: u64,
+    stack_tests: u64,
+    backs: usize,
+    distances: Vec<u32>,
+}
+
 /// Runs the sweep.
 pub fn stats(scene: &Scene, leaf_sizes: &[u32], rays: usize, seed: u64) -> Result<StatsReport, String> {
     let rays = crate::traverse::rays(scene, rays, seed);
@@ -69,12 +80,8 @@ pub fn stats(scene: &Scene, leaf_sizes: &[u32], rays: usize, seed: u64) -> Resul
         let b = build(scene, ls);
         let hw = b.layout_ids(256)?;
         let tree = b.golden_tree();
-        let mut per_leaf = vec![0u64; b.leaf_tris.len()];
-        let mut wasted = 0u64;
-        let mut back = vec![0u64; BACK_BINS];
-        let mut dist = vec![0u64; b.depth + 2];
-        let (mut hist_tests, mut stack_tests, mut rays_hit) = (0u64, 0u64, 0u64);
-        for ray in &rays {
+        // rays in parallel; every figure is a sum of integers, merged in ray order
+        let per_ray = |ray: &golden::Ray64| {
             let test = |i: u32| {
                 let n = &b.nodes[i as usize];
                 let r = slab_f64(ray.o, ray.d, ray.tmin, ray.tmax, n.min, n.max);
@@ -92,20 +99,38 @@ pub fn stats(scene: &Scene, leaf_sizes: &[u32], rays: usize, seed: u64) -> Resul
                 }
             }
             let upto = best.map_or(all.leaves.len(), |(k, _)| k + 1);
-            rays_hit += best.is_some() as u64;
             let h = history_traverse(&hw, upto.max(1), |&i| test(i));
             let g = stack_traverse(&tree, upto.max(1), test);
-            hist_tests += h.box_tests;
-            stack_tests += g.box_tests;
-            let mut tests = 0u64;
-            for &leaf in &all.leaves[..upto] {
-                per_leaf[leaf as usize] += 1;
-                tests += b.leaf_tris[leaf as usize].len() as u64;
+            let tests: u64 = all.leaves[..upto].iter().map(|&l| b.leaf_tris[l as usize].len() as u64).sum();
+            RayStats {
+                visited: all.leaves[..upto].to_vec(),
+                hit: best.is_some(),
+                wasted: tests - best.is_some() as u64,
+                hist_tests: h.box_tests,
+                stack_tests: g.box_tests,
+                backs: h.passes.saturating_sub(1) as usize,
+                distances: h.back_distances,
             }
-            wasted += tests - best.is_some() as u64;
-            let backs = h.passes.saturating_sub(1) as usize;
-            back[backs.min(BACK_BINS - 1)] += 1;
-            for &d in &h.back_distances {
+        };
+        let parts: Vec<RayStats> = {
+            use rayon::prelude::*;
+            rays.par_iter().map(per_ray).collect()
+        };
+        let mut per_leaf = vec![0u64; b.leaf_tris.len()];
+        let mut wasted = 0u64;
+        let mut back = vec![0u64; BACK_BINS];
+        let mut dist = vec![0u64; b.depth + 2];
+        let (mut hist_tests, mut stack_tests, mut rays_hit) = (0u64, 0u64, 0u64);
+        for p in parts {
+            for leaf in p.visited {
+                per_leaf[leaf as usize] += 1;
+            }
+            rays_hit += p.hit as u64;
+            wasted += p.wasted;
+            hist_tests += p.hist_tests;
+            stack_tests += p.stack_tests;
+            back[p.backs.min(BACK_BINS - 1)] += 1;
+            for d in p.distances {
                 dist[(d as usize).min(b.depth + 1)] += 1;
             }
         }

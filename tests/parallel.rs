@@ -42,3 +42,12 @@ fn verify_is_the_same_on_one_and_two_threads() {
     let s2 = pool(2).install(|| verify_slab(&cfg, &scene));
     assert_eq!(untimed(&s1), untimed(&s2));
 }
+
+#[test]
+fn stats_are_the_same_on_one_and_two_threads() {
+    let scene = Scene::builtin();
+    let one = pool(1).install(|| raypipe::stats::stats(&scene, &[2, 8], 300, 4).unwrap());
+    let two = pool(2).install(|| raypipe::stats::stats(&scene, &[2, 8], 300, 4).unwrap());
+    assert_eq!(serde_json::to_string(&one).unwrap(), serde_json::to_string(&two).unwrap());
+    assert!(one.rows.iter().all(|r| r.rays_hit > 0));
+}
