@@ -81,6 +81,9 @@ struct VerifyArgs {
     /// Print the results as JSON.
     #[arg(long)]
     json: bool,
+    /// A plan (`raypipe plan --json`): verify only its formats within budget (unless --format).
+    #[arg(long)]
+    plan: Option<PathBuf>,
     #[command(flatten)]
     rti: RtiArgs,
 }
@@ -201,9 +204,12 @@ enum Cmd {
         /// Unit: rti, slab or op.
         #[arg(long, default_value = "rti")]
         unit: String,
-        /// Number format.
-        #[arg(long, value_parser = parse_format, default_value = "f32")]
-        format: AnyFormat,
+        /// Number format (default f32, or the plan's narrowest format within its budget).
+        #[arg(long, value_parser = parse_format)]
+        format: Option<AnyFormat>,
+        /// A plan (`raypipe plan --json`): its format, leaf size and level pipelines.
+        #[arg(long)]
+        plan: Option<PathBuf>,
         /// Output directory (replaced atomically).
         #[arg(long, required_unless_present = "check")]
         out: Option<PathBuf>,
@@ -374,10 +380,14 @@ fn load_scene(path: Option<&std::path::Path>) -> Result<Scene, String> {
 fn run_verify(a: VerifyArgs) -> Result<bool, String> {
     let rti = a.rti.config()?;
     let scene = load_scene(a.scene.as_deref())?;
-    let formats = if a.format.is_empty() {
-        DEFAULT_FORMATS.iter().map(|f| f.parse().expect("built-in format name")).collect()
-    } else {
-        a.format
+    let plan = a.plan.as_deref().map(raypipe::plan::load).transpose()?;
+    if let Some(p) = &plan {
+        p.check_scene(&scene)?;
+    }
+    let formats = match (a.format.is_empty(), &plan) {
+        (false, _) => a.format,
+        (true, Some(p)) => p.within_budget()?,
+        (true, None) => DEFAULT_FORMATS.iter().map(|f| f.parse().expect("built-in format name")).collect(),
     };
     let cfg = VerifyConfig { formats, rays: a.rays as usize, seed: a.seed, rti, sample: a.sample as usize };
     let rep = verify(&cfg, &scene);
@@ -410,6 +420,7 @@ fn run() -> Result<bool, String> {
             seed: 1,
             sample: 512,
             json: false,
+            plan: None,
             rti: RtiArgs { cull: false, det_threshold: 0.0, tie: Tie::First },
         }),
         Some(Cmd::Verify(a)) => run_verify(a),
@@ -479,6 +490,7 @@ fn run() -> Result<bool, String> {
         Some(Cmd::Vectors {
             unit,
             format,
+            plan,
             out,
             count,
             seed,
@@ -499,8 +511,20 @@ fn run() -> Result<bool, String> {
             }
             let out = out.ok_or("--out is required")?;
             let unit: vectors::gen::Unit = unit.parse()?;
+            // a plan fixes what the scene does not need: the format, the leaf size, the levels
+            let plan = plan.as_deref().map(raypipe::plan::load).transpose()?;
+            let format = match (format, &plan) {
+                (Some(f), _) => f,
+                (None, Some(p)) => p.narrowest()?,
+                (None, None) => "f32".parse().expect("built-in format name"),
+            };
+            let (leaf_size, levels) =
+                plan.as_ref().map_or((leaf_size, levels), |p| (p.leaf_size, p.level_pipelines as u64));
             let tree = if unit == vectors::gen::Unit::Traverse {
                 let scene = load_scene(scene.as_deref())?;
+                if let Some(p) = &plan {
+                    p.check_scene(&scene)?;
+                }
                 let b = raypipe::bvh::build(&scene, leaf_size);
                 Some(vectors::traverse::TreeInput { name: scene.name.clone(), nodes: b.nodes, root: 0 })
             } else if scene.is_some() {

@@ -6,7 +6,7 @@
 use crate::scene::Scene;
 use crate::verify::{verify, VerifyConfig};
 use datapath::{with_format, AnyFormat, Format};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
 /// What to plan for.
@@ -27,7 +27,7 @@ pub struct PlanConfig {
 }
 
 /// One candidate format.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FormatFit {
     /// Format name.
     pub format: String,
@@ -48,7 +48,7 @@ pub struct FormatFit {
 }
 
 /// The plan.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Plan {
     /// Scene name.
     pub scene: String,
@@ -84,6 +84,47 @@ pub struct Plan {
     pub rays: usize,
     /// Seed.
     pub seed: u64,
+}
+
+/// Reads a plan written by `raypipe plan --json`.
+pub fn load(path: &std::path::Path) -> Result<Plan, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    serde_json::from_str(&text)
+        .map_err(|e| format!("{}: not a plan ({e}); write one with raypipe plan --json", path.display()))
+}
+
+impl Plan {
+    /// The plan's formats within its budget, as formats.
+    pub fn within_budget(&self) -> Result<Vec<AnyFormat>, String> {
+        let v: Vec<AnyFormat> =
+            self.formats.iter().filter(|f| f.meets_budget).map(|f| f.format.parse()).collect::<Result<_, _>>()?;
+        if v.is_empty() {
+            return Err(format!("the plan has no format within its budget {:e}", self.budget));
+        }
+        Ok(v)
+    }
+
+    /// The narrowest format within the budget.
+    pub fn narrowest(&self) -> Result<AnyFormat, String> {
+        self.smallest_within_budget
+            .as_deref()
+            .ok_or_else(|| format!("the plan has no format within its budget {:e}", self.budget))?
+            .parse()
+    }
+
+    /// The plan was made for this scene (same name and triangle count).
+    pub fn check_scene(&self, scene: &Scene) -> Result<(), String> {
+        if self.scene != scene.name || self.triangles != scene.tris.len() {
+            return Err(format!(
+                "the plan was made for scene {} ({} triangles), not {} ({} triangles)",
+                self.scene,
+                self.triangles,
+                scene.name,
+                scene.tris.len()
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Closed / consistently oriented, from the triangles' exact vertex coordinates.

@@ -401,3 +401,55 @@ fn plan_and_stress_print_json() {
     assert!(v["slab"].as_array().unwrap().iter().all(|r| r["false_misses"] == 0));
     assert_eq!(v["seed"], 1);
 }
+
+#[test]
+fn verify_and_vectors_follow_a_plan() {
+    let dir = std::env::temp_dir().join(format!("raypipe-cli-{}-plan", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let o = raypipe(&["plan", "--rays", "16", "--format", "bf16,f32", "--budget", "0", "--json"]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let plan = dir.join("plan.json");
+    std::fs::write(&plan, &o.stdout).unwrap();
+    let p: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let within: Vec<String> = p["formats"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["meets_budget"] == true)
+        .map(|f| f["format"].as_str().unwrap().to_string())
+        .collect();
+    assert!(!within.is_empty());
+    // verify runs exactly the formats within budget
+    let o = raypipe(&["verify", "--rays", "8", "--plan", plan.to_str().unwrap()]);
+    let (out, _) = text(&o);
+    assert!(o.status.success(), "{out}");
+    for f in ["bf16", "f32"] {
+        assert_eq!(out.lines().any(|l| l.starts_with(&format!("{f} "))), within.contains(&f.to_string()), "{out}");
+    }
+    // vectors take the narrowest format and the plan's level pipelines
+    let set = dir.join("set");
+    let o = raypipe(&[
+        "vectors",
+        "--unit",
+        "traverse",
+        "--count",
+        "1",
+        "--plan",
+        plan.to_str().unwrap(),
+        "--out",
+        set.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(set.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(m["format"], p["smallest_within_budget"]);
+    assert_eq!(m["params"]["max_levels"], p["level_pipelines"]);
+    // a plan for another scene, or a file that is not a plan
+    let obj = temp_file("other.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    assert_clear_error(
+        &raypipe(&["verify", "--plan", plan.to_str().unwrap(), "--scene", obj.to_str().unwrap()]),
+        "the plan was made for scene",
+    );
+    let bad = temp_file("bad.json", "{}");
+    assert_clear_error(&raypipe(&["verify", "--plan", bad.to_str().unwrap()]), "not a plan");
+}
