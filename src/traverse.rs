@@ -60,6 +60,9 @@ pub struct TraverseRow {
     pub back_within_8: u64,
     /// Back traversals.
     pub back_total: u64,
+    /// Box tests a traversal to the end would add after the first N leaves: the work stopping
+    /// at N skips.
+    pub box_tests_skipped: u64,
 }
 
 /// The whole run.
@@ -164,6 +167,7 @@ fn one_format<F: Format>(
         restarts: 0,
         back_within_8: 0,
         back_total: 0,
+        box_tests_skipped: 0,
     };
     for ray in rays {
         let sr = s.prepare(ray.o, ray.d, ray.tmin, ray.tmax);
@@ -173,6 +177,9 @@ fn one_format<F: Format>(
         };
         let g = stack_traverse(tree, n, test);
         let h = history_traverse(hw, n, |&i| test(i));
+        if h.leaves.len() == n {
+            row.box_tests_skipped += history_traverse(hw, usize::MAX, |&i| test(i)).box_tests - h.box_tests;
+        }
         let t = trail_traverse(hw, n, |&i| test(i));
         row.rays += 1;
         row.history_mismatches += (h.leaves != g.leaves) as u64;
@@ -219,6 +226,21 @@ pub fn render(r: &TraverseReport) -> String {
     }
     s += "\nhist≠/trail≠: rays whose first-N leaf sequence differs from the ordered stack traversal with the same box tester (must be 0).\n";
     s += "no-restart: rays with leaves that needed a single pass; overhead: box tests of the history traversal / the stack traversal's; back<=8: back traversals within 8 levels.\n";
+    s += "skipped work: box tests a traversal to the end would add after the first N leaves: ";
+    s += &r
+        .rows
+        .iter()
+        .map(|w| {
+            format!(
+                "{} {} ({:.1}% of the history traversal's)",
+                w.format,
+                w.box_tests_skipped,
+                100.0 * w.box_tests_skipped as f64 / w.history_box_tests.max(1) as f64
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    s += "\n";
     s += if r.passed { "equivalence: PASS\n" } else { "equivalence: FAIL\n" };
     s
 }

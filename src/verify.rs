@@ -61,6 +61,9 @@ pub struct FormatReport {
     pub closest_disagreements: u64,
     /// Model throughput of the pairwise batch path, million tests per second (one thread).
     pub mtests_per_s: f64,
+    /// Tests whose valid bit was cleared at stage 7: the work a valid-gated divide stage (and
+    /// everything after it) skips.
+    pub divide_skipped: u64,
     /// The first property failure, as an `explain` command line.
     pub first_violation: Option<String>,
 }
@@ -124,11 +127,11 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// One ray's share of a format report: counts (tests, decisive, golden hits, model hits,
-/// false misses, false hits, violations, shared hits, closest-hit disagreements), t errors and
-/// the first violation.
+/// false misses, false hits, violations, shared hits, closest-hit disagreements, divides
+/// skipped), t errors and the first violation.
 #[derive(Default)]
 struct RayAcc {
-    c: [u64; 9],
+    c: [u64; 10],
     ulps: Vec<f64>,
     rels: Vec<f64>,
     first_violation: Option<String>,
@@ -159,6 +162,7 @@ fn run_format<F: Format>(
         t_err_rel_median: 0.0,
         t_err_rel_max: 0.0,
         closest_disagreements: 0,
+        divide_skipped: 0,
         mtests_per_s: 0.0,
         first_violation: None,
     };
@@ -191,6 +195,7 @@ fn run_format<F: Format>(
                 acc.rels.push(j.t_error() / j.golden.t.abs().max(f64::MIN_POSITIVE));
             }
             let out = rti.test(&mray, &rti.tri(tri.v));
+            acc.c[9] += !out.valid as u64;
             rti.capture(&mut cap, &out, k as u32);
             qtris.push(crate::judge::quantise(&rti, ray, tri).1);
         }
@@ -208,7 +213,7 @@ fn run_format<F: Format>(
         rays.par_iter().zip(lists.par_iter()).map(|(r, l)| per_ray(r, l)).collect()
     };
     let (mut ulps, mut rels) = (Vec::new(), Vec::new());
-    let mut c = [0u64; 9];
+    let mut c = [0u64; 10];
     for p in parts {
         for (a, b) in c.iter_mut().zip(p.c) {
             *a += b;
@@ -229,6 +234,7 @@ fn run_format<F: Format>(
         rep.violations,
         rep.shared_hits,
         rep.closest_disagreements,
+        rep.divide_skipped,
     ] = c;
     rep.t_err_ulps_max = ulps.iter().copied().fold(0.0, f64::max);
     rep.t_err_rel_max = rels.iter().copied().fold(0.0, f64::max);
@@ -345,6 +351,14 @@ pub fn render(r: &VerifyReport) -> String {
         );
     }
     s += "\nf-miss/f-hit: model vs golden f64 on the same quantised inputs; viol: decisive tests (error bound clear of every threshold) where hit/miss differs or the t error exceeds its bound.\n";
+    s += "skipped work: tests whose valid bit clears at stage 7, so a valid-gated divide stage skips them: ";
+    s += &r
+        .formats
+        .iter()
+        .map(|f| format!("{} {:.1}%", f.format, 100.0 * f.divide_skipped as f64 / f.tests.max(1) as f64))
+        .collect::<Vec<_>>()
+        .join(", ");
+    s += "\n";
     s += &render_slab(&r.slab);
     if r.passed {
         s += "property: PASS (no violations)\n";

@@ -51,3 +51,33 @@ fn stats_are_the_same_on_one_and_two_threads() {
     assert_eq!(serde_json::to_string(&one).unwrap(), serde_json::to_string(&two).unwrap());
     assert!(one.rows.iter().all(|r| r.rays_hit > 0));
 }
+
+#[test]
+fn skipped_work_is_counted() {
+    let scene = Scene::builtin();
+    // RTI: every hit was valid, so the divides skipped are at most the tests without a hit
+    let cfg =
+        VerifyConfig { formats: vec!["f32".parse().unwrap()], rays: 16, seed: 2, rti: Default::default(), sample: 512 };
+    let f = &verify(&cfg, &scene).formats[0];
+    assert!(f.divide_skipped > 0 && f.divide_skipped <= f.tests - f.model_hits, "{f:?}");
+    // traversal: stopping at N = 1 skips box tests; an N no ray reaches skips none
+    let t = |n: usize| {
+        raypipe::traverse::traverse(
+            &raypipe::traverse::TraverseConfig {
+                formats: vec!["f32".parse().unwrap()],
+                variant: "plain".into(),
+                rays: 200,
+                seed: 3,
+                n,
+                leaf_size: 4,
+                levels: 64,
+            },
+            &scene,
+        )
+        .unwrap()
+        .rows[0]
+            .box_tests_skipped
+    };
+    assert!(t(1) > 0);
+    assert_eq!(t(1_000_000), 0);
+}
