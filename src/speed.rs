@@ -221,6 +221,13 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
             bs.push(&s.store_box(lo, hi).unwrap_or_else(|_| s.empty_box()));
         }
         let mut out = SlabOutSoa::with_len(pairs);
+        rows.push(row(
+            "slab f32 kernel (dispatch, plain)",
+            rate(pairs, 5, || {
+                datapath::simd::slab_batch_f32(&s, &rs, &bs, &mut out);
+            }),
+            SLAB_OPS,
+        ));
         rows.push(row("slab f32 scalar model (plain)", rate(pairs, 3, || s.batch(&rs, &bs, &mut out)), SLAB_OPS));
     }
     SpeedReport { pairs, seed, kernels: k.map(|k| format!("{k:?}")), peak_gops: peak / 1e9, rows }

@@ -13,6 +13,7 @@
 
 use crate::format::{DivMode, F16Half, F32Native, Ieee, NanMode, Subnormals};
 use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
+use crate::slab::{BoxesSoa, Slab, SlabNan, SlabOutSoa, SlabRaysSoa};
 use half::f16;
 
 /// Which implementation ran.
@@ -101,6 +102,55 @@ pub fn rti_batch_f16(
         }
         _ => {
             rti.batch(rays, tris, out);
+            Kernel::Scalar
+        }
+    }
+}
+
+/// The kernel `slab_batch_f32` uses for this unit on this machine (the round-to-nearest
+/// variants; the directed one runs the scalar model).
+pub fn slab_kernel_f32(s: &Slab<Ieee<F32Native>>) -> Kernel {
+    #[cfg(target_arch = "x86_64")]
+    if eligible(&s.fmt) && !s.cfg.directed && std::arch::is_x86_feature_detected!("avx2") {
+        return Kernel::Avx2;
+    }
+    let _ = s;
+    Kernel::Scalar
+}
+
+/// [`Slab::batch`] for binary32 on the fastest kernel available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn slab_batch_f32(
+    s: &Slab<Ieee<F32Native>>,
+    rays: &SlabRaysSoa<f32>,
+    boxes: &BoxesSoa<f32>,
+    out: &mut SlabOutSoa<f32>,
+) -> Kernel {
+    let n = rays.tmin.len();
+    assert!(boxes.min[0].len() == n && out.hit.len() == n, "batch lengths differ");
+    let cols_ok = rays.o.iter().chain(&rays.inv_d).all(|c| c.len() == n)
+        && rays.tmax.len() == n
+        && boxes.min.iter().chain(&boxes.max).all(|c| c.len() == n)
+        && out.t_near.len() == n
+        && out.t_far.len() == n;
+    match slab_kernel_f32(s) {
+        #[cfg(target_arch = "x86_64")]
+        Kernel::Avx2 if cols_ok => {
+            let full = n / 8 * 8;
+            // SAFETY: AVX2 was detected; every column holds n >= full lanes (checked above).
+            unsafe { avx2::slab_f32(s, rays, boxes, out, full) };
+            for i in full..n {
+                let o = s.test(&rays.get(i), &boxes.get(i));
+                out.hit[i] = o.hit;
+                out.t_near[i] = o.t_near;
+                out.t_far[i] = o.t_far;
+            }
+            Kernel::Avx2
+        }
+        _ => {
+            s.batch(rays, boxes, out);
             Kernel::Scalar
         }
     }
@@ -224,6 +274,95 @@ mod avx2 {
         }
         t
     };
+
+    /// The next binary32 encoding above each lane (NaN and +inf unchanged, ±0 to the
+    /// smallest subnormal), as the scalar model's `next_up` with IEEE subnormals.
+    #[target_feature(enable = "avx2")]
+    fn next_up(v: __m256) -> __m256 {
+        let b = _mm256_castps_si256(v);
+        let keep = _mm256_or_si256(
+            _mm256_castps_si256(_mm256_cmp_ps::<_CMP_UNORD_Q>(v, v)),
+            _mm256_cmpeq_epi32(b, _mm256_set1_epi32(0x7f80_0000)),
+        );
+        let zero = _mm256_cmpeq_epi32(_mm256_and_si256(b, _mm256_set1_epi32(0x7fff_ffff)), _mm256_setzero_si256());
+        // negative: bits - 1, positive: bits + 1
+        let step = _mm256_or_si256(_mm256_srai_epi32::<31>(b), _mm256_set1_epi32(1));
+        let r = _mm256_add_epi32(b, step);
+        let r = _mm256_blendv_epi8(r, _mm256_set1_epi32(1), zero);
+        _mm256_castsi256_ps(_mm256_blendv_epi8(r, b, keep))
+    }
+
+    /// The next encoding below: next_up mirrored through the sign (NaN unchanged).
+    #[target_feature(enable = "avx2")]
+    fn next_down(v: __m256) -> __m256 {
+        let sign = _mm256_set1_ps(-0.0);
+        _mm256_xor_ps(next_up(_mm256_xor_ps(v, sign)), sign)
+    }
+
+    #[target_feature(enable = "avx2")]
+    pub(super) fn slab_f32(
+        s: &Slab<Ieee<F32Native>>,
+        rays: &SlabRaysSoa<f32>,
+        boxes: &BoxesSoa<f32>,
+        out: &mut SlabOutSoa<f32>,
+        full: usize,
+    ) {
+        let nan = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fc0_0000));
+        // SAFETY: the caller checked that every column holds at least `full` lanes.
+        let load = |c: &Vec<f32>, i: usize| unsafe { _mm256_loadu_ps(c.as_ptr().add(i)) };
+        let take_on_false = s.cfg.nan == SlabNan::TakeOnFalse;
+        // near chain: acc replaced by x when x is farther in; far chain: when x is nearer
+        let near_sel = |acc: __m256, x: __m256| {
+            if take_on_false {
+                _mm256_blendv_ps(x, acc, _mm256_cmp_ps::<_CMP_LE_OQ>(x, acc))
+            } else {
+                _mm256_blendv_ps(acc, x, _mm256_cmp_ps::<_CMP_LT_OQ>(acc, x))
+            }
+        };
+        let far_sel = |acc: __m256, x: __m256| {
+            if take_on_false {
+                _mm256_blendv_ps(x, acc, _mm256_cmp_ps::<_CMP_LE_OQ>(acc, x))
+            } else {
+                _mm256_blendv_ps(acc, x, _mm256_cmp_ps::<_CMP_LT_OQ>(x, acc))
+            }
+        };
+        let mut i = 0;
+        while i < full {
+            let mut tn = load(&rays.tmin, i);
+            let mut tf = load(&rays.tmax, i);
+            let mut near = [tn; 3];
+            let mut far = [tf; 3];
+            for a in 0..3 {
+                let (o, inv) = (load(&rays.o[a], i), load(&rays.inv_d[a], i));
+                let tlo = _mm256_mul_ps(_mm256_sub_ps(load(&boxes.min[a], i), o), inv);
+                let thi = _mm256_mul_ps(_mm256_sub_ps(load(&boxes.max[a], i), o), inv);
+                // the sign bit of 1/d picks the near plane (blendv reads the sign bit)
+                near[a] = _mm256_blendv_ps(tlo, thi, inv);
+                far[a] = _mm256_blendv_ps(thi, tlo, inv);
+            }
+            for a in 0..3 {
+                tn = near_sel(tn, near[a]);
+                tf = far_sel(tf, far[a]);
+            }
+            for _ in 0..s.cfg.widen_ulps.unsigned_abs() {
+                if s.cfg.widen_ulps > 0 {
+                    tn = next_down(tn);
+                    tf = next_up(tf);
+                } else {
+                    tn = next_up(tn);
+                    tf = next_down(tf);
+                }
+            }
+            let hit = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf)) as usize;
+            // SAFETY: lanes i..i + 8 are in bounds; the bytes written are 0 or 1.
+            unsafe {
+                (out.hit.as_mut_ptr().add(i) as *mut u64).write_unaligned(SPREAD[hit]);
+                _mm256_storeu_ps(out.t_near.as_mut_ptr().add(i), canon(tn, nan));
+                _mm256_storeu_ps(out.t_far.as_mut_ptr().add(i), canon(tf, nan));
+            }
+            i += 8;
+        }
+    }
 
     /// Replaces NaN lanes by `canonical`.
     #[target_feature(enable = "avx2")]

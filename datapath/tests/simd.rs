@@ -119,3 +119,79 @@ fn the_kernels_run_where_the_machine_has_them_and_hit_often_enough_to_matter() {
     assert!(hits > 200 && hits < 3800, "{hits}");
     assert!(out.t.iter().any(|t| t.is_nan()) && out.t.iter().any(|t| t.is_infinite()));
 }
+
+mod slab {
+    use super::*;
+    use datapath::simd::{slab_batch_f32, slab_kernel_f32};
+    use datapath::slab::{Aabb, BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa};
+
+    fn f64_value(r: &mut SplitMix64) -> f64 {
+        match r.below(12) {
+            0 => [0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 1e-40, -1e-40, 3e38][r.below(8) as usize],
+            1 => f32::from_bits(r.next_u64() as u32) as f64,
+            _ => r.range(-2.0, 2.0),
+        }
+    }
+
+    fn run(variant: &str, seed: u64, n: usize) -> Result<(SlabOutSoa<f32>, SlabOutSoa<f32>, Kernel), TestCaseError> {
+        let f = Ieee::new(F32Native, FpOpts::default());
+        let s = Slab::new(f, SlabConfig::named(variant).unwrap());
+        let mut r = SplitMix64::new(seed);
+        let (mut rays, mut boxes) = (SlabRaysSoa::default(), BoxesSoa::default());
+        for _ in 0..n {
+            let c: [f64; 3] = std::array::from_fn(|_| r.range(-1.0, 1.0));
+            let o: [f64; 3] = std::array::from_fn(|_| f64_value(&mut r));
+            // half the rays aim near the box centre so that hits and grazes occur
+            let d: [f64; 3] = if r.below(2) == 0 {
+                std::array::from_fn(|a| c[a] + r.range(-0.6, 0.6) - o[a])
+            } else {
+                std::array::from_fn(|_| f64_value(&mut r))
+            };
+            let tmax = if r.below(3) == 0 { f64_value(&mut r) } else { f64::INFINITY };
+            rays.push(&s.prepare(o, d, 0.0, tmax));
+            // a box around c, or raw bits
+            let b = if r.below(4) == 0 {
+                Aabb {
+                    min: std::array::from_fn(|_| f32::from_bits(r.next_u64() as u32)),
+                    max: std::array::from_fn(|_| f32::from_bits(r.next_u64() as u32)),
+                }
+            } else {
+                let e: [f64; 3] = std::array::from_fn(|_| if r.below(5) == 0 { 0.0 } else { r.range(0.0, 0.5) });
+                s.store_box(std::array::from_fn(|a| c[a] - e[a]), std::array::from_fn(|a| c[a] + e[a])).unwrap()
+            };
+            boxes.push(&b);
+        }
+        let (mut a, mut b) = (SlabOutSoa::with_len(n), SlabOutSoa::with_len(n));
+        s.batch(&rays, &boxes, &mut a);
+        let k = slab_batch_f32(&s, &rays, &boxes, &mut b);
+        Ok((a, b, k))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+        #[test]
+        fn slab_kernel_matches_the_scalar_model(seed in any::<u64>(), n in 0usize..70, v in 0usize..4) {
+            let variant = ["plain", "conservative", "take-on-false", "embree"][v];
+            let (a, b, _) = run(variant, seed, n)?;
+            prop_assert_eq!(&a.hit, &b.hit);
+            let bits = |x: &Vec<f32>| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            prop_assert_eq!(bits(&a.t_near), bits(&b.t_near));
+            prop_assert_eq!(bits(&a.t_far), bits(&b.t_far));
+        }
+    }
+
+    #[test]
+    fn the_slab_kernel_runs_and_the_directed_variant_stays_scalar() {
+        let f = Ieee::new(F32Native, FpOpts::default());
+        #[cfg(target_arch = "x86_64")]
+        assert_eq!(
+            slab_kernel_f32(&Slab::new(f, SlabConfig::named("conservative").unwrap())) == Kernel::Avx2,
+            std::arch::is_x86_feature_detected!("avx2")
+        );
+        assert_eq!(slab_kernel_f32(&Slab::new(f, SlabConfig::named("directed").unwrap())), Kernel::Scalar);
+        let (a, _, _) = run("plain", 5, 4000).unwrap();
+        let hits = a.hit.iter().filter(|&&h| h).count();
+        assert!(hits > 200 && hits < 3800, "{hits}");
+    }
+}
