@@ -1,6 +1,6 @@
 //! criterion benchmarks of the RTI models (pairwise batch path) against baselines: the golden
 //! f64 reference, a plain scalar f32 Möller–Trumbore and a `half`-crate scalar fp16 one.
-//! Run: `cargo bench --bench rti`.
+//! Run: `cargo bench --bench rti` (`RAYPIPE_PLAN=plan.json` benches only a plan's formats).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use datapath::rng::SplitMix64;
@@ -29,8 +29,12 @@ fn bench_models(c: &mut Criterion) {
     let cases = cases();
     let mut g = c.benchmark_group("rti_batch");
     g.throughput(Throughput::Elements(N as u64));
-    for name in ["f32", "fp16", "bf16", "e8m16", "q8.24:divide"] {
-        let any: AnyFormat = name.parse().unwrap();
+    // RAYPIPE_PLAN=plan.json (from `raypipe plan --json`) benches only the plan's formats within budget
+    let formats: Vec<AnyFormat> = match std::env::var_os("RAYPIPE_PLAN") {
+        Some(p) => raypipe::plan::load(std::path::Path::new(&p)).and_then(|p| p.within_budget()).expect("RAYPIPE_PLAN"),
+        None => ["f32", "fp16", "bf16", "e8m16", "q8.24:divide"].iter().map(|n| n.parse().unwrap()).collect(),
+    };
+    for any in formats {
         with_format!(any, |f| {
             let rti = Rti::new(f, RtiConfig::default());
             let (mut rays, mut tris) = (RaysSoa::default(), TrisSoa::default());
