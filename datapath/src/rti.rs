@@ -434,7 +434,15 @@ impl<F: Format> Rti<F> {
     pub fn batch(&self, rays: &RaysSoa<F::V>, tris: &TrisSoa<F::V>, out: &mut HitsSoa<F::V>) {
         let n = rays.len();
         assert!(tris.len() == n && out.len() == n, "batch lengths differ");
-        for i in 0..n {
+        self.batch_from(rays, tris, out, 0);
+    }
+
+    /// [`Rti::batch`] from slot `from` on (the SIMD kernels' tail).
+    ///
+    /// # Panics
+    /// If a column is shorter than the ray batch.
+    pub fn batch_from(&self, rays: &RaysSoa<F::V>, tris: &TrisSoa<F::V>, out: &mut HitsSoa<F::V>, from: usize) {
+        for i in from..rays.len() {
             let o = self.test(&rays.get(i), &tris.get(i));
             out.hit[i] = o.hit;
             out.valid[i] = o.valid;

@@ -50,6 +50,51 @@ pub fn kernel_f16(rti: &Rti<Ieee<F16Half>>) -> Kernel {
     Kernel::Scalar
 }
 
+/// The signature of an RTI kernel: lanes `0..full` of every column.
+#[cfg(target_arch = "x86_64")]
+type RtiKernelFn<F> = unsafe fn(
+    &Rti<F>,
+    &RaysSoa<<F as crate::Format>::V>,
+    &TrisSoa<<F as crate::Format>::V>,
+    &mut HitsSoa<<F as crate::Format>::V>,
+    usize,
+);
+
+/// Every column of an RTI batch holds `n` slots.
+fn rti_columns_ok<V>(rays: &RaysSoa<V>, tris: &TrisSoa<V>, out: &HitsSoa<V>, n: usize) -> bool {
+    rays.o.iter().chain(&rays.d).all(|c| c.len() == n)
+        && rays.tmax.len() == n
+        && tris.v.iter().flatten().all(|c| c.len() == n)
+        && out.valid.len() == n
+        && [&out.t, &out.u, &out.v].iter().all(|c| c.len() == n)
+}
+
+/// Runs `kernel` (when `which` is AVX2 and every column has the batch's length) on the full
+/// 8-lane vectors and the scalar model on the rest; otherwise the scalar model throughout.
+fn rti_dispatch<F: crate::Format>(
+    rti: &Rti<F>,
+    rays: &RaysSoa<F::V>,
+    tris: &TrisSoa<F::V>,
+    out: &mut HitsSoa<F::V>,
+    which: Kernel,
+    #[cfg(target_arch = "x86_64")] kernel: RtiKernelFn<F>,
+) -> Kernel {
+    let n = rays.len();
+    assert!(tris.len() == n && out.len() == n, "batch lengths differ");
+    #[cfg(target_arch = "x86_64")]
+    if which == Kernel::Avx2 && rti_columns_ok(rays, tris, out, n) {
+        let full = n / 8 * 8;
+        // SAFETY: `which` is AVX2 only after run-time feature detection; every column holds
+        // n >= full slots (checked above).
+        unsafe { kernel(rti, rays, tris, out, full) };
+        rti.batch_from(rays, tris, out, full);
+        return Kernel::Avx2;
+    }
+    let _ = which;
+    rti.batch(rays, tris, out);
+    Kernel::Scalar
+}
+
 /// [`Rti::batch`] for binary32 on the fastest kernel available; the same bits.
 ///
 /// # Panics
@@ -60,23 +105,16 @@ pub fn rti_batch_f32(
     tris: &TrisSoa<f32>,
     out: &mut HitsSoa<f32>,
 ) -> Kernel {
-    let n = rays.len();
-    assert!(tris.len() == n && out.len() == n, "batch lengths differ");
-    match kernel_f32(rti) {
+    let which = kernel_f32(rti);
+    rti_dispatch(
+        rti,
+        rays,
+        tris,
+        out,
+        which,
         #[cfg(target_arch = "x86_64")]
-        Kernel::Avx2 => {
-            let full = n / 8 * 8;
-            // SAFETY: AVX2 was detected at run time; the kernel reads and writes lanes
-            // 0..full of columns whose lengths were checked above.
-            unsafe { avx2::rti_f32(rti, rays, tris, out, full) };
-            tail(rti, rays, tris, out, full);
-            Kernel::Avx2
-        }
-        _ => {
-            rti.batch(rays, tris, out);
-            Kernel::Scalar
-        }
-    }
+        avx2::rti_f32,
+    )
 }
 
 /// [`Rti::batch`] for binary16 on the fastest kernel available; the same bits.
@@ -89,22 +127,16 @@ pub fn rti_batch_f16(
     tris: &TrisSoa<f16>,
     out: &mut HitsSoa<f16>,
 ) -> Kernel {
-    let n = rays.len();
-    assert!(tris.len() == n && out.len() == n, "batch lengths differ");
-    match kernel_f16(rti) {
+    let which = kernel_f16(rti);
+    rti_dispatch(
+        rti,
+        rays,
+        tris,
+        out,
+        which,
         #[cfg(target_arch = "x86_64")]
-        Kernel::Avx2 => {
-            let full = n / 8 * 8;
-            // SAFETY: AVX2 and F16C were detected at run time; lanes 0..full are in bounds.
-            unsafe { avx2::rti_f16(rti, rays, tris, out, full) };
-            tail(rti, rays, tris, out, full);
-            Kernel::Avx2
-        }
-        _ => {
-            rti.batch(rays, tris, out);
-            Kernel::Scalar
-        }
-    }
+        avx2::rti_f16,
+    )
 }
 
 /// The kernel `slab_batch_f32` uses for this unit on this machine (the round-to-nearest
@@ -141,36 +173,13 @@ pub fn slab_batch_f32(
             let full = n / 8 * 8;
             // SAFETY: AVX2 was detected; every column holds n >= full lanes (checked above).
             unsafe { avx2::slab_f32(s, rays, boxes, out, full) };
-            for i in full..n {
-                let o = s.test(&rays.get(i), &boxes.get(i));
-                out.hit[i] = o.hit;
-                out.t_near[i] = o.t_near;
-                out.t_far[i] = o.t_far;
-            }
+            s.batch_from(rays, boxes, out, full);
             Kernel::Avx2
         }
         _ => {
             s.batch(rays, boxes, out);
             Kernel::Scalar
         }
-    }
-}
-
-/// The lanes after the last full vector, on the scalar model.
-fn tail<F: crate::Format>(
-    rti: &Rti<F>,
-    rays: &RaysSoa<F::V>,
-    tris: &TrisSoa<F::V>,
-    out: &mut HitsSoa<F::V>,
-    from: usize,
-) {
-    for i in from..rays.len() {
-        let o = rti.test(&rays.get(i), &tris.get(i));
-        out.hit[i] = o.hit;
-        out.valid[i] = o.valid;
-        out.t[i] = o.t;
-        out.u[i] = o.u;
-        out.v[i] = o.v;
     }
 }
 

@@ -552,7 +552,21 @@ impl<F: Format> Slab<F> {
     pub fn batch(&self, rays: &SlabRaysSoa<F::V>, boxes: &BoxesSoa<F::V>, out: &mut SlabOutSoa<F::V>) {
         let n = rays.tmin.len();
         assert!(boxes.min[0].len() == n && out.hit.len() == n, "batch lengths differ");
-        for i in 0..n {
+        self.batch_from(rays, boxes, out, 0);
+    }
+
+    /// [`Slab::batch`] from slot `from` on (the SIMD kernel's tail).
+    ///
+    /// # Panics
+    /// If a column is shorter than the ray batch.
+    pub fn batch_from(
+        &self,
+        rays: &SlabRaysSoa<F::V>,
+        boxes: &BoxesSoa<F::V>,
+        out: &mut SlabOutSoa<F::V>,
+        from: usize,
+    ) {
+        for i in from..rays.tmin.len() {
             let o = self.test(&rays.get(i), &boxes.get(i));
             out.hit[i] = o.hit;
             out.t_near[i] = o.t_near;

@@ -195,3 +195,18 @@ mod slab {
         assert!(hits > 200 && hits < 3800, "{hits}");
     }
 }
+
+#[test]
+fn a_short_column_is_never_read_past_its_end_by_a_kernel() {
+    // the kernels read every column through raw pointers: a batch whose columns disagree in
+    // length must take the scalar path, which panics on the short column
+    let f = Ieee::new(F32Native, FpOpts::default());
+    let rti = Rti::new(f, RtiConfig::default());
+    let (mut rays, tris) = columns(&f, 16, 1, &F32_SPECIALS);
+    rays.d[1].truncate(9);
+    let r = std::panic::catch_unwind(move || {
+        let mut out = HitsSoa::with_len(16);
+        rti_batch_f32(&rti, &rays, &tris, &mut out)
+    });
+    assert!(r.is_err());
+}
