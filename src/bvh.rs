@@ -25,18 +25,7 @@ pub struct SceneBvh {
 impl SceneBvh {
     /// The same tree for the golden stack traversal.
     pub fn golden_tree(&self) -> golden::bvh::Tree {
-        use golden::bvh::Node;
-        golden::bvh::Tree {
-            nodes: self
-                .nodes
-                .iter()
-                .map(|n| match n.children {
-                    Some([l, r]) => Node::Inner { left: l, right: r },
-                    None => Node::Leaf { leaf: n.leaf },
-                })
-                .collect(),
-            root: Some(0),
-        }
+        vectors::traverse::golden_tree(&self.nodes, 0)
     }
 
     /// The hardware layout for `levels` level pipelines, each entry naming its node (the box

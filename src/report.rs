@@ -62,6 +62,26 @@ pub struct Point {
     pub pareto: bool,
 }
 
+impl Point {
+    /// A point with nothing measured yet.
+    fn new(unit: &str, variant: String, f: AnyFormat) -> Self {
+        Point {
+            unit: unit.into(),
+            variant,
+            width: with_format!(f, |f| f.width()),
+            ns_per_test: 0.0,
+            tests: 0,
+            false_misses: 0,
+            false_hits: 0,
+            error_rate: 0.0,
+            t_err_ulps_median: 0.0,
+            t_err_ulps_max: 0.0,
+            t_err_rel_max: 0.0,
+            pareto: false,
+        }
+    }
+}
+
 /// The report.
 #[derive(Clone, Debug, Serialize)]
 pub struct Report {
@@ -143,20 +163,7 @@ pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
     let mut points = Vec::new();
     for f in &cfg.formats {
         let name = f.name();
-        let mut p = Point {
-            unit: "rti".into(),
-            variant: name.clone(),
-            width: with_format!(*f, |f| f.width()),
-            ns_per_test: 0.0,
-            tests: 0,
-            false_misses: 0,
-            false_hits: 0,
-            error_rate: 0.0,
-            t_err_ulps_median: 0.0,
-            t_err_ulps_max: 0.0,
-            t_err_rel_max: 0.0,
-            pareto: false,
-        };
+        let mut p = Point::new("rti", name.clone(), *f);
         // time: the fastest bit-identical implementation (SIMD kernel where one applies)
         p.ns_per_test = 1e3 / crate::speed::rti_rate(*f, 512, cfg.seed).max(1e-9);
         for s in scenes {
@@ -182,20 +189,7 @@ pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
         let name = f.name();
         for v in &cfg.variants {
             datapath::slab::SlabConfig::named(v)?;
-            let mut p = Point {
-                unit: "slab".into(),
-                variant: format!("{name} {v}"),
-                width: with_format!(*f, |f| f.width()),
-                ns_per_test: 0.0,
-                tests: 0,
-                false_misses: 0,
-                false_hits: 0,
-                error_rate: 0.0,
-                t_err_ulps_median: 0.0,
-                t_err_ulps_max: 0.0,
-                t_err_rel_max: 0.0,
-                pareto: false,
-            };
+            let mut p = Point::new("slab", format!("{name} {v}"), *f);
             let (mut time, mut timed) = (0.0, 0u64);
             for s in scenes {
                 let rows = verify_slab(&VerifyConfig { formats: vec![*f], ..vcfg.clone() }, s);

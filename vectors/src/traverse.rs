@@ -277,7 +277,7 @@ pub(crate) fn generate<F: Format>(
         .ok_or("tree has no leaf")?;
     let deep_box = (tree.nodes[deep_node].min, tree.nodes[deep_node].max);
     let root = &tree.nodes[tree.root as usize];
-    let golden = golden_tree(tree);
+    let golden = golden_tree(&tree.nodes, tree.root);
     let w = f.width();
     let k = crate::gen::kind_of(&f);
     let mut files = vec![
@@ -361,18 +361,18 @@ pub(crate) fn generate<F: Format>(
     Ok(TraverseParts { files, counts, params, options })
 }
 
-fn golden_tree(t: &TreeInput) -> golden::bvh::Tree {
+/// The same tree for the golden stack traversal (node indices kept).
+pub fn golden_tree(nodes: &[NodeDesc], root: u32) -> golden::bvh::Tree {
     use golden::bvh::Node;
     golden::bvh::Tree {
-        nodes: t
-            .nodes
+        nodes: nodes
             .iter()
             .map(|n| match n.children {
                 Some([l, r]) => Node::Inner { left: l, right: r },
                 None => Node::Leaf { leaf: n.leaf },
             })
             .collect(),
-        root: Some(t.root),
+        root: Some(root),
     }
 }
 
