@@ -9,7 +9,9 @@
 //! NaN payloads never influence a non-NaN result or a compare, so the kernels canonicalise NaN
 //! only where a value leaves them (t, u, v). Eligible formats: IEEE subnormals and canonical
 //! NaN (either division mode, either culling); others, and machines without AVX2, run the
-//! scalar model. Columns are processed in chunks of 8 lanes straight from the SoA inputs.
+//! scalar model, as does a det threshold that is negative or NaN (the kernels' sign-flip side
+//! tests need det_ok to exclude det = ±0). Columns are processed 8 lanes at a time straight
+//! from the SoA inputs.
 
 use crate::format::{DivMode, F16Half, F32Native, Ieee, NanMode, Subnormals};
 use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
@@ -32,7 +34,7 @@ fn eligible<B: crate::format::IeeeBackend>(f: &Ieee<B>) -> bool {
 /// The kernel `rti_batch_f32` uses for this unit on this machine.
 pub fn kernel_f32(rti: &Rti<Ieee<F32Native>>) -> Kernel {
     #[cfg(target_arch = "x86_64")]
-    if eligible(&rti.fmt) && std::arch::is_x86_feature_detected!("avx2") {
+    if eligible(&rti.fmt) && rti.det_thr >= 0.0 && std::arch::is_x86_feature_detected!("avx2") {
         return Kernel::Avx2;
     }
     let _ = rti;
@@ -42,7 +44,10 @@ pub fn kernel_f32(rti: &Rti<Ieee<F32Native>>) -> Kernel {
 /// The kernel `rti_batch_f16` uses for this unit on this machine.
 pub fn kernel_f16(rti: &Rti<Ieee<F16Half>>) -> Kernel {
     #[cfg(target_arch = "x86_64")]
-    if eligible(&rti.fmt) && std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("f16c")
+    if eligible(&rti.fmt)
+        && rti.det_thr.to_f32() >= 0.0
+        && std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("f16c")
     {
         return Kernel::Avx2;
     }
@@ -190,10 +195,20 @@ mod avx2 {
 
     /// The RTI stage table on 8 lanes. `$load(column, i)` gives 8 binary32 lanes,
     /// `$round(x)` rounds a binary32 result to the format, `$store(column, i, x)` writes 8
-    /// canonical-NaN results, `$thr` is the det threshold as binary32.
+    /// results, `$thr` is the det threshold as binary32, `$nan` the canonical NaN as binary32.
     macro_rules! rti_kernel {
-        ($rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr) => {{
-            let (rti, rays, tris, out) = ($rti, $rays, $tris, $out);
+        ($rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $nan:expr) => {{
+            // one loop per (culling, division mode), so that neither is decided per vector
+            let backface = $rti.cull == Cull::Backface;
+            match ($rti.fmt.opts.div, backface) {
+                (DivMode::RecipMul, false) => rti_kernel!(@loop $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $nan, false, true),
+                (DivMode::RecipMul, true) => rti_kernel!(@loop $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $nan, true, true),
+                (DivMode::Divide, false) => rti_kernel!(@loop $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $nan, false, false),
+                (DivMode::Divide, true) => rti_kernel!(@loop $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $nan, true, false),
+            }
+        }};
+        (@loop $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $nan:expr, $backface:expr, $recip:expr) => {{
+            let (rays, tris, out) = ($rays, $tris, $out);
             let load = $load;
             let rd = $round;
             let store = $store;
@@ -207,62 +222,87 @@ mod avx2 {
             let zero = _mm256_setzero_ps();
             let one = _mm256_set1_ps(1.0);
             let sign = _mm256_set1_ps(-0.0);
-            let mut i = 0;
-            while i < $full {
-                let [ox, oy, oz] = [0, 1, 2].map(|a| load(&rays.o[a], i));
-                let [dx, dy, dz] = [0, 1, 2].map(|a| load(&rays.d[a], i));
-                let v = |k: usize, a: usize| load(&tris.v[k][a], i);
-                let (v0x, v0y, v0z) = (v(0, 0), v(0, 1), v(0, 2));
-                // stage 1
-                let (e1x, e1y, e1z) = (sub(v(1, 0), v0x), sub(v(1, 1), v0y), sub(v(1, 2), v0z));
-                let (e2x, e2y, e2z) = (sub(v(2, 0), v0x), sub(v(2, 1), v0y), sub(v(2, 2), v0z));
-                let (sx, sy, sz) = (sub(ox, v0x), sub(oy, v0y), sub(oz, v0z));
-                // stages 2, 3: p = d x e2, q = s x e1
-                let px = sub(mul(dy, e2z), mul(dz, e2y));
-                let py = sub(mul(dz, e2x), mul(dx, e2z));
-                let pz = sub(mul(dx, e2y), mul(dy, e2x));
-                let qx = sub(mul(sy, e1z), mul(sz, e1y));
-                let qy = sub(mul(sz, e1x), mul(sx, e1z));
-                let qz = sub(mul(sx, e1y), mul(sy, e1x));
-                // stages 4-6: (x + y) + z
-                let det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
-                let up = add(add(mul(sx, px), mul(sy, py)), mul(sz, pz));
-                let vp = add(add(mul(dx, qx), mul(dy, qy)), mul(dz, qz));
-                let tp = add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz));
-                // stage 7
-                let uv = add(up, vp);
-                let det_ok = match rti.cull {
-                    Cull::TwoSided => lt(thr, _mm256_andnot_ps(sign, det)),
-                    Cull::Backface => lt(thr, det),
-                };
-                let pos = lt(zero, det);
-                let side = |a, b| _mm256_blendv_ps(le(b, a), le(a, b), pos); // pos ? a <= b : b <= a
-                let valid = _mm256_and_ps(
-                    _mm256_and_ps(det_ok, side(zero, up)),
-                    _mm256_and_ps(_mm256_and_ps(side(zero, vp), side(uv, det)), side(zero, tp)),
-                );
-                // the division last
-                let (t, u, w) = match rti.fmt.opts.div {
-                    DivMode::RecipMul => {
+            let nan = $nan;
+            // Two passes over blocks of BLOCK vectors (software pipelining): the first runs
+            // stages 1-6 and keeps det, u', v' and t'; the second runs stage 7, divides and
+            // stores.
+            // The divide's latency then overlaps the next block's arithmetic instead of
+            // filling the scheduler with instructions that wait for it.
+            const BLOCK: usize = 8;
+            let mut keep = [[zero; 4]; BLOCK];
+            let mut base = 0;
+            while base < $full {
+                let nv = (($full - base) / 8).min(BLOCK);
+                for (k, slot) in keep.iter_mut().enumerate().take(nv) {
+                    let i = base + 8 * k;
+                    let [ox, oy, oz] = [0, 1, 2].map(|a| load(&rays.o[a], i));
+                    let [dx, dy, dz] = [0, 1, 2].map(|a| load(&rays.d[a], i));
+                    let v = |k: usize, a: usize| load(&tris.v[k][a], i);
+                    let (v0x, v0y, v0z) = (v(0, 0), v(0, 1), v(0, 2));
+                    // stage 1
+                    let (e1x, e1y, e1z) = (sub(v(1, 0), v0x), sub(v(1, 1), v0y), sub(v(1, 2), v0z));
+                    let (e2x, e2y, e2z) = (sub(v(2, 0), v0x), sub(v(2, 1), v0y), sub(v(2, 2), v0z));
+                    let (sx, sy, sz) = (sub(ox, v0x), sub(oy, v0y), sub(oz, v0z));
+                    // stages 2, 3: p = d x e2, q = s x e1
+                    let px = sub(mul(dy, e2z), mul(dz, e2y));
+                    let py = sub(mul(dz, e2x), mul(dx, e2z));
+                    let pz = sub(mul(dx, e2y), mul(dy, e2x));
+                    let qx = sub(mul(sy, e1z), mul(sz, e1y));
+                    let qy = sub(mul(sz, e1x), mul(sx, e1z));
+                    let qz = sub(mul(sx, e1y), mul(sy, e1x));
+                    // stages 4-6: (x + y) + z
+                    let det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
+                    let up = add(add(mul(sx, px), mul(sy, py)), mul(sz, pz));
+                    let vp = add(add(mul(dx, qx), mul(dy, qy)), mul(dz, qz));
+                    let tp = add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz));
+                    *slot = [det, up, vp, tp];
+                }
+                for (k, &[det, up, vp, tp]) in keep.iter().enumerate().take(nv) {
+                    let i = base + 8 * k;
+                    // stage 7
+                    let uv = add(up, vp);
+                    // The compares of stage 7, with the det-sign select done by a sign flip:
+                    // when `det_ok` holds, det is neither ±0 nor NaN (threshold >= 0, checked
+                    // by the dispatch), so `det > 0 ? a <= b : b <= a` equals `a^s <= b^s`
+                    // with s = det's sign bit (negation is exact): `valid` is the same bit.
+                    let abs_det = _mm256_andnot_ps(sign, det);
+                    let det_ok = if $backface { lt(thr, det) } else { lt(thr, abs_det) };
+                    let s = _mm256_and_ps(sign, det);
+                    let nonneg = |x| le(zero, _mm256_xor_ps(x, s));
+                    let valid = _mm256_and_ps(
+                        _mm256_and_ps(det_ok, nonneg(up)),
+                        _mm256_and_ps(_mm256_and_ps(nonneg(vp), le(_mm256_xor_ps(uv, s), abs_det)), nonneg(tp)),
+                    );
+                    // the division last
+                    let (t, u, w) = if $recip {
                         let inv = div(one, det);
                         (mul(tp, inv), mul(up, inv), mul(vp, inv))
+                    } else {
+                        (div(tp, det), div(up, det), div(vp, det))
+                    };
+                    let tmin = load(&rays.tmin, i);
+                    let tmax = load(&rays.tmax, i);
+                    let hit = _mm256_and_ps(valid, _mm256_and_ps(le(tmin, t), le(t, tmax)));
+                    let (hm, vm) = (_mm256_movemask_ps(hit) as usize, _mm256_movemask_ps(valid) as usize);
+                    // SAFETY: lanes i..i + 8 are in bounds (checked by the caller); every
+                    // byte written is 0 or 1, a valid bool.
+                    unsafe {
+                        (out.hit.as_mut_ptr().add(i) as *mut u64).write_unaligned(SPREAD[hm]);
+                        (out.valid.as_mut_ptr().add(i) as *mut u64).write_unaligned(SPREAD[vm]);
                     }
-                    DivMode::Divide => (div(tp, det), div(up, det), div(vp, det)),
-                };
-                let tmin = load(&rays.tmin, i);
-                let tmax = load(&rays.tmax, i);
-                let hit = _mm256_and_ps(valid, _mm256_and_ps(le(tmin, t), le(t, tmax)));
-                let (hm, vm) = (_mm256_movemask_ps(hit) as usize, _mm256_movemask_ps(valid) as usize);
-                // SAFETY: lanes i..i + 8 are in bounds (checked by the caller); every byte
-                // written is 0 or 1, a valid bool.
-                unsafe {
-                    (out.hit.as_mut_ptr().add(i) as *mut u64).write_unaligned(SPREAD[hm]);
-                    (out.valid.as_mut_ptr().add(i) as *mut u64).write_unaligned(SPREAD[vm]);
+                    // NaN lanes are rare: canonicalise only when one of the 24 results is NaN
+                    let any_nan =
+                        _mm256_or_ps(_mm256_cmp_ps::<_CMP_UNORD_Q>(t, u), _mm256_cmp_ps::<_CMP_UNORD_Q>(w, w));
+                    let (t, u, w) = if _mm256_movemask_ps(any_nan) == 0 {
+                        (t, u, w)
+                    } else {
+                        (canon(t, nan), canon(u, nan), canon(w, nan))
+                    };
+                    store(&mut out.t, i, t);
+                    store(&mut out.u, i, u);
+                    store(&mut out.v, i, w);
                 }
-                store(&mut out.t, i, t);
-                store(&mut out.u, i, u);
-                store(&mut out.v, i, w);
-                i += 8;
+                base += 8 * nv;
             }
         }};
     }
@@ -397,8 +437,9 @@ mod avx2 {
             full,
             |c: &Vec<f32>, i: usize| unsafe { _mm256_loadu_ps(c.as_ptr().add(i)) },
             |x: __m256| x,
-            |c: &mut Vec<f32>, i: usize, x: __m256| unsafe { _mm256_storeu_ps(c.as_mut_ptr().add(i), canon(x, nan)) },
-            rti.det_thr
+            |c: &mut Vec<f32>, i: usize, x: __m256| unsafe { _mm256_storeu_ps(c.as_mut_ptr().add(i), x) },
+            rti.det_thr,
+            nan
         );
     }
 
@@ -422,12 +463,10 @@ mod avx2 {
             |c: &Vec<f16>, i: usize| unsafe { _mm256_cvtph_ps(_mm_loadu_si128(c.as_ptr().add(i) as *const __m128i)) },
             |x: __m256| _mm256_cvtph_ps(_mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x)),
             |c: &mut Vec<f16>, i: usize, x: __m256| unsafe {
-                _mm_storeu_si128(
-                    c.as_mut_ptr().add(i) as *mut __m128i,
-                    _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(canon(x, nan)),
-                )
+                _mm_storeu_si128(c.as_mut_ptr().add(i) as *mut __m128i, _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x))
             },
-            rti.det_thr.to_f32()
+            rti.det_thr.to_f32(),
+            nan
         );
     }
 }

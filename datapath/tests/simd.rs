@@ -72,7 +72,7 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
     #[test]
-    fn f32_kernel_matches_the_scalar_model(seed in any::<u64>(), n in 0usize..70, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-6), Just(0.5)]) {
+    fn f32_kernel_matches_the_scalar_model(seed in any::<u64>(), n in 0usize..200, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-6), Just(0.5)]) {
         let f = Ieee::new(F32Native, FpOpts { div: if divide { DivMode::Divide } else { DivMode::RecipMul }, ..FpOpts::default() });
         let rti = Rti::new(f, config(cull, thr));
         let (rays, tris) = columns(&f, n, seed, &F32_SPECIALS);
@@ -83,7 +83,7 @@ proptest! {
     }
 
     #[test]
-    fn f16_kernel_matches_the_scalar_model(seed in any::<u64>(), n in 0usize..70, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-3), Just(0.5)]) {
+    fn f16_kernel_matches_the_scalar_model(seed in any::<u64>(), n in 0usize..200, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-3), Just(0.5)]) {
         let f = Ieee::new(F16Half, FpOpts { div: if divide { DivMode::Divide } else { DivMode::RecipMul }, ..FpOpts::default() });
         let rti = Rti::new(f, config(cull, thr));
         let (rays, tris) = columns(&f, n, seed, &F16_SPECIALS);
@@ -110,6 +110,15 @@ fn the_kernels_run_where_the_machine_has_them_and_hit_often_enough_to_matter() {
     let prop = Ieee::new(F16Half, FpOpts { nan: NanMode::Propagate, ..FpOpts::default() });
     assert_eq!(kernel_f32(&Rti::new(ftz, RtiConfig::default())), Kernel::Scalar);
     assert_eq!(kernel_f16(&Rti::new(prop, RtiConfig::default())), Kernel::Scalar);
+    // so does a negative or NaN det threshold (the kernels' sign-flip side tests assume >= 0)
+    for thr in [-0.5f32, f32::NAN] {
+        let mut neg = Rti::new(f32f, RtiConfig::default());
+        neg.det_thr = thr;
+        assert_eq!(kernel_f32(&neg), Kernel::Scalar);
+        let mut neg16 = Rti::new(f16f, RtiConfig::default());
+        neg16.det_thr = half::f16::from_f32(thr);
+        assert_eq!(kernel_f16(&neg16), Kernel::Scalar);
+    }
     // the generated columns are not vacuous: hits, misses and NaN outputs all occur
     let rti = Rti::new(f32f, RtiConfig::default());
     let (rays, tris) = columns(&f32f, 4000, 3, &F32_SPECIALS);
