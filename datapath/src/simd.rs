@@ -1,21 +1,33 @@
-//! SIMD batch kernels of the RTI model, bit-identical to the scalar model, with runtime dispatch.
+//! SIMD batch kernels of the RTI and slab models, bit-identical to the scalar models, with
+//! runtime dispatch.
 //!
-//! One kernel body (the `rti_kernel!` macro) is instantiated for binary32 and binary16 on
-//! AVX2 (+ F16C for binary16), eight tests per vector, in the stage table's exact operation
-//! order with separate multiplies and adds (no FMA). binary16 computes every operation in
-//! binary32 and rounds it to binary16 at once (`vcvtps2ph` nearest-even, then back): binary32's
-//! 24 bits are at least 2·11 + 2, so this double rounding is innocuous for + − × ÷ and the
-//! result is the correctly rounded binary16 operation, subnormals and overflow included.
+//! One kernel body per unit (the `rti_kernel!` and `slab_kernel!` macros) is instantiated for
+//! binary32 and binary16 on AVX2 (+ F16C for binary16), eight tests per vector, in the stage
+//! table's exact operation order with separate multiplies and adds (no FMA). binary16 computes
+//! every operation in binary32 and rounds it to binary16 at once (`vcvtps2ph` nearest-even,
+//! then back): binary32's 24 bits are at least 2·11 + 2, so this double rounding is innocuous
+//! for + − × ÷ and the result is the correctly rounded binary16 operation, subnormals and
+//! overflow included; compares and min/max of binary16 values held in binary32 are exact.
 //! NaN payloads never influence a non-NaN result or a compare, so the kernels canonicalise NaN
-//! only where a value leaves them (t, u, v). Eligible formats: IEEE subnormals and canonical
-//! NaN (either division mode, either culling); others, and machines without AVX2, run the
-//! scalar model, as does a det threshold that is negative or NaN (the kernels' sign-flip side
-//! tests need det_ok to exclude det = ±0). Columns are processed 8 lanes at a time straight
-//! from the SoA inputs.
+//! only where a value leaves them, and only when a movemask shows a NaN lane.
+//!
+//! The slab kernels take either pairs (ray i against box i) or one ray against every box (a
+//! node's children, a level): the second reads only the six box columns and picks each axis's
+//! near plane once per batch. The plain comparator `t = (x > t) ? x : t` is exactly `vmaxps(x,
+//! t)` (the second operand on NaN or equality, ±0 included), so it costs one instruction.
+//!
+//! Eligible formats: IEEE subnormals and canonical NaN (either division mode, either culling;
+//! every slab variant but the directed one); others, and machines without AVX2, run the
+//! scalar model, as does a det threshold that is negative or NaN (the RTI kernels' sign-flip
+//! side tests need det_ok to exclude det = ±0). Columns are processed 8 lanes at a time
+//! straight from the SoA inputs; a batch's last `n mod 8` slots run the scalar model.
+//!
+//! No AVX-512 kernels: the machines this suite is developed and tested on have none, and a
+//! kernel that no test has run is not offered.
 
 use crate::format::{DivMode, F16Half, F32Native, Ieee, NanMode, Subnormals};
 use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
-use crate::slab::{BoxesSoa, Slab, SlabNan, SlabOutSoa, SlabRaysSoa};
+use crate::slab::{BoxesSoa, Slab, SlabNan, SlabOutSoa, SlabRay, SlabRaysSoa};
 use half::f16;
 
 /// Which implementation ran.
@@ -144,14 +156,99 @@ pub fn rti_batch_f16(
     )
 }
 
-/// The kernel `slab_batch_f32` uses for this unit on this machine (the round-to-nearest
-/// variants; the directed one runs the scalar model).
+/// The kernel `slab_batch_f32` / `slab_ray_f32` use for this unit on this machine (the
+/// round-to-nearest variants; the directed one runs the scalar model).
 pub fn slab_kernel_f32(s: &Slab<Ieee<F32Native>>) -> Kernel {
     #[cfg(target_arch = "x86_64")]
     if eligible(&s.fmt) && !s.cfg.directed && std::arch::is_x86_feature_detected!("avx2") {
         return Kernel::Avx2;
     }
     let _ = s;
+    Kernel::Scalar
+}
+
+/// The kernel `slab_batch_f16` / `slab_ray_f16` use for this unit on this machine.
+pub fn slab_kernel_f16(s: &Slab<Ieee<F16Half>>) -> Kernel {
+    #[cfg(target_arch = "x86_64")]
+    if eligible(&s.fmt)
+        && !s.cfg.directed
+        && std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("f16c")
+    {
+        return Kernel::Avx2;
+    }
+    let _ = s;
+    Kernel::Scalar
+}
+
+/// Every box and output column holds `n` slots.
+fn slab_columns_ok<V>(boxes: &BoxesSoa<V>, out: &SlabOutSoa<V>, n: usize) -> bool {
+    boxes.min.iter().chain(&boxes.max).all(|c| c.len() == n)
+        && out.hit.len() == n
+        && out.t_near.len() == n
+        && out.t_far.len() == n
+}
+
+/// Every ray column holds `n` slots.
+fn slab_rays_ok<V>(rays: &SlabRaysSoa<V>, n: usize) -> bool {
+    rays.o.iter().chain(&rays.inv_d).all(|c| c.len() == n) && rays.tmin.len() == n && rays.tmax.len() == n
+}
+
+/// What a slab batch tests: ray i against box i, or one ray against every box.
+#[derive(Clone, Copy)]
+enum SlabRays<'a, V> {
+    Pairs(&'a SlabRaysSoa<V>),
+    One(&'a SlabRay<V>),
+}
+
+/// The signature of a slab kernel: lanes `0..full` of every column.
+#[cfg(target_arch = "x86_64")]
+type SlabKernelFn<F> = unsafe fn(
+    &Slab<F>,
+    SlabRays<<F as crate::Format>::V>,
+    &BoxesSoa<<F as crate::Format>::V>,
+    &mut SlabOutSoa<<F as crate::Format>::V>,
+    usize,
+);
+
+/// Runs `kernel` (when `which` is AVX2 and every column has the batch's length) on the full
+/// 8-lane vectors and the scalar model on the rest; otherwise the scalar model throughout.
+fn slab_dispatch<F: crate::Format>(
+    s: &Slab<F>,
+    rays: SlabRays<F::V>,
+    boxes: &BoxesSoa<F::V>,
+    out: &mut SlabOutSoa<F::V>,
+    which: Kernel,
+    #[cfg(target_arch = "x86_64")] kernel: SlabKernelFn<F>,
+) -> Kernel {
+    let n = out.hit.len();
+    let rays_ok = match rays {
+        SlabRays::Pairs(r) => {
+            assert!(r.tmin.len() == n && boxes.min[0].len() == n, "batch lengths differ");
+            slab_rays_ok(r, n)
+        }
+        SlabRays::One(_) => {
+            assert!(boxes.min[0].len() == n, "batch lengths differ");
+            true
+        }
+    };
+    #[cfg(target_arch = "x86_64")]
+    if which == Kernel::Avx2 && rays_ok && slab_columns_ok(boxes, out, n) {
+        let full = n / 8 * 8;
+        // SAFETY: `which` is AVX2 only after run-time feature detection; every column holds
+        // n >= full slots (checked above).
+        unsafe { kernel(s, rays, boxes, out, full) };
+        match rays {
+            SlabRays::Pairs(r) => s.batch_from(r, boxes, out, full),
+            SlabRays::One(r) => s.batch_ray_from(r, boxes, out, full),
+        }
+        return Kernel::Avx2;
+    }
+    let _ = (which, rays_ok);
+    match rays {
+        SlabRays::Pairs(r) => s.batch(r, boxes, out),
+        SlabRays::One(r) => s.batch_ray(r, boxes, out),
+    }
     Kernel::Scalar
 }
 
@@ -165,27 +262,82 @@ pub fn slab_batch_f32(
     boxes: &BoxesSoa<f32>,
     out: &mut SlabOutSoa<f32>,
 ) -> Kernel {
-    let n = rays.tmin.len();
-    assert!(boxes.min[0].len() == n && out.hit.len() == n, "batch lengths differ");
-    let cols_ok = rays.o.iter().chain(&rays.inv_d).all(|c| c.len() == n)
-        && rays.tmax.len() == n
-        && boxes.min.iter().chain(&boxes.max).all(|c| c.len() == n)
-        && out.t_near.len() == n
-        && out.t_far.len() == n;
-    match slab_kernel_f32(s) {
+    let which = slab_kernel_f32(s);
+    slab_dispatch(
+        s,
+        SlabRays::Pairs(rays),
+        boxes,
+        out,
+        which,
         #[cfg(target_arch = "x86_64")]
-        Kernel::Avx2 if cols_ok => {
-            let full = n / 8 * 8;
-            // SAFETY: AVX2 was detected; every column holds n >= full lanes (checked above).
-            unsafe { avx2::slab_f32(s, rays, boxes, out, full) };
-            s.batch_from(rays, boxes, out, full);
-            Kernel::Avx2
-        }
-        _ => {
-            s.batch(rays, boxes, out);
-            Kernel::Scalar
-        }
-    }
+        avx2::slab_f32,
+    )
+}
+
+/// [`Slab::batch_ray`] (one ray, many boxes) for binary32 on the fastest kernel available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn slab_ray_f32(
+    s: &Slab<Ieee<F32Native>>,
+    ray: &SlabRay<f32>,
+    boxes: &BoxesSoa<f32>,
+    out: &mut SlabOutSoa<f32>,
+) -> Kernel {
+    let which = slab_kernel_f32(s);
+    slab_dispatch(
+        s,
+        SlabRays::One(ray),
+        boxes,
+        out,
+        which,
+        #[cfg(target_arch = "x86_64")]
+        avx2::slab_f32,
+    )
+}
+
+/// [`Slab::batch`] for binary16 on the fastest kernel available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn slab_batch_f16(
+    s: &Slab<Ieee<F16Half>>,
+    rays: &SlabRaysSoa<f16>,
+    boxes: &BoxesSoa<f16>,
+    out: &mut SlabOutSoa<f16>,
+) -> Kernel {
+    let which = slab_kernel_f16(s);
+    slab_dispatch(
+        s,
+        SlabRays::Pairs(rays),
+        boxes,
+        out,
+        which,
+        #[cfg(target_arch = "x86_64")]
+        avx2::slab_f16,
+    )
+}
+
+/// [`Slab::batch_ray`] (one ray, many boxes) for binary16 on the fastest kernel available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn slab_ray_f16(
+    s: &Slab<Ieee<F16Half>>,
+    ray: &SlabRay<f16>,
+    boxes: &BoxesSoa<f16>,
+    out: &mut SlabOutSoa<f16>,
+) -> Kernel {
+    let which = slab_kernel_f16(s);
+    slab_dispatch(
+        s,
+        SlabRays::One(ray),
+        boxes,
+        out,
+        which,
+        #[cfg(target_arch = "x86_64")]
+        avx2::slab_f16,
+    )
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -348,69 +500,192 @@ mod avx2 {
         _mm256_xor_ps(next_up(_mm256_xor_ps(v, sign)), sign)
     }
 
+    /// [`next_up`] on the binary16 grid, for lanes that hold binary16 values widened to binary32.
+    #[target_feature(enable = "avx2,f16c")]
+    fn next_up16(v: __m256) -> __m256 {
+        // exact: every lane is a binary16 value (a NaN stays a NaN and is kept)
+        let b = _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(v);
+        let mag = _mm_and_si128(b, _mm_set1_epi16(0x7fff));
+        let keep = _mm_or_si128(
+            _mm_cmpgt_epi16(mag, _mm_set1_epi16(0x7c00)), // NaN
+            _mm_cmpeq_epi16(b, _mm_set1_epi16(0x7c00)),   // +inf
+        );
+        let zero = _mm_cmpeq_epi16(mag, _mm_setzero_si128());
+        let step = _mm_or_si128(_mm_srai_epi16::<15>(b), _mm_set1_epi16(1));
+        let r = _mm_add_epi16(b, step);
+        let r = _mm_blendv_epi8(r, _mm_set1_epi16(1), zero);
+        _mm256_cvtph_ps(_mm_blendv_epi8(r, b, keep))
+    }
+
+    /// [`next_down`] on the binary16 grid.
+    #[target_feature(enable = "avx2,f16c")]
+    fn next_down16(v: __m256) -> __m256 {
+        let sign = _mm256_set1_ps(-0.0);
+        _mm256_xor_ps(next_up16(_mm256_xor_ps(v, sign)), sign)
+    }
+
+    /// The slab stage table on 8 lanes, for either batch shape. `$load(column, i)` gives 8
+    /// binary32 lanes, `$round(x)` rounds a binary32 result to the format, `$store(column, i,
+    /// x)` writes 8 results, `$up` / `$down` step on the format's grid, `$nan` is the canonical
+    /// NaN as binary32.
+    macro_rules! slab_kernel {
+        ($s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $down:expr, $nan:expr, $bcast:expr) => {{
+            // one loop per comparator and batch shape, so that neither is decided per vector
+            let tof = $s.cfg.nan == SlabNan::TakeOnFalse;
+            match ($rays, tof) {
+                (SlabRays::Pairs(r), false) => slab_kernel!(@loop $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $down, $nan, $bcast, false),
+                (SlabRays::Pairs(r), true) => slab_kernel!(@loop $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $down, $nan, $bcast, true),
+                (SlabRays::One(r), false) => slab_kernel!(@loop $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $down, $nan, $bcast, false),
+                (SlabRays::One(r), true) => slab_kernel!(@loop $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $down, $nan, $bcast, true),
+            }
+        }};
+        // per-batch preparation, hoisted out of the loop: column pointers; for one ray, each
+        // axis's near and far plane columns (picked by the sign bit of 1/d) and the broadcast
+        // origin, 1/d and t interval
+        (@prep pairs $r:ident, $bmin:ident, $bmax:ident, $bcast:ident) => {
+            (
+                $r.o.each_ref().map(|c| c.as_ptr()),
+                $r.inv_d.each_ref().map(|c| c.as_ptr()),
+                $r.tmin.as_ptr(),
+                $r.tmax.as_ptr(),
+            )
+        };
+        (@prep one $r:ident, $bmin:ident, $bmax:ident, $bcast:ident) => {{
+            let neg = $r.inv_d.map(|x| x.to_bits() >> (8 * std::mem::size_of_val(&x) - 1) == 1);
+            (
+                std::array::from_fn::<_, 3, _>(|a| if neg[a] { $bmax[a] } else { $bmin[a] }),
+                std::array::from_fn::<_, 3, _>(|a| if neg[a] { $bmin[a] } else { $bmax[a] }),
+                ($r.o.map($bcast), $r.inv_d.map($bcast)),
+                ($bcast($r.tmin), $bcast($r.tmax)),
+            )
+        }};
+        // axis a of lanes i..i + 8: (near-plane t, far-plane t)
+        (@plane pairs $prep:ident, $bmin:ident, $bmax:ident, $load:ident, $rd:ident, $a:expr, $i:ident) => {{
+            let (o, inv) = ($load($prep.0[$a], $i), $load($prep.1[$a], $i));
+            let tlo = $rd(_mm256_mul_ps($rd(_mm256_sub_ps($load($bmin[$a], $i), o)), inv));
+            let thi = $rd(_mm256_mul_ps($rd(_mm256_sub_ps($load($bmax[$a], $i), o)), inv));
+            // the sign bit of 1/d picks the near plane (blendv reads the sign bit)
+            (_mm256_blendv_ps(tlo, thi, inv), _mm256_blendv_ps(thi, tlo, inv))
+        }};
+        (@plane one $prep:ident, $bmin:ident, $bmax:ident, $load:ident, $rd:ident, $a:expr, $i:ident) => {{
+            let (o, inv) = ($prep.2 .0[$a], $prep.2 .1[$a]);
+            (
+                $rd(_mm256_mul_ps($rd(_mm256_sub_ps($load($prep.0[$a], $i), o)), inv)),
+                $rd(_mm256_mul_ps($rd(_mm256_sub_ps($load($prep.1[$a], $i), o)), inv)),
+            )
+        }};
+        // the t interval the chains start from
+        (@limits pairs $prep:ident, $load:ident, $i:ident) => {
+            ($load($prep.2, $i), $load($prep.3, $i))
+        };
+        (@limits one $prep:ident, $load:ident, $i:ident) => {
+            $prep.3
+        };
+        (@loop $s:expr, $shape:ident $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $down:expr, $nan:expr, $bcast:expr, $tof:expr) => {{
+            let (s, boxes, out) = ($s, $boxes, $out);
+            let (load, rd, store, up, down, nan, bcast) = ($load, $round, $store, $up, $down, $nan, $bcast);
+            let bmin = boxes.min.each_ref().map(|c| c.as_ptr());
+            let bmax = boxes.max.each_ref().map(|c| c.as_ptr());
+            let prep = slab_kernel!(@prep $shape $r, bmin, bmax, bcast);
+            let _ = bcast; // the pairs shape broadcasts nothing
+            let (o_hit, o_near, o_far) = (out.hit.as_mut_ptr(), out.t_near.as_mut_ptr(), out.t_far.as_mut_ptr());
+            let widen = s.cfg.widen_ulps;
+            let mut i = 0;
+            while i < $full {
+                let (mut tn, mut tf) = slab_kernel!(@limits $shape prep, load, i);
+                let p = [
+                    slab_kernel!(@plane $shape prep, bmin, bmax, load, rd, 0, i),
+                    slab_kernel!(@plane $shape prep, bmin, bmax, load, rd, 1, i),
+                    slab_kernel!(@plane $shape prep, bmin, bmax, load, rd, 2, i),
+                ];
+                for (near, far) in p {
+                    if $tof {
+                        // t = (x <= t) ? t : x (near), (t <= x) ? t : x (far)
+                        tn = _mm256_blendv_ps(near, tn, _mm256_cmp_ps::<_CMP_LE_OQ>(near, tn));
+                        tf = _mm256_blendv_ps(far, tf, _mm256_cmp_ps::<_CMP_LE_OQ>(tf, far));
+                    } else {
+                        // t = (x > t) ? x : t (near), (x < t) ? x : t (far): exactly vmaxps(x, t)
+                        // and vminps(x, t), which return the second operand on NaN or equality
+                        tn = _mm256_max_ps(near, tn);
+                        tf = _mm256_min_ps(far, tf);
+                    }
+                }
+                for _ in 0..widen.unsigned_abs() {
+                    if widen > 0 {
+                        tn = down(tn);
+                        tf = up(tf);
+                    } else {
+                        tn = up(tn);
+                        tf = down(tf);
+                    }
+                }
+                let hit = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf)) as usize;
+                // SAFETY: lanes i..i + 8 are in bounds; the bytes written are 0 or 1.
+                unsafe { (o_hit.add(i) as *mut u64).write_unaligned(SPREAD[hit]) };
+                // NaN lanes are rare: canonicalise only when a movemask shows one
+                let (tn, tf) = if _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_UNORD_Q>(tn, tf)) == 0 {
+                    (tn, tf)
+                } else {
+                    (canon(tn, nan), canon(tf, nan))
+                };
+                store(o_near, i, tn);
+                store(o_far, i, tf);
+                i += 8;
+            }
+        }};
+    }
+
     #[target_feature(enable = "avx2")]
     pub(super) fn slab_f32(
         s: &Slab<Ieee<F32Native>>,
-        rays: &SlabRaysSoa<f32>,
+        rays: SlabRays<f32>,
         boxes: &BoxesSoa<f32>,
         out: &mut SlabOutSoa<f32>,
         full: usize,
     ) {
-        let nan = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fc0_0000));
-        // SAFETY: the caller checked that every column holds at least `full` lanes.
-        let load = |c: &Vec<f32>, i: usize| unsafe { _mm256_loadu_ps(c.as_ptr().add(i)) };
-        let take_on_false = s.cfg.nan == SlabNan::TakeOnFalse;
-        // near chain: acc replaced by x when x is farther in; far chain: when x is nearer
-        let near_sel = |acc: __m256, x: __m256| {
-            if take_on_false {
-                _mm256_blendv_ps(x, acc, _mm256_cmp_ps::<_CMP_LE_OQ>(x, acc))
-            } else {
-                _mm256_blendv_ps(acc, x, _mm256_cmp_ps::<_CMP_LT_OQ>(acc, x))
-            }
-        };
-        let far_sel = |acc: __m256, x: __m256| {
-            if take_on_false {
-                _mm256_blendv_ps(x, acc, _mm256_cmp_ps::<_CMP_LE_OQ>(acc, x))
-            } else {
-                _mm256_blendv_ps(acc, x, _mm256_cmp_ps::<_CMP_LT_OQ>(x, acc))
-            }
-        };
-        let mut i = 0;
-        while i < full {
-            let mut tn = load(&rays.tmin, i);
-            let mut tf = load(&rays.tmax, i);
-            let mut near = [tn; 3];
-            let mut far = [tf; 3];
-            for a in 0..3 {
-                let (o, inv) = (load(&rays.o[a], i), load(&rays.inv_d[a], i));
-                let tlo = _mm256_mul_ps(_mm256_sub_ps(load(&boxes.min[a], i), o), inv);
-                let thi = _mm256_mul_ps(_mm256_sub_ps(load(&boxes.max[a], i), o), inv);
-                // the sign bit of 1/d picks the near plane (blendv reads the sign bit)
-                near[a] = _mm256_blendv_ps(tlo, thi, inv);
-                far[a] = _mm256_blendv_ps(thi, tlo, inv);
-            }
-            for a in 0..3 {
-                tn = near_sel(tn, near[a]);
-                tf = far_sel(tf, far[a]);
-            }
-            for _ in 0..s.cfg.widen_ulps.unsigned_abs() {
-                if s.cfg.widen_ulps > 0 {
-                    tn = next_down(tn);
-                    tf = next_up(tf);
-                } else {
-                    tn = next_up(tn);
-                    tf = next_down(tf);
-                }
-            }
-            let hit = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf)) as usize;
-            // SAFETY: lanes i..i + 8 are in bounds; the bytes written are 0 or 1.
-            unsafe {
-                (out.hit.as_mut_ptr().add(i) as *mut u64).write_unaligned(SPREAD[hit]);
-                _mm256_storeu_ps(out.t_near.as_mut_ptr().add(i), canon(tn, nan));
-                _mm256_storeu_ps(out.t_far.as_mut_ptr().add(i), canon(tf, nan));
-            }
-            i += 8;
-        }
+        // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
+        slab_kernel!(
+            s,
+            rays,
+            boxes,
+            out,
+            full,
+            |c: *const f32, i: usize| unsafe { _mm256_loadu_ps(c.add(i)) },
+            |x: __m256| x,
+            |c: *mut f32, i: usize, x: __m256| unsafe { _mm256_storeu_ps(c.add(i), x) },
+            next_up,
+            next_down,
+            _mm256_castsi256_ps(_mm256_set1_epi32(0x7fc0_0000)),
+            |x: f32| _mm256_set1_ps(x)
+        );
+    }
+
+    #[target_feature(enable = "avx2,f16c")]
+    pub(super) fn slab_f16(
+        s: &Slab<Ieee<F16Half>>,
+        rays: SlabRays<f16>,
+        boxes: &BoxesSoa<f16>,
+        out: &mut SlabOutSoa<f16>,
+        full: usize,
+    ) {
+        // SAFETY (loads and stores): the caller checked that every column holds `full` lanes;
+        // f16 is a 2-byte plain value.
+        slab_kernel!(
+            s,
+            rays,
+            boxes,
+            out,
+            full,
+            |c: *const f16, i: usize| unsafe { _mm256_cvtph_ps(_mm_loadu_si128(c.add(i) as *const __m128i)) },
+            |x: __m256| _mm256_cvtph_ps(_mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x)),
+            |c: *mut f16, i: usize, x: __m256| unsafe {
+                _mm_storeu_si128(c.add(i) as *mut __m128i, _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x))
+            },
+            next_up16,
+            next_down16,
+            _mm256_castsi256_ps(_mm256_set1_epi32(0x7fc0_0000)), // becomes 0x7e00 in binary16
+            |x: f16| _mm256_set1_ps(x.to_f32())
+        );
     }
 
     /// Replaces NaN lanes by `canonical`.

@@ -567,10 +567,27 @@ impl<F: Format> Slab<F> {
         from: usize,
     ) {
         for i in from..rays.tmin.len() {
-            let o = self.test(&rays.get(i), &boxes.get(i));
-            out.hit[i] = o.hit;
-            out.t_near[i] = o.t_near;
-            out.t_far[i] = o.t_far;
+            out.set(i, self.test(&rays.get(i), &boxes.get(i)));
+        }
+    }
+
+    /// One ray against every box of a structure-of-arrays batch (a node's children, a level,
+    /// a whole scene): slot i is box i. Bit-identical to [`Slab::test`]; allocation-free.
+    ///
+    /// # Panics
+    /// If the columns differ in length.
+    pub fn batch_ray(&self, ray: &SlabRay<F::V>, boxes: &BoxesSoa<F::V>, out: &mut SlabOutSoa<F::V>) {
+        assert!(boxes.min[0].len() == out.hit.len(), "batch lengths differ");
+        self.batch_ray_from(ray, boxes, out, 0);
+    }
+
+    /// [`Slab::batch_ray`] from slot `from` on (the SIMD kernel's tail).
+    ///
+    /// # Panics
+    /// If a column is shorter than the output.
+    pub fn batch_ray_from(&self, ray: &SlabRay<F::V>, boxes: &BoxesSoa<F::V>, out: &mut SlabOutSoa<F::V>, from: usize) {
+        for i in from..out.hit.len() {
+            out.set(i, self.test(ray, &boxes.get(i)));
         }
     }
 }
@@ -668,5 +685,12 @@ impl<V: Copy + Default> SlabOutSoa<V> {
     /// Output columns for `n` results.
     pub fn with_len(n: usize) -> Self {
         Self { hit: vec![false; n], t_near: vec![V::default(); n], t_far: vec![V::default(); n] }
+    }
+
+    /// Writes one result into slot i.
+    pub fn set(&mut self, i: usize, o: SlabOut<V>) {
+        self.hit[i] = o.hit;
+        self.t_near[i] = o.t_near;
+        self.t_far[i] = o.t_far;
     }
 }

@@ -131,20 +131,23 @@ fn the_kernels_run_where_the_machine_has_them_and_hit_often_enough_to_matter() {
 
 mod slab {
     use super::*;
-    use datapath::simd::{slab_batch_f32, slab_kernel_f32};
-    use datapath::slab::{Aabb, BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa};
+    use datapath::simd::{
+        slab_batch_f16, slab_batch_f32, slab_kernel_f16, slab_kernel_f32, slab_ray_f16, slab_ray_f32,
+    };
+    use datapath::slab::{Aabb, BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRay, SlabRaysSoa};
 
     fn f64_value(r: &mut SplitMix64) -> f64 {
         match r.below(12) {
-            0 => [0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 1e-40, -1e-40, 3e38][r.below(8) as usize],
+            0 => [0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 1e-40, -1e-40, 3e38, 6e-8, 65504.0]
+                [r.below(10) as usize],
             1 => f32::from_bits(r.next_u64() as u32) as f64,
             _ => r.range(-2.0, 2.0),
         }
     }
 
-    fn run(variant: &str, seed: u64, n: usize) -> Result<(SlabOutSoa<f32>, SlabOutSoa<f32>, Kernel), TestCaseError> {
-        let f = Ieee::new(F32Native, FpOpts::default());
-        let s = Slab::new(f, SlabConfig::named(variant).unwrap());
+    /// A seeded slab batch: rays (half aimed near their box), boxes (a quarter raw bits).
+    fn batch<F: Format>(s: &Slab<F>, seed: u64, n: usize) -> (SlabRaysSoa<F::V>, BoxesSoa<F::V>) {
+        let f = &s.fmt;
         let mut r = SplitMix64::new(seed);
         let (mut rays, mut boxes) = (SlabRaysSoa::default(), BoxesSoa::default());
         for _ in 0..n {
@@ -161,8 +164,8 @@ mod slab {
             // a box around c, or raw bits
             let b = if r.below(4) == 0 {
                 Aabb {
-                    min: std::array::from_fn(|_| f32::from_bits(r.next_u64() as u32)),
-                    max: std::array::from_fn(|_| f32::from_bits(r.next_u64() as u32)),
+                    min: std::array::from_fn(|_| f.from_bits(r.next_u64())),
+                    max: std::array::from_fn(|_| f.from_bits(r.next_u64())),
                 }
             } else {
                 let e: [f64; 3] = std::array::from_fn(|_| if r.below(5) == 0 { 0.0 } else { r.range(0.0, 0.5) });
@@ -170,38 +173,128 @@ mod slab {
             };
             boxes.push(&b);
         }
+        (rays, boxes)
+    }
+
+    type PairsFn<F> = fn(
+        &Slab<F>,
+        &SlabRaysSoa<<F as Format>::V>,
+        &BoxesSoa<<F as Format>::V>,
+        &mut SlabOutSoa<<F as Format>::V>,
+    ) -> Kernel;
+    type RayFn<F> = fn(
+        &Slab<F>,
+        &SlabRay<<F as Format>::V>,
+        &BoxesSoa<<F as Format>::V>,
+        &mut SlabOutSoa<<F as Format>::V>,
+    ) -> Kernel;
+
+    fn same<F: Format>(f: &F, a: &SlabOutSoa<F::V>, b: &SlabOutSoa<F::V>) -> Result<(), TestCaseError> {
+        prop_assert_eq!(&a.hit, &b.hit);
+        let bits = |x: &Vec<F::V>| x.iter().map(|&v| f.to_bits(v)).collect::<Vec<_>>();
+        prop_assert_eq!(bits(&a.t_near), bits(&b.t_near));
+        prop_assert_eq!(bits(&a.t_far), bits(&b.t_far));
+        Ok(())
+    }
+
+    /// The kernels (pairs, and one ray against all the boxes) against the scalar model.
+    fn check<F: Format + Copy>(
+        f: F,
+        variant: &str,
+        seed: u64,
+        n: usize,
+        pairs: PairsFn<F>,
+        one: RayFn<F>,
+    ) -> Result<(), TestCaseError>
+    where
+        F::V: Default,
+    {
+        let s = Slab::new(f, SlabConfig::named(variant).unwrap());
+        let (rays, boxes) = batch(&s, seed, n);
         let (mut a, mut b) = (SlabOutSoa::with_len(n), SlabOutSoa::with_len(n));
         s.batch(&rays, &boxes, &mut a);
-        let k = slab_batch_f32(&s, &rays, &boxes, &mut b);
-        Ok((a, b, k))
+        pairs(&s, &rays, &boxes, &mut b);
+        same(&f, &a, &b)?;
+        if n > 0 {
+            let ray = rays.get(seed as usize % n);
+            s.batch_ray(&ray, &boxes, &mut a);
+            one(&s, &ray, &boxes, &mut b);
+            same(&f, &a, &b)?;
+        }
+        Ok(())
     }
+
+    const VARIANTS: [&str; 4] = ["plain", "conservative", "take-on-false", "embree"];
 
     proptest! {
         #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
         #[test]
-        fn slab_kernel_matches_the_scalar_model(seed in any::<u64>(), n in 0usize..70, v in 0usize..4) {
-            let variant = ["plain", "conservative", "take-on-false", "embree"][v];
-            let (a, b, _) = run(variant, seed, n)?;
-            prop_assert_eq!(&a.hit, &b.hit);
-            let bits = |x: &Vec<f32>| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-            prop_assert_eq!(bits(&a.t_near), bits(&b.t_near));
-            prop_assert_eq!(bits(&a.t_far), bits(&b.t_far));
+        fn f32_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..200, v in 0usize..4) {
+            check(Ieee::new(F32Native, FpOpts::default()), VARIANTS[v], seed, n, slab_batch_f32, slab_ray_f32)?;
+        }
+
+        #[test]
+        fn f16_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..200, v in 0usize..4) {
+            check(Ieee::new(F16Half, FpOpts::default()), VARIANTS[v], seed, n, slab_batch_f16, slab_ray_f16)?;
         }
     }
 
     #[test]
-    fn the_slab_kernel_runs_and_the_directed_variant_stays_scalar() {
+    fn the_slab_kernels_run_and_the_directed_variant_stays_scalar() {
         let f = Ieee::new(F32Native, FpOpts::default());
+        let h = Ieee::new(F16Half, FpOpts::default());
         #[cfg(target_arch = "x86_64")]
+        {
+            let avx2 = std::arch::is_x86_feature_detected!("avx2");
+            let f16c = std::arch::is_x86_feature_detected!("f16c");
+            let named = |v| SlabConfig::named(v).unwrap();
+            assert_eq!(slab_kernel_f32(&Slab::new(f, named("conservative"))) == Kernel::Avx2, avx2);
+            assert_eq!(slab_kernel_f16(&Slab::new(h, named("conservative"))) == Kernel::Avx2, avx2 && f16c);
+        }
+        let directed = SlabConfig::named("directed").unwrap();
+        assert_eq!(slab_kernel_f32(&Slab::new(f, directed)), Kernel::Scalar);
+        assert_eq!(slab_kernel_f16(&Slab::new(h, directed)), Kernel::Scalar);
+        // the generated batches are not vacuous: hits, misses and NaN distances occur, and the
+        // conservative variant widens (its intervals differ from plain's)
+        for (fmt_hits, nan) in [
+            {
+                let s = Slab::new(f, SlabConfig::named("plain").unwrap());
+                let (rays, boxes) = batch(&s, 5, 4000);
+                let mut out = SlabOutSoa::with_len(4000);
+                slab_batch_f32(&s, &rays, &boxes, &mut out);
+                (out.hit.iter().filter(|&&h| h).count(), out.t_near.iter().chain(&out.t_far).any(|t| t.is_nan()))
+            },
+            {
+                let s = Slab::new(h, SlabConfig::named("plain").unwrap());
+                let (rays, boxes) = batch(&s, 5, 4000);
+                let mut out = SlabOutSoa::with_len(4000);
+                slab_batch_f16(&s, &rays, &boxes, &mut out);
+                (out.hit.iter().filter(|&&h| h).count(), out.t_near.iter().chain(&out.t_far).any(|t| t.is_nan()))
+            },
+        ] {
+            assert!(fmt_hits > 200 && fmt_hits < 3800, "{fmt_hits}");
+            assert!(nan);
+        }
+    }
+
+    #[test]
+    fn one_ray_batches_hit_and_miss() {
+        // one ray against many boxes: a ray through the middle of a row of boxes
+        let f = Ieee::new(F16Half, FpOpts::default());
+        let s = Slab::new(f, SlabConfig::named("conservative").unwrap());
+        let (_, boxes) = batch(&s, 9, 300);
+        let ray = s.prepare([0.0, 0.0, -5.0], [0.01, -0.02, 1.0], 0.0, f64::INFINITY);
+        let (mut a, mut b) = (SlabOutSoa::with_len(300), SlabOutSoa::with_len(300));
+        s.batch_ray(&ray, &boxes, &mut a);
+        slab_ray_f16(&s, &ray, &boxes, &mut b);
+        let hits = b.hit.iter().filter(|&&h| h).count();
+        assert!(hits > 10 && hits < 290, "{hits}");
+        assert_eq!(a.hit, b.hit);
         assert_eq!(
-            slab_kernel_f32(&Slab::new(f, SlabConfig::named("conservative").unwrap())) == Kernel::Avx2,
-            std::arch::is_x86_feature_detected!("avx2")
+            a.t_near.iter().map(|t| t.to_bits()).collect::<Vec<_>>(),
+            b.t_near.iter().map(|t| t.to_bits()).collect::<Vec<_>>()
         );
-        assert_eq!(slab_kernel_f32(&Slab::new(f, SlabConfig::named("directed").unwrap())), Kernel::Scalar);
-        let (a, _, _) = run("plain", 5, 4000).unwrap();
-        let hits = a.hit.iter().filter(|&&h| h).count();
-        assert!(hits > 200 && hits < 3800, "{hits}");
     }
 }
 
