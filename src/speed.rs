@@ -220,22 +220,73 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     push(row("half-crate scalar fp16 MT (baseline)", pairs, RTI_OPS, 3, || {
         black_box(c16.iter().filter(|(r, t)| half_mt(black_box(r), black_box(t))).count());
     }));
-    // the slab unit over the bounding boxes of the same triangles
+    // the slab unit over the bounding boxes of the same triangles: pairs, and one ray against
+    // every box (the shape a node's or a level's children have)
+    for (name, any) in [("f32", datapath::AnyFormat::F32(f32f)), ("fp16", datapath::AnyFormat::F16(f16f))] {
+        datapath::with_format!(any, |f| {
+            use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa};
+            let s = Slab::new(f, SlabConfig::default());
+            let (mut rs, mut bs) = (SlabRaysSoa::default(), BoxesSoa::default());
+            for (ray, tri) in &cases {
+                rs.push(&s.prepare(ray.o, ray.d, ray.tmin, ray.tmax));
+                let lo = std::array::from_fn(|a| tri.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min));
+                let hi = std::array::from_fn(|a| tri.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max));
+                bs.push(&s.store_box(lo, hi).unwrap_or_else(|_| s.empty_box()));
+            }
+            let mut out = SlabOutSoa::with_len(pairs);
+            push(row(&format!("slab {name} kernel (dispatch, plain)"), pairs, SLAB_OPS, 7, || {
+                datapath::simd::slab_batch(&s, &rs, &bs, &mut out);
+            }));
+            if pairs > 0 {
+                let ray = rs.get(0);
+                push(row(&format!("slab {name} kernel, one ray x {pairs} boxes (plain)"), pairs, SLAB_OPS, 7, || {
+                    datapath::simd::slab_ray(&s, &ray, &bs, &mut out);
+                }));
+            }
+            push(row(&format!("slab {name} scalar model (plain)"), pairs, SLAB_OPS, 3, || s.batch(&rs, &bs, &mut out)));
+        });
+    }
+    // a batch far beyond the caches: one pass over 1 M-pair columns against the same pairs
+    // streamed through L1-sized chunks gathered from the scene (gather included)
     {
-        use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa};
-        let s = Slab::new(f32f, SlabConfig::default());
-        let (mut rs, mut bs) = (SlabRaysSoa::default(), BoxesSoa::default());
-        for (ray, tri) in &cases {
-            rs.push(&s.prepare(ray.o, ray.d, ray.tmin, ray.tmax));
-            let lo = std::array::from_fn(|a| tri.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min));
-            let hi = std::array::from_fn(|a| tri.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max));
-            bs.push(&s.store_box(lo, hi).unwrap_or_else(|_| s.empty_box()));
+        let big = 1 << 20;
+        let (rays, tris) = columns(&r32, &cases);
+        let (mut br, mut bt) = (RaysSoa::with_capacity(big), TrisSoa::with_capacity(big));
+        for i in 0..big {
+            br.push(&rays.get(i % pairs.max(1)));
+            bt.push(&tris.get(i % pairs.max(1)));
         }
-        let mut out = SlabOutSoa::with_len(pairs);
-        push(row("slab f32 kernel (dispatch, plain)", pairs, SLAB_OPS, 7, || {
-            datapath::simd::slab_batch_f32(&s, &rs, &bs, &mut out);
-        }));
-        push(row("slab f32 scalar model (plain)", pairs, SLAB_OPS, 3, || s.batch(&rs, &bs, &mut out)));
+        let mut bo = HitsSoa::with_len(big);
+        if pairs > 0 {
+            push(row("rti f32 kernel, one pass over 1 M-pair columns", big, RTI_OPS, 3, || {
+                rti_batch_f32(&r32, &br, &bt, &mut bo);
+            }));
+            let mut sink = 0;
+            push(row("rti f32 kernel, 1 M pairs streamed through L1 chunks", big, RTI_OPS, 3, || {
+                datapath::simd::rti_stream(
+                    &r32,
+                    big,
+                    |range, rs, ts| {
+                        // the chunk's pairs, column by column, from the cached columns
+                        let mut k = 0;
+                        while k < range.len() {
+                            let from = (range.start + k) % pairs;
+                            let m = (pairs - from).min(range.len() - k);
+                            let cols = rs.o.iter_mut().chain(&mut rs.d).chain([&mut rs.tmin, &mut rs.tmax]);
+                            let srcs = rays.o.iter().chain(&rays.d).chain([&rays.tmin, &rays.tmax]);
+                            for (dst, src) in
+                                cols.chain(ts.v.iter_mut().flatten()).zip(srcs.chain(tris.v.iter().flatten()))
+                            {
+                                dst[k..k + m].copy_from_slice(&src[from..from + m]);
+                            }
+                            k += m;
+                        }
+                    },
+                    |_, _, _, out| sink += out.hit[0] as usize,
+                );
+            }));
+            black_box(sink);
+        }
     }
     let peak = peaks.iter().copied().fold(0.0, f64::max);
     SpeedReport { pairs, seed, kernels: k.map(|k| format!("{k:?}")), peak_gops: peak / 1e9, rows }

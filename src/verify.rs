@@ -4,7 +4,7 @@
 
 use crate::judge::{judge, Judged};
 use crate::scene::Scene;
-use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiConfig, TrisSoa};
+use datapath::rti::{Capture, Rti, RtiConfig};
 use datapath::{with_format, AnyFormat, Format};
 use golden::{Ray64, Tri64};
 use serde::Serialize;
@@ -59,7 +59,8 @@ pub struct FormatReport {
     pub t_err_rel_max: f64,
     /// Rays whose min-capture result names a different triangle (or hit/miss) than the golden closest hit.
     pub closest_disagreements: u64,
-    /// Model throughput of the pairwise batch path, million tests per second (one thread).
+    /// Throughput of the fastest bit-identical batch path (the SIMD kernel for f32 / fp16),
+    /// fed from the scene in L1-sized chunks, gather included: million tests per second (one thread).
     pub mtests_per_s: f64,
     /// Tests whose valid bit was cleared at stage 7: the work a valid-gated divide stage (and
     /// everything after it) skips.
@@ -244,44 +245,34 @@ fn run_format<F: Format>(
     rep
 }
 
-/// Times the pairwise batch path over every test of the run (model only), in chunks.
-fn throughput<F: Format>(rti: &Rti<F>, scene: &Scene, rays: &[(Ray64, usize)], lists: &[Vec<usize>]) -> f64 {
-    const CHUNK: usize = 1 << 14;
-    let mut rs = RaysSoa::default();
-    let mut ts = TrisSoa::default();
-    let mut out = HitsSoa::with_len(CHUNK);
-    let mut secs = 0.0;
-    let mut n = 0usize;
+/// Times the fastest bit-identical batch path (the SIMD kernels for f32 / fp16, the scalar
+/// model otherwise) over every test of the run, one thread, streamed through L1-sized chunks
+/// gathered from the scene: million tests per second, the gather included.
+fn throughput<F: Format + 'static>(rti: &Rti<F>, scene: &Scene, rays: &[(Ray64, usize)], lists: &[Vec<usize>]) -> f64
+where
+    F::V: 'static + Default,
+{
+    let pairs: Vec<(usize, usize)> =
+        lists.iter().enumerate().flat_map(|(r, list)| list.iter().map(move |&t| (r, t))).collect();
+    let mrays: Vec<_> = rays.iter().map(|(ray, _)| rti.ray(ray.o, ray.d, ray.tmin, ray.tmax)).collect();
+    let mtris: Vec<_> = scene.tris.iter().map(|t| rti.tri(t.v)).collect();
     let mut sink = 0usize;
-    let mut flush = |rs: &mut RaysSoa<F::V>, ts: &mut TrisSoa<F::V>, out: &mut HitsSoa<F::V>| {
-        if rs.is_empty() {
-            return;
-        }
-        if out.len() != rs.len() {
-            *out = HitsSoa::with_len(rs.len());
-        }
-        let t0 = Instant::now();
-        rti.batch(rs, ts, out);
-        secs += t0.elapsed().as_secs_f64();
-        n += rs.len();
-        sink += out.hit.iter().filter(|&&h| h).count();
-        *rs = RaysSoa::default();
-        *ts = TrisSoa::default();
-    };
-    for ((ray, _), list) in rays.iter().zip(lists) {
-        let mray = rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
-        for &ti in list {
-            rs.push(&mray);
-            ts.push(&rti.tri(scene.tris[ti].v));
-            if rs.len() == CHUNK {
-                flush(&mut rs, &mut ts, &mut out);
+    let t0 = Instant::now();
+    datapath::simd::rti_stream(
+        rti,
+        pairs.len(),
+        |range, rs, ts| {
+            for (k, &(r, t)) in pairs[range].iter().enumerate() {
+                rs.set(k, &mrays[r]);
+                ts.set(k, &mtris[t]);
             }
-        }
-    }
-    flush(&mut rs, &mut ts, &mut out);
+        },
+        |_, _, _, out| sink += out.hit.iter().filter(|&&h| h).count(),
+    );
+    let secs = t0.elapsed().as_secs_f64();
     std::hint::black_box(sink);
     if secs > 0.0 {
-        n as f64 / secs / 1e6
+        pairs.len() as f64 / secs / 1e6
     } else {
         0.0
     }
@@ -395,7 +386,7 @@ pub struct SlabReport {
     pub false_hits: u64,
     /// Tests settled by the exact rational decision (near the boundary or disagreeing with f64).
     pub exact_calls: u64,
-    /// Model throughput of the batch path, million tests per second (one thread).
+    /// Throughput of the fastest bit-identical batch path (the SIMD kernel for f32 / fp16), million tests per second (one thread).
     pub mtests_per_s: f64,
 }
 
@@ -487,7 +478,7 @@ fn slab_one<F: Format>(
     }
     let mut out = SlabOutSoa::with_len(rs.tmin.len());
     let t0 = Instant::now();
-    s.batch(&rs, &bs, &mut out);
+    datapath::simd::slab_batch(&s, &rs, &bs, &mut out);
     let secs = t0.elapsed().as_secs_f64();
     std::hint::black_box(&out);
     rep.mtests_per_s = if secs > 0.0 { rep.tests as f64 / secs / 1e6 } else { 0.0 };

@@ -467,6 +467,31 @@ pub struct RaysSoa<V> {
 }
 
 impl<V: Copy> RaysSoa<V> {
+    /// Empty columns with room for `n` rays.
+    pub fn with_capacity(n: usize) -> Self {
+        Self {
+            o: std::array::from_fn(|_| Vec::with_capacity(n)),
+            d: std::array::from_fn(|_| Vec::with_capacity(n)),
+            tmin: Vec::with_capacity(n),
+            tmax: Vec::with_capacity(n),
+        }
+    }
+    /// Sets the number of rays (new slots hold `fill`), keeping the allocations.
+    pub fn resize(&mut self, n: usize, fill: V) {
+        self.o.iter_mut().chain(&mut self.d).for_each(|c| c.resize(n, fill));
+        self.tmin.resize(n, fill);
+        self.tmax.resize(n, fill);
+    }
+    /// Overwrites ray i.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, r: &Ray<V>) {
+        for k in 0..3 {
+            self.o[k][i] = r.o[k];
+            self.d[k][i] = r.d[k];
+        }
+        self.tmin[i] = r.tmin;
+        self.tmax[i] = r.tmax;
+    }
     /// Number of rays.
     pub fn len(&self) -> usize {
         self.tmin.len()
@@ -504,6 +529,23 @@ pub struct TrisSoa<V> {
 }
 
 impl<V: Copy> TrisSoa<V> {
+    /// Empty columns with room for `n` triangles.
+    pub fn with_capacity(n: usize) -> Self {
+        Self { v: std::array::from_fn(|_| std::array::from_fn(|_| Vec::with_capacity(n))) }
+    }
+    /// Sets the number of triangles (new slots hold `fill`), keeping the allocations.
+    pub fn resize(&mut self, n: usize, fill: V) {
+        self.v.iter_mut().flatten().for_each(|c| c.resize(n, fill));
+    }
+    /// Overwrites triangle i.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, t: &Tri<V>) {
+        for j in 0..3 {
+            for k in 0..3 {
+                self.v[j][k][i] = t.v[j][k];
+            }
+        }
+    }
     /// Number of triangles.
     pub fn len(&self) -> usize {
         self.v[0][0].len()
@@ -551,6 +593,14 @@ impl<V: Copy + Default> HitsSoa<V> {
             t: vec![V::default(); n],
             u: vec![V::default(); n],
             v: vec![V::default(); n],
+        }
+    }
+    /// Sets the number of result slots (new slots hold defaults), keeping the allocations.
+    pub fn resize(&mut self, n: usize) {
+        self.hit.resize(n, false);
+        self.valid.resize(n, false);
+        for c in [&mut self.t, &mut self.u, &mut self.v] {
+            c.resize(n, V::default());
         }
     }
     /// Number of results.

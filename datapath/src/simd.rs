@@ -340,6 +340,124 @@ pub fn slab_ray_f16(
     )
 }
 
+/// [`Rti::batch`] for any format on the fastest bit-identical implementation: the SIMD kernels
+/// for binary32 and binary16 where they apply, the scalar model otherwise.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn rti_batch<F: crate::Format + 'static>(
+    rti: &Rti<F>,
+    rays: &RaysSoa<F::V>,
+    tris: &TrisSoa<F::V>,
+    out: &mut HitsSoa<F::V>,
+) -> Kernel
+where
+    F::V: 'static,
+{
+    use std::any::Any;
+    let (r, ra, tr) = (rti as &dyn Any, rays as &dyn Any, tris as &dyn Any);
+    if let (Some(r), Some(ra), Some(tr)) = (r.downcast_ref(), ra.downcast_ref(), tr.downcast_ref()) {
+        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
+        return rti_batch_f32(r, ra, tr, out);
+    }
+    if let (Some(r), Some(ra), Some(tr)) = (r.downcast_ref(), ra.downcast_ref(), tr.downcast_ref()) {
+        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
+        return rti_batch_f16(r, ra, tr, out);
+    }
+    rti.batch(rays, tris, out);
+    Kernel::Scalar
+}
+
+/// [`Slab::batch`] for any format on the fastest bit-identical implementation.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn slab_batch<F: crate::Format + 'static>(
+    s: &Slab<F>,
+    rays: &SlabRaysSoa<F::V>,
+    boxes: &BoxesSoa<F::V>,
+    out: &mut SlabOutSoa<F::V>,
+) -> Kernel
+where
+    F::V: 'static,
+{
+    use std::any::Any;
+    let (sl, ra, bo) = (s as &dyn Any, rays as &dyn Any, boxes as &dyn Any);
+    if let (Some(sl), Some(ra), Some(bo)) = (sl.downcast_ref(), ra.downcast_ref(), bo.downcast_ref()) {
+        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
+        return slab_batch_f32(sl, ra, bo, out);
+    }
+    if let (Some(sl), Some(ra), Some(bo)) = (sl.downcast_ref(), ra.downcast_ref(), bo.downcast_ref()) {
+        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
+        return slab_batch_f16(sl, ra, bo, out);
+    }
+    s.batch(rays, boxes, out);
+    Kernel::Scalar
+}
+
+/// [`Slab::batch_ray`] (one ray, many boxes) for any format on the fastest bit-identical
+/// implementation.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn slab_ray<F: crate::Format + 'static>(
+    s: &Slab<F>,
+    ray: &SlabRay<F::V>,
+    boxes: &BoxesSoa<F::V>,
+    out: &mut SlabOutSoa<F::V>,
+) -> Kernel
+where
+    F::V: 'static,
+{
+    use std::any::Any;
+    let (sl, ra, bo) = (s as &dyn Any, ray as &dyn Any, boxes as &dyn Any);
+    if let (Some(sl), Some(ra), Some(bo)) = (sl.downcast_ref(), ra.downcast_ref(), bo.downcast_ref()) {
+        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
+        return slab_ray_f32(sl, ra, bo, out);
+    }
+    if let (Some(sl), Some(ra), Some(bo)) = (sl.downcast_ref(), ra.downcast_ref(), bo.downcast_ref()) {
+        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
+        return slab_ray_f16(sl, ra, bo, out);
+    }
+    s.batch_ray(ray, boxes, out);
+    Kernel::Scalar
+}
+
+/// Pairs per chunk of [`rti_stream`]: 256 pairs × (15 input + 3 output columns) × 4 bytes plus
+/// two flag columns is 19 KiB, inside a 32 KiB L1 data cache.
+pub const CHUNK: usize = 256;
+
+/// Streams `n` RTI tests through L1-sized chunks on the fastest kernel (see [`rti_batch`]):
+/// for each chunk `start..end` of at most [`CHUNK`] pairs, the columns are sized to
+/// `end - start` slots, `fill(start..end, rays, tris)` writes every slot (slot k holds pair
+/// `start + k`, e.g. with [`RaysSoa::set`]), the kernel runs, and `consume(start..end, rays,
+/// tris, out)` reads the results. The columns are allocated once, side by side, so a pass over
+/// millions of pairs keeps its working set in L1 (one pass over columns of 1 M pairs is
+/// DRAM-bound, and equal-offset page-aligned columns contend for the same L1 sets).
+pub fn rti_stream<F: crate::Format + 'static>(
+    rti: &Rti<F>,
+    n: usize,
+    mut fill: impl FnMut(std::ops::Range<usize>, &mut RaysSoa<F::V>, &mut TrisSoa<F::V>),
+    mut consume: impl FnMut(std::ops::Range<usize>, &RaysSoa<F::V>, &TrisSoa<F::V>, &HitsSoa<F::V>),
+) -> Kernel
+where
+    F::V: 'static + Default,
+{
+    let (mut rays, mut tris) = (RaysSoa::default(), TrisSoa::default());
+    let mut out = HitsSoa::default();
+    let mut kernel = Kernel::Scalar;
+    for start in (0..n).step_by(CHUNK) {
+        let end = (start + CHUNK).min(n);
+        rays.resize(end - start, F::V::default());
+        tris.resize(end - start, F::V::default());
+        out.resize(end - start);
+        fill(start..end, &mut rays, &mut tris);
+        kernel = rti_batch(rti, &rays, &tris, &mut out);
+        consume(start..end, &rays, &tris, &out);
+    }
+    kernel
+}
+
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use super::*;

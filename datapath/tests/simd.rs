@@ -312,3 +312,88 @@ fn a_short_column_is_never_read_past_its_end_by_a_kernel() {
     });
     assert!(r.is_err());
 }
+
+mod generic {
+    use super::*;
+    use datapath::simd::{rti_batch, rti_stream, slab_batch, CHUNK};
+    use datapath::slab::{Slab, SlabConfig, SlabOutSoa, SlabRaysSoa};
+    use datapath::{with_format, AnyFormat};
+
+    /// The format-generic dispatch runs the kernels for binary32 / binary16 and the scalar
+    /// model otherwise, with the scalar model's bits either way.
+    #[test]
+    fn the_generic_dispatch_picks_the_kernel_by_format() {
+        #[cfg(target_arch = "x86_64")]
+        let simd = std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("f16c");
+        #[cfg(not(target_arch = "x86_64"))]
+        let simd = false;
+        for name in ["f32", "fp16", "bf16", "q8.24:divide"] {
+            let any: AnyFormat = name.parse().unwrap();
+            with_format!(any, |f| {
+                let rti = Rti::new(f, RtiConfig::default());
+                let specials: Vec<u64> = vec![0, 1, f.to_bits(f.from_f64(f64::INFINITY))];
+                let (rays, tris) = columns(&f, 77, 4, &specials);
+                let (mut a, mut b) = (HitsSoa::with_len(77), HitsSoa::with_len(77));
+                rti.batch(&rays, &tris, &mut a);
+                let k = rti_batch(&rti, &rays, &tris, &mut b);
+                same(&f, &a, &b).unwrap();
+                let expect_simd = simd && (name == "f32" || name == "fp16");
+                assert_eq!(k == Kernel::Avx2, expect_simd, "{name}");
+                let s = Slab::new(f, SlabConfig::named("conservative").unwrap());
+                let (mut sr, mut sb) = (SlabRaysSoa::default(), datapath::slab::BoxesSoa::default());
+                for i in 0..77 {
+                    let r = rays.get(i);
+                    let o = r.o.map(|x| f.to_f64(x));
+                    let d = r.d.map(|x| f.to_f64(x));
+                    sr.push(&s.prepare(o, d, 0.0, f64::INFINITY));
+                    sb.push(&s.store_box([-1.0, -1.0, -1.0], [0.5, 0.25, 1.0]).unwrap());
+                }
+                let (mut x, mut y) = (SlabOutSoa::with_len(77), SlabOutSoa::with_len(77));
+                s.batch(&sr, &sb, &mut x);
+                let k = slab_batch(&s, &sr, &sb, &mut y);
+                assert_eq!(x.hit, y.hit);
+                assert_eq!(k == Kernel::Avx2, expect_simd, "{name}");
+            });
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+
+        /// Streaming in L1-sized chunks gives every slot the bits one whole batch gives it.
+        #[test]
+        fn the_stream_equals_one_batch(seed in any::<u64>(), n in prop_oneof![0usize..3, CHUNK - 3..CHUNK + 3, 3 * CHUNK..4 * CHUNK]) {
+            let f = Ieee::new(F32Native, FpOpts::default());
+            let rti = Rti::new(f, RtiConfig::default());
+            let (rays, tris) = columns(&f, n, seed, &F32_SPECIALS);
+            let mut whole = HitsSoa::with_len(n);
+            rti.batch(&rays, &tris, &mut whole);
+            let mut streamed = HitsSoa::with_len(n);
+            let mut chunks = 0;
+            rti_stream(
+                &rti,
+                n,
+                |r, ra, tr| {
+                    assert!(ra.len() == r.len() && tr.len() == r.len());
+                    for (k, i) in r.enumerate() {
+                        ra.set(k, &rays.get(i));
+                        tr.set(k, &tris.get(i));
+                    }
+                },
+                |r, _, _, out| {
+                    assert!(r.len() <= CHUNK && out.len() == r.len());
+                    chunks += 1;
+                    for (k, i) in r.enumerate() {
+                        streamed.hit[i] = out.hit[k];
+                        streamed.valid[i] = out.valid[k];
+                        streamed.t[i] = out.t[k];
+                        streamed.u[i] = out.u[k];
+                        streamed.v[i] = out.v[k];
+                    }
+                },
+            );
+            prop_assert_eq!(chunks, n.div_ceil(CHUNK));
+            same(&f, &whole, &streamed)?;
+        }
+    }
+}
