@@ -6,8 +6,9 @@
 //! the t error (ulps, relative) on shared hits from `verify`. Slab error: false misses and
 //! false hits against the exact decision (`verify`'s slab table plus the stress classes).
 //! Time, one thread: RTI — the fastest bit-identical implementation (the SIMD kernels for
-//! binary32 / binary16, the scalar batch otherwise) on 512 cached pairs; slab — the scalar
-//! batch over the scenes' pairs, weighted.
+//! binary32 / binary16, the scalar batch otherwise) on 512 cached pairs; slab — the fastest
+//! bit-identical batch (the SIMD kernels for binary32 / binary16 but the directed variant) over
+//! the scenes' pairs, weighted.
 
 use crate::scene::Scene;
 use crate::stress::{stress, StressConfig};
