@@ -252,92 +252,70 @@ fn slab_dispatch<F: crate::Format>(
     Kernel::Scalar
 }
 
-/// [`Slab::batch`] for binary32 on the fastest kernel available; the same bits.
-///
-/// # Panics
-/// If the column lengths differ.
-pub fn slab_batch_f32(
-    s: &Slab<Ieee<F32Native>>,
-    rays: &SlabRaysSoa<f32>,
-    boxes: &BoxesSoa<f32>,
-    out: &mut SlabOutSoa<f32>,
-) -> Kernel {
-    let which = slab_kernel_f32(s);
-    slab_dispatch(
-        s,
-        SlabRays::Pairs(rays),
-        boxes,
-        out,
-        which,
-        #[cfg(target_arch = "x86_64")]
-        avx2::slab_f32,
-    )
+/// A typed slab entry point: the unit's kernel choice, then [`slab_dispatch`].
+macro_rules! slab_entry {
+    ($(#[$doc:meta])* $name:ident, $fmt:ty, $v:ty, $rays:ty, $shape:ident, $which:ident, $kernel:ident) => {
+        $(#[$doc])*
+        ///
+        /// # Panics
+        /// If the column lengths differ.
+        pub fn $name(s: &Slab<$fmt>, rays: &$rays, boxes: &BoxesSoa<$v>, out: &mut SlabOutSoa<$v>) -> Kernel {
+            let which = $which(s);
+            slab_dispatch(
+                s,
+                SlabRays::$shape(rays),
+                boxes,
+                out,
+                which,
+                #[cfg(target_arch = "x86_64")]
+                avx2::$kernel,
+            )
+        }
+    };
 }
 
-/// [`Slab::batch_ray`] (one ray, many boxes) for binary32 on the fastest kernel available; the same bits.
-///
-/// # Panics
-/// If the column lengths differ.
-pub fn slab_ray_f32(
-    s: &Slab<Ieee<F32Native>>,
-    ray: &SlabRay<f32>,
-    boxes: &BoxesSoa<f32>,
-    out: &mut SlabOutSoa<f32>,
-) -> Kernel {
-    let which = slab_kernel_f32(s);
-    slab_dispatch(
-        s,
-        SlabRays::One(ray),
-        boxes,
-        out,
-        which,
-        #[cfg(target_arch = "x86_64")]
-        avx2::slab_f32,
-    )
-}
+slab_entry!(
+    /// [`Slab::batch`] for binary32 on the fastest kernel available; the same bits.
+    slab_batch_f32, Ieee<F32Native>, f32, SlabRaysSoa<f32>, Pairs, slab_kernel_f32, slab_f32
+);
+slab_entry!(
+    /// [`Slab::batch_ray`] (one ray, many boxes) for binary32 on the fastest kernel available; the same bits.
+    slab_ray_f32, Ieee<F32Native>, f32, SlabRay<f32>, One, slab_kernel_f32, slab_f32
+);
+slab_entry!(
+    /// [`Slab::batch`] for binary16 on the fastest kernel available; the same bits.
+    slab_batch_f16, Ieee<F16Half>, f16, SlabRaysSoa<f16>, Pairs, slab_kernel_f16, slab_f16
+);
+slab_entry!(
+    /// [`Slab::batch_ray`] (one ray, many boxes) for binary16 on the fastest kernel available; the same bits.
+    slab_ray_f16, Ieee<F16Half>, f16, SlabRay<f16>, One, slab_kernel_f16, slab_f16
+);
 
-/// [`Slab::batch`] for binary16 on the fastest kernel available; the same bits.
-///
-/// # Panics
-/// If the column lengths differ.
-pub fn slab_batch_f16(
-    s: &Slab<Ieee<F16Half>>,
-    rays: &SlabRaysSoa<f16>,
-    boxes: &BoxesSoa<f16>,
-    out: &mut SlabOutSoa<f16>,
-) -> Kernel {
-    let which = slab_kernel_f16(s);
-    slab_dispatch(
-        s,
-        SlabRays::Pairs(rays),
-        boxes,
-        out,
-        which,
-        #[cfg(target_arch = "x86_64")]
-        avx2::slab_f16,
-    )
-}
-
-/// [`Slab::batch_ray`] (one ray, many boxes) for binary16 on the fastest kernel available; the same bits.
-///
-/// # Panics
-/// If the column lengths differ.
-pub fn slab_ray_f16(
-    s: &Slab<Ieee<F16Half>>,
-    ray: &SlabRay<f16>,
-    boxes: &BoxesSoa<f16>,
-    out: &mut SlabOutSoa<f16>,
-) -> Kernel {
-    let which = slab_kernel_f16(s);
-    slab_dispatch(
-        s,
-        SlabRays::One(ray),
-        boxes,
-        out,
-        which,
-        #[cfg(target_arch = "x86_64")]
-        avx2::slab_f16,
-    )
+/// The body of a format-generic dispatch: calls `$f32` (or `$f16`) when the unit and its
+/// columns are the binary32 (binary16) types, the scalar model `$scalar` otherwise.
+macro_rules! by_format {
+    ($unit:expr, $a:expr, $b:expr, $out:expr, $f32:ident, $f16:ident, $scalar:expr) => {{
+        use std::any::Any;
+        let (unit, a, b) = ($unit as &dyn Any, $a as &dyn Any, $b as &dyn Any);
+        if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
+            return $f32(
+                unit,
+                a,
+                b,
+                ($out as &mut dyn Any).downcast_mut().expect("the output type follows the format"),
+            );
+        }
+        if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
+            return $f16(
+                unit,
+                a,
+                b,
+                ($out as &mut dyn Any).downcast_mut().expect("the output type follows the format"),
+            );
+        }
+        $scalar;
+        Kernel::Scalar
+    }};
 }
 
 /// [`Rti::batch`] for any format on the fastest bit-identical implementation: the SIMD kernels
@@ -354,18 +332,7 @@ pub fn rti_batch<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
-    use std::any::Any;
-    let (r, ra, tr) = (rti as &dyn Any, rays as &dyn Any, tris as &dyn Any);
-    if let (Some(r), Some(ra), Some(tr)) = (r.downcast_ref(), ra.downcast_ref(), tr.downcast_ref()) {
-        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
-        return rti_batch_f32(r, ra, tr, out);
-    }
-    if let (Some(r), Some(ra), Some(tr)) = (r.downcast_ref(), ra.downcast_ref(), tr.downcast_ref()) {
-        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
-        return rti_batch_f16(r, ra, tr, out);
-    }
-    rti.batch(rays, tris, out);
-    Kernel::Scalar
+    by_format!(rti, rays, tris, out, rti_batch_f32, rti_batch_f16, rti.batch(rays, tris, out))
 }
 
 /// [`Slab::batch`] for any format on the fastest bit-identical implementation.
@@ -381,18 +348,7 @@ pub fn slab_batch<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
-    use std::any::Any;
-    let (sl, ra, bo) = (s as &dyn Any, rays as &dyn Any, boxes as &dyn Any);
-    if let (Some(sl), Some(ra), Some(bo)) = (sl.downcast_ref(), ra.downcast_ref(), bo.downcast_ref()) {
-        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
-        return slab_batch_f32(sl, ra, bo, out);
-    }
-    if let (Some(sl), Some(ra), Some(bo)) = (sl.downcast_ref(), ra.downcast_ref(), bo.downcast_ref()) {
-        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
-        return slab_batch_f16(sl, ra, bo, out);
-    }
-    s.batch(rays, boxes, out);
-    Kernel::Scalar
+    by_format!(s, rays, boxes, out, slab_batch_f32, slab_batch_f16, s.batch(rays, boxes, out))
 }
 
 /// [`Slab::batch_ray`] (one ray, many boxes) for any format on the fastest bit-identical
@@ -409,18 +365,7 @@ pub fn slab_ray<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
-    use std::any::Any;
-    let (sl, ra, bo) = (s as &dyn Any, ray as &dyn Any, boxes as &dyn Any);
-    if let (Some(sl), Some(ra), Some(bo)) = (sl.downcast_ref(), ra.downcast_ref(), bo.downcast_ref()) {
-        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
-        return slab_ray_f32(sl, ra, bo, out);
-    }
-    if let (Some(sl), Some(ra), Some(bo)) = (sl.downcast_ref(), ra.downcast_ref(), bo.downcast_ref()) {
-        let out = (out as &mut dyn Any).downcast_mut().expect("the output type follows the format");
-        return slab_ray_f16(sl, ra, bo, out);
-    }
-    s.batch_ray(ray, boxes, out);
-    Kernel::Scalar
+    by_format!(s, ray, boxes, out, slab_ray_f32, slab_ray_f16, s.batch_ray(ray, boxes, out))
 }
 
 /// Pairs per chunk of [`rti_stream`]: 256 pairs × (15 input + 3 output columns) × 4 bytes plus
