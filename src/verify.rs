@@ -477,9 +477,15 @@ fn slab_one<F: Format>(
         }
     }
     let mut out = SlabOutSoa::with_len(rs.tmin.len());
-    let t0 = Instant::now();
+    // one untimed pass first (the output pages are faulted in), then the best of three
     datapath::simd::slab_batch(&s, &rs, &bs, &mut out);
-    let secs = t0.elapsed().as_secs_f64();
+    let secs = (0..3)
+        .map(|_| {
+            let t0 = Instant::now();
+            datapath::simd::slab_batch(&s, &rs, &bs, &mut out);
+            t0.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min);
     std::hint::black_box(&out);
     rep.mtests_per_s = if secs > 0.0 { rep.tests as f64 / secs / 1e6 } else { 0.0 };
     rep
