@@ -147,32 +147,15 @@ fn scene_cases(pairs: usize, seed: u64) -> Vec<(Ray64, Tri64)> {
 /// kernels for binary32 and binary16 where they apply, the scalar batch otherwise), over
 /// `pairs` pairs of the built-in scene that stay in cache.
 pub fn rti_rate(any: datapath::AnyFormat, pairs: usize, seed: u64) -> f64 {
-    use datapath::{with_format, AnyFormat};
     let cases = scene_cases(pairs, seed);
-    let mut out = HitsSoa::with_len(pairs);
-    match any {
-        AnyFormat::F32(f) => {
-            let rti = Rti::new(f, RtiConfig::default());
-            let (rays, tris) = columns(&rti, &cases);
-            rate(pairs, 3, || {
-                rti_batch_f32(&rti, &rays, &tris, &mut out);
-            })
-        }
-        AnyFormat::F16(f) => {
-            let rti = Rti::new(f, RtiConfig::default());
-            let (rays, tris) = columns(&rti, &cases);
-            let mut out = HitsSoa::with_len(pairs);
-            rate(pairs, 3, || {
-                rti_batch_f16(&rti, &rays, &tris, &mut out);
-            })
-        }
-        other => with_format!(other, |f| {
-            let rti = Rti::new(f, RtiConfig::default());
-            let (rays, tris) = columns(&rti, &cases);
-            let mut out = HitsSoa::with_len(pairs);
-            rate(pairs, 3, || rti.batch(&rays, &tris, &mut out))
-        }),
-    }
+    datapath::with_format!(any, |f| {
+        let rti = Rti::new(f, RtiConfig::default());
+        let (rays, tris) = columns(&rti, &cases);
+        let mut out = HitsSoa::with_len(pairs);
+        rate(pairs, 3, || {
+            datapath::simd::rti_batch(&rti, &rays, &tris, &mut out);
+        })
+    })
 }
 
 /// Measures.
