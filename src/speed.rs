@@ -47,12 +47,20 @@ pub struct SpeedReport {
     pub rows: Vec<SpeedRow>,
 }
 
-/// Adds and multiplies on independent accumulators for about `secs`: lane-ops per second.
+/// Adds and multiplies on independent accumulators for about `secs`, on the widest vector
+/// unit the kernels use here: lane-ops per second.
 fn peak(secs: f64) -> f64 {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: AVX2 detected.
-        return unsafe { peak_avx2(secs) };
+    {
+        let k = datapath::simd::kernels_here();
+        if k.contains(&Kernel::Avx512) {
+            // SAFETY: AVX-512F detected.
+            return unsafe { peak_avx512(secs) };
+        }
+        if k.contains(&Kernel::Avx2) {
+            // SAFETY: AVX2 detected.
+            return unsafe { peak_avx2(secs) };
+        }
     }
     peak_scalar(secs)
 }
@@ -84,26 +92,34 @@ fn peak_scalar(secs: f64) -> f64 {
     r
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn peak_avx2(secs: f64) -> f64 {
-    use std::arch::x86_64::*;
-    let a = _mm256_set1_ps(black_box(-1e-7));
-    let m = _mm256_set1_ps(black_box(1.000_000_1));
-    let mut acc = [_mm256_set1_ps(1.0); 12];
-    let iters = 10_000u64;
-    let r = timed(secs, iters * 12 * 2 * 8, || {
-        let mut v = acc; // in registers for the burst
-        for _ in 0..iters {
-            for x in v.iter_mut() {
-                *x = _mm256_mul_ps(_mm256_add_ps(*x, a), m);
-            }
+/// A vector peak loop: 12 independent add-then-multiply chains, kept in registers.
+macro_rules! peak_simd {
+    ($name:ident, $feat:literal, $set1:ident, $add:ident, $mul:ident, $lanes:expr) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feat)]
+        fn $name(secs: f64) -> f64 {
+            use std::arch::x86_64::*;
+            let a = $set1(black_box(-1e-7));
+            let m = $set1(black_box(1.000_000_1));
+            let mut acc = [$set1(1.0); 12];
+            let iters = 10_000u64;
+            let r = timed(secs, iters * 12 * 2 * $lanes, || {
+                let mut v = acc; // in registers for the burst
+                for _ in 0..iters {
+                    for x in v.iter_mut() {
+                        *x = $mul($add(*x, a), m);
+                    }
+                }
+                acc = black_box(v);
+            });
+            black_box(acc);
+            r
         }
-        acc = black_box(v);
-    });
-    black_box(acc);
-    r
+    };
 }
+
+peak_simd!(peak_avx2, "avx2", _mm256_set1_ps, _mm256_add_ps, _mm256_mul_ps, 8);
+peak_simd!(peak_avx512, "avx512f", _mm512_set1_ps, _mm512_add_ps, _mm512_mul_ps, 16);
 
 /// Best of `reps` timings of `f` over `n` tests, each repeating `f` for at least 20 ms
 /// (a small working set stays in cache): million tests per second.

@@ -1,15 +1,16 @@
 //! SIMD batch kernels of the RTI and slab models, bit-identical to the scalar models, with
 //! runtime dispatch.
 //!
-//! One kernel body per unit (the `rti_kernel!` and `slab_kernel!` macros) is instantiated for
-//! binary32 and binary16 on AVX2 (+ F16C for binary16), eight tests per vector, in the stage
+//! One kernel body per unit (the `rti_kernel!` and `slab_kernel!` macros), written in the
+//! operations of an [`isa`] module, is instantiated for binary32 and binary16 on AVX2 (+ F16C
+//! for binary16; 8 tests per vector) and on AVX-512F (16 tests per vector), in the stage
 //! table's exact operation order with separate multiplies and adds (no FMA). binary16 computes
 //! every operation in binary32 and rounds it to binary16 at once (`vcvtps2ph` nearest-even,
 //! then back): binary32's 24 bits are at least 2·11 + 2, so this double rounding is innocuous
 //! for + − × ÷ and the result is the correctly rounded binary16 operation, subnormals and
 //! overflow included; compares and min/max of binary16 values held in binary32 are exact.
 //! NaN payloads never influence a non-NaN result or a compare, so the kernels canonicalise NaN
-//! only where a value leaves them, and only when a movemask shows a NaN lane.
+//! only where a value leaves them, and only when a mask shows a NaN lane.
 //!
 //! The slab kernels take either pairs (ray i against box i) or one ray against every box (a
 //! node's children, a level): the second reads only the six box columns and picks each axis's
@@ -19,52 +20,88 @@
 //! Eligible formats: IEEE subnormals and canonical NaN (either division mode, either culling;
 //! every slab variant but the directed one); others, and machines without AVX2, run the
 //! scalar model, as does a det threshold that is negative or NaN (the RTI kernels' sign-flip
-//! side tests need det_ok to exclude det = ±0). Columns are processed 8 lanes at a time
-//! straight from the SoA inputs; a batch's last `n mod 8` slots run the scalar model.
+//! side tests need det_ok to exclude det = ±0). Columns are processed a vector at a time
+//! straight from the SoA inputs; a batch's last `n mod lanes` slots run the scalar model.
 //!
-//! No AVX-512 kernels: the machines this suite is developed and tested on have none, and a
-//! kernel that no test has run is not offered.
+//! The dispatch takes the widest kernel the machine has ([`kernels_here`]), within this
+//! thread's cap ([`with_kernel_cap`]), so every kernel can be tested and timed on one machine.
+//! The AVX-512 kernels are tested by the same property tests as the AVX2 ones, on an emulated
+//! AVX-512 machine (`emu/avx512`) when the host has none. There is no AVX512-FP16 kernel
+//! (native binary16 arithmetic): no emulator available here implements it, and an untested
+//! kernel is not offered; binary16 runs on AVX-512F through the conversions above.
 
 use crate::format::{DivMode, F16Half, F32Native, Ieee, NanMode, Subnormals};
 use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
 use crate::slab::{BoxesSoa, Slab, SlabNan, SlabOutSoa, SlabRay, SlabRaysSoa};
 use half::f16;
 
-/// Which implementation ran.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which implementation ran (ordered: a cap of `Avx2` allows `Scalar` and `Avx2`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Kernel {
-    /// AVX2 (binary32) or AVX2 + F16C (binary16), 8 lanes.
-    Avx2,
     /// The scalar model.
     Scalar,
+    /// AVX2 (binary32) or AVX2 + F16C (binary16), 8 lanes.
+    Avx2,
+    /// AVX-512F (binary32 and binary16, the latter through its conversions), 16 lanes.
+    Avx512,
 }
 
+thread_local! {
+    /// The widest kernel this thread's dispatch may choose.
+    static CAP: std::cell::Cell<Kernel> = const { std::cell::Cell::new(Kernel::Avx512) };
+}
+
+/// Runs `f` with this thread's dispatch limited to kernels no wider than `cap` (to test or
+/// time a narrower kernel on a wider machine); the previous cap is restored afterwards.
+pub fn with_kernel_cap<R>(cap: Kernel, f: impl FnOnce() -> R) -> R {
+    struct Restore(Kernel);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            CAP.with(|c| c.set(self.0));
+        }
+    }
+    let _restore = Restore(CAP.with(|c| c.replace(cap)));
+    f()
+}
+
+/// The kernels this machine can run, narrowest first (`Scalar` always).
+pub fn kernels_here() -> Vec<Kernel> {
+    let mut k = vec![Kernel::Scalar];
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::is_x86_feature_detected as has;
+        if has!("avx2") && has!("f16c") {
+            k.push(Kernel::Avx2);
+        }
+        if has!("avx512f") && has!("avx2") && has!("f16c") {
+            k.push(Kernel::Avx512);
+        }
+    }
+    k
+}
+
+/// The kernels model this binary32 / binary16 format: IEEE subnormals and canonical NaN.
 fn eligible<B: crate::format::IeeeBackend>(f: &Ieee<B>) -> bool {
     f.opts.subnormals == Subnormals::Ieee && f.opts.nan == NanMode::Canonical
 }
 
-/// The kernel `rti_batch_f32` uses for this unit on this machine.
-pub fn kernel_f32(rti: &Rti<Ieee<F32Native>>) -> Kernel {
-    #[cfg(target_arch = "x86_64")]
-    if eligible(&rti.fmt) && rti.det_thr >= 0.0 && std::arch::is_x86_feature_detected!("avx2") {
-        return Kernel::Avx2;
+/// The widest kernel this machine has within this thread's cap, if `eligible`.
+fn best_kernel(eligible: bool) -> Kernel {
+    let cap = CAP.with(|c| c.get());
+    match eligible {
+        true => kernels_here().into_iter().filter(|&k| k <= cap).max().unwrap_or(Kernel::Scalar),
+        false => Kernel::Scalar,
     }
-    let _ = rti;
-    Kernel::Scalar
 }
 
-/// The kernel `rti_batch_f16` uses for this unit on this machine.
+/// The kernel `rti_batch_f32` uses for this unit on this machine (and this thread's cap).
+pub fn kernel_f32(rti: &Rti<Ieee<F32Native>>) -> Kernel {
+    best_kernel(eligible(&rti.fmt) && rti.det_thr >= 0.0)
+}
+
+/// The kernel `rti_batch_f16` uses for this unit on this machine (and this thread's cap).
 pub fn kernel_f16(rti: &Rti<Ieee<F16Half>>) -> Kernel {
-    #[cfg(target_arch = "x86_64")]
-    if eligible(&rti.fmt)
-        && rti.det_thr.to_f32() >= 0.0
-        && std::arch::is_x86_feature_detected!("avx2")
-        && std::arch::is_x86_feature_detected!("f16c")
-    {
-        return Kernel::Avx2;
-    }
-    let _ = rti;
-    Kernel::Scalar
+    best_kernel(eligible(&rti.fmt) && rti.det_thr.to_f32() >= 0.0)
 }
 
 /// The signature of an RTI kernel: lanes `0..full` of every column.
@@ -86,26 +123,37 @@ fn rti_columns_ok<V>(rays: &RaysSoa<V>, tris: &TrisSoa<V>, out: &HitsSoa<V>, n: 
         && [&out.t, &out.u, &out.v].iter().all(|c| c.len() == n)
 }
 
-/// Runs `kernel` (when `which` is AVX2 and every column has the batch's length) on the full
-/// 8-lane vectors and the scalar model on the rest; otherwise the scalar model throughout.
+/// The kernel of `table` (AVX2, AVX-512) that `which` names, and its lanes per vector.
+#[cfg(target_arch = "x86_64")]
+fn pick<K>(which: Kernel, table: [K; 2]) -> Option<(K, usize)> {
+    let [v8, v16] = table;
+    match which {
+        Kernel::Scalar => None,
+        Kernel::Avx2 => Some((v8, isa::v8::LANES)),
+        Kernel::Avx512 => Some((v16, isa::v16::LANES)),
+    }
+}
+
+/// Runs the kernel of `table` that `which` names (when every column has the batch's length)
+/// on the full vectors and the scalar model on the rest; otherwise the scalar model throughout.
 fn rti_dispatch<F: crate::Format>(
     rti: &Rti<F>,
     rays: &RaysSoa<F::V>,
     tris: &TrisSoa<F::V>,
     out: &mut HitsSoa<F::V>,
     which: Kernel,
-    #[cfg(target_arch = "x86_64")] kernel: RtiKernelFn<F>,
+    #[cfg(target_arch = "x86_64")] table: [RtiKernelFn<F>; 2],
 ) -> Kernel {
     let n = rays.len();
     assert!(tris.len() == n && out.len() == n, "batch lengths differ");
     #[cfg(target_arch = "x86_64")]
-    if which == Kernel::Avx2 && rti_columns_ok(rays, tris, out, n) {
-        let full = n / 8 * 8;
-        // SAFETY: `which` is AVX2 only after run-time feature detection; every column holds
-        // n >= full slots (checked above).
+    if let Some((kernel, lanes)) = pick(which, table).filter(|_| rti_columns_ok(rays, tris, out, n)) {
+        let full = n / lanes * lanes;
+        // SAFETY: `which` names a kernel only after run-time feature detection; every column
+        // holds n >= full slots (checked above).
         unsafe { kernel(rti, rays, tris, out, full) };
         rti.batch_from(rays, tris, out, full);
-        return Kernel::Avx2;
+        return which;
     }
     let _ = which;
     rti.batch(rays, tris, out);
@@ -130,7 +178,7 @@ pub fn rti_batch_f32(
         out,
         which,
         #[cfg(target_arch = "x86_64")]
-        avx2::rti_f32,
+        [kernels::v8::rti_f32, kernels::v16::rti_f32],
     )
 }
 
@@ -152,33 +200,19 @@ pub fn rti_batch_f16(
         out,
         which,
         #[cfg(target_arch = "x86_64")]
-        avx2::rti_f16,
+        [kernels::v8::rti_f16, kernels::v16::rti_f16],
     )
 }
 
 /// The kernel `slab_batch_f32` / `slab_ray_f32` use for this unit on this machine (the
 /// round-to-nearest variants; the directed one runs the scalar model).
 pub fn slab_kernel_f32(s: &Slab<Ieee<F32Native>>) -> Kernel {
-    #[cfg(target_arch = "x86_64")]
-    if eligible(&s.fmt) && !s.cfg.directed && std::arch::is_x86_feature_detected!("avx2") {
-        return Kernel::Avx2;
-    }
-    let _ = s;
-    Kernel::Scalar
+    best_kernel(eligible(&s.fmt) && !s.cfg.directed)
 }
 
 /// The kernel `slab_batch_f16` / `slab_ray_f16` use for this unit on this machine.
 pub fn slab_kernel_f16(s: &Slab<Ieee<F16Half>>) -> Kernel {
-    #[cfg(target_arch = "x86_64")]
-    if eligible(&s.fmt)
-        && !s.cfg.directed
-        && std::arch::is_x86_feature_detected!("avx2")
-        && std::arch::is_x86_feature_detected!("f16c")
-    {
-        return Kernel::Avx2;
-    }
-    let _ = s;
-    Kernel::Scalar
+    best_kernel(eligible(&s.fmt) && !s.cfg.directed)
 }
 
 /// Every box and output column holds `n` slots.
@@ -211,15 +245,15 @@ type SlabKernelFn<F> = unsafe fn(
     usize,
 );
 
-/// Runs `kernel` (when `which` is AVX2 and every column has the batch's length) on the full
-/// 8-lane vectors and the scalar model on the rest; otherwise the scalar model throughout.
+/// Runs the kernel of `table` that `which` names (when every column has the batch's length)
+/// on the full vectors and the scalar model on the rest; otherwise the scalar model throughout.
 fn slab_dispatch<F: crate::Format>(
     s: &Slab<F>,
     rays: SlabRays<F::V>,
     boxes: &BoxesSoa<F::V>,
     out: &mut SlabOutSoa<F::V>,
     which: Kernel,
-    #[cfg(target_arch = "x86_64")] kernel: SlabKernelFn<F>,
+    #[cfg(target_arch = "x86_64")] table: [SlabKernelFn<F>; 2],
 ) -> Kernel {
     let n = out.hit.len();
     let rays_ok = match rays {
@@ -233,16 +267,16 @@ fn slab_dispatch<F: crate::Format>(
         }
     };
     #[cfg(target_arch = "x86_64")]
-    if which == Kernel::Avx2 && rays_ok && slab_columns_ok(boxes, out, n) {
-        let full = n / 8 * 8;
-        // SAFETY: `which` is AVX2 only after run-time feature detection; every column holds
-        // n >= full slots (checked above).
+    if let Some((kernel, lanes)) = pick(which, table).filter(|_| rays_ok && slab_columns_ok(boxes, out, n)) {
+        let full = n / lanes * lanes;
+        // SAFETY: `which` names a kernel only after run-time feature detection; every column
+        // holds n >= full slots (checked above).
         unsafe { kernel(s, rays, boxes, out, full) };
         match rays {
             SlabRays::Pairs(r) => s.batch_from(r, boxes, out, full),
             SlabRays::One(r) => s.batch_ray_from(r, boxes, out, full),
         }
-        return Kernel::Avx2;
+        return which;
     }
     let _ = (which, rays_ok);
     match rays {
@@ -268,7 +302,7 @@ macro_rules! slab_entry {
                 out,
                 which,
                 #[cfg(target_arch = "x86_64")]
-                avx2::$kernel,
+                [kernels::v8::$kernel, kernels::v16::$kernel],
             )
         }
     };
@@ -403,41 +437,451 @@ where
     kernel
 }
 
+/// The vector operations the kernel bodies use, one module per instruction set with the same
+/// names: `v8` (AVX2, 8 binary32 lanes, masks as vectors) and `v16` (AVX-512F, 16 lanes, masks
+/// as `__mmask16`). Each function is one or two instructions; binary16 columns are widened to
+/// binary32 on load (`vcvtph2ps`, exact) and narrowed on store (`vcvtps2ph`, nearest-even).
 #[cfg(target_arch = "x86_64")]
-mod avx2 {
-    use super::*;
-    use std::arch::x86_64::*;
+mod isa {
+    /// An 8-bit lane mask spread to 8 bytes of 0 / 1 (lane k in byte k).
+    pub(super) const SPREAD: [u64; 256] = {
+        let mut t = [0u64; 256];
+        let mut m = 0;
+        while m < 256 {
+            let mut k = 0;
+            while k < 8 {
+                if m >> k & 1 == 1 {
+                    t[m] |= 1 << (8 * k);
+                }
+                k += 1;
+            }
+            m += 1;
+        }
+        t
+    };
 
-    /// The RTI stage table on 8 lanes. `$load(column, i)` gives 8 binary32 lanes,
-    /// `$round(x)` rounds a binary32 result to the format, `$store(column, i, x)` writes 8
-    /// results, `$thr` is the det threshold as binary32, `$nan` the canonical NaN as binary32.
+    /// The binary16 next-up step on 16 binary16 encodings (NaN and +inf unchanged, ±0 to the
+    /// smallest subnormal), as the scalar model's `next_up` with IEEE subnormals.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub(super) fn step_up16(b: std::arch::x86_64::__m256i) -> std::arch::x86_64::__m256i {
+        use std::arch::x86_64::*;
+        let mag = _mm256_and_si256(b, _mm256_set1_epi16(0x7fff));
+        let keep = _mm256_or_si256(
+            _mm256_cmpgt_epi16(mag, _mm256_set1_epi16(0x7c00)), // NaN
+            _mm256_cmpeq_epi16(b, _mm256_set1_epi16(0x7c00)),   // +inf
+        );
+        let zero = _mm256_cmpeq_epi16(mag, _mm256_setzero_si256());
+        // negative: bits - 1, positive: bits + 1
+        let step = _mm256_or_si256(_mm256_srai_epi16::<15>(b), _mm256_set1_epi16(1));
+        let r = _mm256_add_epi16(b, step);
+        let r = _mm256_blendv_epi8(r, _mm256_set1_epi16(1), zero);
+        _mm256_blendv_epi8(r, b, keep)
+    }
+
+    /// AVX2 (+ F16C for binary16): 8 lanes, a mask is a vector of all-ones / all-zeros lanes.
+    pub(super) mod v8 {
+        use half::f16;
+        use std::arch::x86_64::*;
+        /// Lanes per vector.
+        pub const LANES: usize = 8;
+        /// A mask.
+        pub type M = __m256;
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn splat(x: f32) -> __m256 {
+            _mm256_set1_ps(x)
+        }
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn splat_bits(x: u32) -> __m256 {
+            _mm256_castsi256_ps(_mm256_set1_epi32(x as i32))
+        }
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn add(a: __m256, b: __m256) -> __m256 {
+            _mm256_add_ps(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn sub(a: __m256, b: __m256) -> __m256 {
+            _mm256_sub_ps(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn mul(a: __m256, b: __m256) -> __m256 {
+            _mm256_mul_ps(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn div(a: __m256, b: __m256) -> __m256 {
+            _mm256_div_ps(a, b)
+        }
+        /// `a > b ? a : b` (vmaxps: the second operand on NaN or equality).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn max(a: __m256, b: __m256) -> __m256 {
+            _mm256_max_ps(a, b)
+        }
+        /// `a < b ? a : b` (vminps).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn min(a: __m256, b: __m256) -> __m256 {
+            _mm256_min_ps(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn le(a: __m256, b: __m256) -> M {
+            _mm256_cmp_ps::<_CMP_LE_OQ>(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn lt(a: __m256, b: __m256) -> M {
+            _mm256_cmp_ps::<_CMP_LT_OQ>(a, b)
+        }
+        /// Lanes where a or b is NaN.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn unord(a: __m256, b: __m256) -> M {
+            _mm256_cmp_ps::<_CMP_UNORD_Q>(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn and_m(a: M, b: M) -> M {
+            _mm256_and_ps(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn or_m(a: M, b: M) -> M {
+            _mm256_or_ps(a, b)
+        }
+        /// The mask as lane bits (lane k in bit k).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn bits(m: M) -> u32 {
+            _mm256_movemask_ps(m) as u32
+        }
+        /// `m ? b : a` per lane.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn blend(a: __m256, b: __m256, m: M) -> __m256 {
+            _mm256_blendv_ps(a, b, m)
+        }
+        /// `sign(x) ? b : a` per lane (the sign bit of x, as vblendvps reads it).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn blend_sign(a: __m256, b: __m256, x: __m256) -> __m256 {
+            _mm256_blendv_ps(a, b, x)
+        }
+        /// The sign bits of x (everything else cleared).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn sign(x: __m256) -> __m256 {
+            _mm256_and_ps(x, _mm256_set1_ps(-0.0))
+        }
+        /// |x| by clearing the sign bit.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn abs(x: __m256) -> __m256 {
+            _mm256_andnot_ps(_mm256_set1_ps(-0.0), x)
+        }
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn xor(a: __m256, b: __m256) -> __m256 {
+            _mm256_xor_ps(a, b)
+        }
+        /// Writes the mask's lanes as bools 0 / 1 to `p[i..i + 8]`.
+        ///
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn flags(p: *mut bool, i: usize, m: M) {
+            // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
+            unsafe { (p.add(i) as *mut u64).write_unaligned(super::SPREAD[bits(m) as usize]) }
+        }
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn load32(p: *const f32, i: usize) -> __m256 {
+            unsafe { _mm256_loadu_ps(p.add(i)) }
+        }
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn store32(p: *mut f32, i: usize, x: __m256) {
+            unsafe { _mm256_storeu_ps(p.add(i), x) }
+        }
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2,f16c")]
+        pub unsafe fn load16(p: *const f16, i: usize) -> __m256 {
+            unsafe { _mm256_cvtph_ps(_mm_loadu_si128(p.add(i) as *const __m128i)) }
+        }
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2,f16c")]
+        pub unsafe fn store16(p: *mut f16, i: usize, x: __m256) {
+            unsafe { _mm_storeu_si128(p.add(i) as *mut __m128i, _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x)) }
+        }
+        /// Rounds binary32 lanes to binary16 (nearest-even), held in binary32.
+        #[inline]
+        #[target_feature(enable = "avx2,f16c")]
+        pub fn round16(x: __m256) -> __m256 {
+            _mm256_cvtph_ps(_mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x))
+        }
+        /// The next binary32 encoding above each lane (NaN and +inf unchanged, ±0 to the
+        /// smallest subnormal), as the scalar model's `next_up` with IEEE subnormals.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn next_up(v: __m256) -> __m256 {
+            let b = _mm256_castps_si256(v);
+            let keep = _mm256_or_si256(
+                _mm256_castps_si256(_mm256_cmp_ps::<_CMP_UNORD_Q>(v, v)),
+                _mm256_cmpeq_epi32(b, _mm256_set1_epi32(0x7f80_0000)),
+            );
+            let zero = _mm256_cmpeq_epi32(_mm256_and_si256(b, _mm256_set1_epi32(0x7fff_ffff)), _mm256_setzero_si256());
+            // negative: bits - 1, positive: bits + 1
+            let step = _mm256_or_si256(_mm256_srai_epi32::<31>(b), _mm256_set1_epi32(1));
+            let r = _mm256_add_epi32(b, step);
+            let r = _mm256_blendv_epi8(r, _mm256_set1_epi32(1), zero);
+            _mm256_castsi256_ps(_mm256_blendv_epi8(r, b, keep))
+        }
+        /// [`next_up`] on the binary16 grid, for lanes that hold binary16 values.
+        #[inline]
+        #[target_feature(enable = "avx2,f16c")]
+        pub fn next_up16(v: __m256) -> __m256 {
+            // exact: every lane is a binary16 value (a NaN stays a NaN and is kept); the upper
+            // 8 halves of the 256-bit step are don't-care
+            let b = _mm256_castsi128_si256(_mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(v));
+            _mm256_cvtph_ps(_mm256_castsi256_si128(super::step_up16(b)))
+        }
+    }
+
+    /// AVX-512F: 16 lanes, a mask is a `__mmask16` (binary16 via the AVX-512F conversions,
+    /// the binary16 step on 256-bit AVX2 integer lanes).
+    pub(super) mod v16 {
+        use half::f16;
+        use std::arch::x86_64::*;
+        /// Lanes per vector.
+        pub const LANES: usize = 16;
+        /// A mask.
+        pub type M = __mmask16;
+        /// vcvtps2ph: round to nearest even, exceptions suppressed (flags are not modelled).
+        const NEAREST: i32 = _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC;
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn splat(x: f32) -> __m512 {
+            _mm512_set1_ps(x)
+        }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn splat_bits(x: u32) -> __m512 {
+            _mm512_castsi512_ps(_mm512_set1_epi32(x as i32))
+        }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn add(a: __m512, b: __m512) -> __m512 {
+            _mm512_add_ps(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn sub(a: __m512, b: __m512) -> __m512 {
+            _mm512_sub_ps(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn mul(a: __m512, b: __m512) -> __m512 {
+            _mm512_mul_ps(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn div(a: __m512, b: __m512) -> __m512 {
+            _mm512_div_ps(a, b)
+        }
+        /// `a > b ? a : b` (vmaxps: the second operand on NaN or equality).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn max(a: __m512, b: __m512) -> __m512 {
+            _mm512_max_ps(a, b)
+        }
+        /// `a < b ? a : b` (vminps).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn min(a: __m512, b: __m512) -> __m512 {
+            _mm512_min_ps(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn le(a: __m512, b: __m512) -> M {
+            _mm512_cmp_ps_mask::<_CMP_LE_OQ>(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn lt(a: __m512, b: __m512) -> M {
+            _mm512_cmp_ps_mask::<_CMP_LT_OQ>(a, b)
+        }
+        /// Lanes where a or b is NaN.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn unord(a: __m512, b: __m512) -> M {
+            _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(a, b)
+        }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn and_m(a: M, b: M) -> M {
+            a & b
+        }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn or_m(a: M, b: M) -> M {
+            a | b
+        }
+        /// The mask as lane bits (lane k in bit k).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn bits(m: M) -> u32 {
+            m as u32
+        }
+        /// `m ? b : a` per lane.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn blend(a: __m512, b: __m512, m: M) -> __m512 {
+            _mm512_mask_blend_ps(m, a, b)
+        }
+        /// `sign(x) ? b : a` per lane.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn blend_sign(a: __m512, b: __m512, x: __m512) -> __m512 {
+            let m = _mm512_test_epi32_mask(_mm512_castps_si512(x), _mm512_set1_epi32(i32::MIN));
+            _mm512_mask_blend_ps(m, a, b)
+        }
+        /// The sign bits of x (everything else cleared).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn sign(x: __m512) -> __m512 {
+            _mm512_castsi512_ps(_mm512_and_si512(_mm512_castps_si512(x), _mm512_set1_epi32(i32::MIN)))
+        }
+        /// |x| by clearing the sign bit.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn abs(x: __m512) -> __m512 {
+            _mm512_castsi512_ps(_mm512_and_si512(_mm512_castps_si512(x), _mm512_set1_epi32(i32::MAX)))
+        }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn xor(a: __m512, b: __m512) -> __m512 {
+            _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(a), _mm512_castps_si512(b)))
+        }
+        /// Writes the mask's lanes as bools 0 / 1 to `p[i..i + 16]`.
+        ///
+        /// # Safety
+        /// `p[i..i + 16]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn flags(p: *mut bool, i: usize, m: M) {
+            // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
+            unsafe {
+                (p.add(i) as *mut u64).write_unaligned(super::SPREAD[(m & 0xff) as usize]);
+                (p.add(i + 8) as *mut u64).write_unaligned(super::SPREAD[(m >> 8) as usize]);
+            }
+        }
+        /// # Safety
+        /// `p[i..i + 16]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn load32(p: *const f32, i: usize) -> __m512 {
+            unsafe { _mm512_loadu_ps(p.add(i)) }
+        }
+        /// # Safety
+        /// `p[i..i + 16]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn store32(p: *mut f32, i: usize, x: __m512) {
+            unsafe { _mm512_storeu_ps(p.add(i), x) }
+        }
+        /// # Safety
+        /// `p[i..i + 16]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn load16(p: *const f16, i: usize) -> __m512 {
+            unsafe { _mm512_cvtph_ps(_mm256_loadu_si256(p.add(i) as *const __m256i)) }
+        }
+        /// # Safety
+        /// `p[i..i + 16]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn store16(p: *mut f16, i: usize, x: __m512) {
+            unsafe { _mm256_storeu_si256(p.add(i) as *mut __m256i, _mm512_cvtps_ph::<NEAREST>(x)) }
+        }
+        /// Rounds binary32 lanes to binary16 (nearest-even), held in binary32.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn round16(x: __m512) -> __m512 {
+            _mm512_cvtph_ps(_mm512_cvtps_ph::<NEAREST>(x))
+        }
+        /// The next binary32 encoding above each lane, as [`super::v8::next_up`].
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn next_up(v: __m512) -> __m512 {
+            let b = _mm512_castps_si512(v);
+            let keep =
+                _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(v, v) | _mm512_cmpeq_epi32_mask(b, _mm512_set1_epi32(0x7f80_0000));
+            let zero = _mm512_testn_epi32_mask(b, _mm512_set1_epi32(0x7fff_ffff));
+            // negative: bits - 1, positive: bits + 1
+            let step = _mm512_or_si512(_mm512_srai_epi32::<31>(b), _mm512_set1_epi32(1));
+            let r = _mm512_add_epi32(b, step);
+            let r = _mm512_mask_blend_epi32(zero, r, _mm512_set1_epi32(1));
+            _mm512_castsi512_ps(_mm512_mask_blend_epi32(keep, r, b))
+        }
+        /// [`next_up`] on the binary16 grid, for lanes that hold binary16 values.
+        #[inline]
+        #[target_feature(enable = "avx512f,avx2")]
+        pub fn next_up16(v: __m512) -> __m512 {
+            // exact: every lane is a binary16 value (a NaN stays a NaN and is kept)
+            _mm512_cvtph_ps(super::step_up16(_mm512_cvtps_ph::<NEAREST>(v)))
+        }
+    }
+}
+
+/// The kernel bodies, instantiated for each instruction set in [`isa`].
+#[cfg(target_arch = "x86_64")]
+mod kernels {
+    use super::*;
+
+    /// The RTI stage table on one vector per step, in the ops of `$x` (an [`isa`] module).
+    /// `$load(column, i)` gives the lanes as binary32, `$round(x)` rounds a binary32 result to
+    /// the format, `$store(column, i, x)` writes results, `$thr` is the det threshold as binary32.
     macro_rules! rti_kernel {
-        ($rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $nan:expr) => {{
+        ($x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr) => {{
             // one loop per (culling, division mode), so that neither is decided per vector
             let backface = $rti.cull == Cull::Backface;
             match ($rti.fmt.opts.div, backface) {
-                (DivMode::RecipMul, false) => rti_kernel!(@loop $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $nan, false, true),
-                (DivMode::RecipMul, true) => rti_kernel!(@loop $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $nan, true, true),
-                (DivMode::Divide, false) => rti_kernel!(@loop $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $nan, false, false),
-                (DivMode::Divide, true) => rti_kernel!(@loop $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $nan, true, false),
+                (DivMode::RecipMul, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, false, true),
+                (DivMode::RecipMul, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, true, true),
+                (DivMode::Divide, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, false, false),
+                (DivMode::Divide, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, true, false),
             }
         }};
-        (@loop $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $nan:expr, $backface:expr, $recip:expr) => {{
+        (@loop $x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $backface:expr, $recip:expr) => {{
             let (rays, tris, out) = ($rays, $tris, $out);
             let load = $load;
             let rd = $round;
             let store = $store;
-            let sub = |a, b| rd(_mm256_sub_ps(a, b));
-            let add = |a, b| rd(_mm256_add_ps(a, b));
-            let mul = |a, b| rd(_mm256_mul_ps(a, b));
-            let div = |a, b| rd(_mm256_div_ps(a, b));
-            let le = |a, b| _mm256_cmp_ps::<_CMP_LE_OQ>(a, b);
-            let lt = |a, b| _mm256_cmp_ps::<_CMP_LT_OQ>(a, b);
-            let thr = _mm256_set1_ps($thr);
-            let zero = _mm256_setzero_ps();
-            let one = _mm256_set1_ps(1.0);
-            let sign = _mm256_set1_ps(-0.0);
-            let nan = $nan;
+            let sub = |a, b| rd($x::sub(a, b));
+            let add = |a, b| rd($x::add(a, b));
+            let mul = |a, b| rd($x::mul(a, b));
+            let div = |a, b| rd($x::div(a, b));
+            let thr = $x::splat($thr);
+            let zero = $x::splat(0.0);
+            let one = $x::splat(1.0);
+            // binary32's canonical NaN; vcvtps2ph makes it binary16's 0x7e00
+            let nan = $x::splat_bits(0x7fc0_0000);
+            const L: usize = $x::LANES;
             // Two passes over blocks of BLOCK vectors (software pipelining): the first runs
             // stages 1-6 and keeps det, u', v' and t'; the second runs stage 7, divides and
             // stores.
@@ -447,9 +891,9 @@ mod avx2 {
             let mut keep = [[zero; 4]; BLOCK];
             let mut base = 0;
             while base < $full {
-                let nv = (($full - base) / 8).min(BLOCK);
+                let nv = (($full - base) / L).min(BLOCK);
                 for (k, slot) in keep.iter_mut().enumerate().take(nv) {
-                    let i = base + 8 * k;
+                    let i = base + L * k;
                     let [ox, oy, oz] = [0, 1, 2].map(|a| load(&rays.o[a], i));
                     let [dx, dy, dz] = [0, 1, 2].map(|a| load(&rays.d[a], i));
                     let v = |k: usize, a: usize| load(&tris.v[k][a], i);
@@ -473,20 +917,20 @@ mod avx2 {
                     *slot = [det, up, vp, tp];
                 }
                 for (k, &[det, up, vp, tp]) in keep.iter().enumerate().take(nv) {
-                    let i = base + 8 * k;
+                    let i = base + L * k;
                     // stage 7
                     let uv = add(up, vp);
                     // The compares of stage 7, with the det-sign select done by a sign flip:
                     // when `det_ok` holds, det is neither ±0 nor NaN (threshold >= 0, checked
                     // by the dispatch), so `det > 0 ? a <= b : b <= a` equals `a^s <= b^s`
                     // with s = det's sign bit (negation is exact): `valid` is the same bit.
-                    let abs_det = _mm256_andnot_ps(sign, det);
-                    let det_ok = if $backface { lt(thr, det) } else { lt(thr, abs_det) };
-                    let s = _mm256_and_ps(sign, det);
-                    let nonneg = |x| le(zero, _mm256_xor_ps(x, s));
-                    let valid = _mm256_and_ps(
-                        _mm256_and_ps(det_ok, nonneg(up)),
-                        _mm256_and_ps(_mm256_and_ps(nonneg(vp), le(_mm256_xor_ps(uv, s), abs_det)), nonneg(tp)),
+                    let abs_det = $x::abs(det);
+                    let det_ok = if $backface { $x::lt(thr, det) } else { $x::lt(thr, abs_det) };
+                    let s = $x::sign(det);
+                    let nonneg = |x| $x::le(zero, $x::xor(x, s));
+                    let valid = $x::and_m(
+                        $x::and_m(det_ok, nonneg(up)),
+                        $x::and_m($x::and_m(nonneg(vp), $x::le($x::xor(uv, s), abs_det)), nonneg(tp)),
                     );
                     // the division last
                     let (t, u, w) = if $recip {
@@ -497,109 +941,41 @@ mod avx2 {
                     };
                     let tmin = load(&rays.tmin, i);
                     let tmax = load(&rays.tmax, i);
-                    let hit = _mm256_and_ps(valid, _mm256_and_ps(le(tmin, t), le(t, tmax)));
-                    let (hm, vm) = (_mm256_movemask_ps(hit) as usize, _mm256_movemask_ps(valid) as usize);
-                    // SAFETY: lanes i..i + 8 are in bounds (checked by the caller); every
-                    // byte written is 0 or 1, a valid bool.
+                    let hit = $x::and_m(valid, $x::and_m($x::le(tmin, t), $x::le(t, tmax)));
+                    // SAFETY: lanes i..i + L are in bounds (checked by the caller).
                     unsafe {
-                        (out.hit.as_mut_ptr().add(i) as *mut u64).write_unaligned(SPREAD[hm]);
-                        (out.valid.as_mut_ptr().add(i) as *mut u64).write_unaligned(SPREAD[vm]);
+                        $x::flags(out.hit.as_mut_ptr(), i, hit);
+                        $x::flags(out.valid.as_mut_ptr(), i, valid);
                     }
-                    // NaN lanes are rare: canonicalise only when one of the 24 results is NaN
-                    let any_nan =
-                        _mm256_or_ps(_mm256_cmp_ps::<_CMP_UNORD_Q>(t, u), _mm256_cmp_ps::<_CMP_UNORD_Q>(w, w));
-                    let (t, u, w) = if _mm256_movemask_ps(any_nan) == 0 {
+                    // NaN lanes are rare: canonicalise only when one of the results is NaN
+                    let canon = |x| $x::blend(x, nan, $x::unord(x, x));
+                    let (t, u, w) = if $x::bits($x::or_m($x::unord(t, u), $x::unord(w, w))) == 0 {
                         (t, u, w)
                     } else {
-                        (canon(t, nan), canon(u, nan), canon(w, nan))
+                        (canon(t), canon(u), canon(w))
                     };
                     store(&mut out.t, i, t);
                     store(&mut out.u, i, u);
                     store(&mut out.v, i, w);
                 }
-                base += 8 * nv;
+                base += L * nv;
             }
         }};
     }
 
-    /// An 8-bit lane mask spread to 8 bytes of 0 / 1 (lane k in byte k).
-    const SPREAD: [u64; 256] = {
-        let mut t = [0u64; 256];
-        let mut m = 0;
-        while m < 256 {
-            let mut k = 0;
-            while k < 8 {
-                if m >> k & 1 == 1 {
-                    t[m] |= 1 << (8 * k);
-                }
-                k += 1;
-            }
-            m += 1;
-        }
-        t
-    };
-
-    /// The next binary32 encoding above each lane (NaN and +inf unchanged, ±0 to the
-    /// smallest subnormal), as the scalar model's `next_up` with IEEE subnormals.
-    #[target_feature(enable = "avx2")]
-    fn next_up(v: __m256) -> __m256 {
-        let b = _mm256_castps_si256(v);
-        let keep = _mm256_or_si256(
-            _mm256_castps_si256(_mm256_cmp_ps::<_CMP_UNORD_Q>(v, v)),
-            _mm256_cmpeq_epi32(b, _mm256_set1_epi32(0x7f80_0000)),
-        );
-        let zero = _mm256_cmpeq_epi32(_mm256_and_si256(b, _mm256_set1_epi32(0x7fff_ffff)), _mm256_setzero_si256());
-        // negative: bits - 1, positive: bits + 1
-        let step = _mm256_or_si256(_mm256_srai_epi32::<31>(b), _mm256_set1_epi32(1));
-        let r = _mm256_add_epi32(b, step);
-        let r = _mm256_blendv_epi8(r, _mm256_set1_epi32(1), zero);
-        _mm256_castsi256_ps(_mm256_blendv_epi8(r, b, keep))
-    }
-
-    /// The next encoding below: next_up mirrored through the sign (NaN unchanged).
-    #[target_feature(enable = "avx2")]
-    fn next_down(v: __m256) -> __m256 {
-        let sign = _mm256_set1_ps(-0.0);
-        _mm256_xor_ps(next_up(_mm256_xor_ps(v, sign)), sign)
-    }
-
-    /// [`next_up`] on the binary16 grid, for lanes that hold binary16 values widened to binary32.
-    #[target_feature(enable = "avx2,f16c")]
-    fn next_up16(v: __m256) -> __m256 {
-        // exact: every lane is a binary16 value (a NaN stays a NaN and is kept)
-        let b = _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(v);
-        let mag = _mm_and_si128(b, _mm_set1_epi16(0x7fff));
-        let keep = _mm_or_si128(
-            _mm_cmpgt_epi16(mag, _mm_set1_epi16(0x7c00)), // NaN
-            _mm_cmpeq_epi16(b, _mm_set1_epi16(0x7c00)),   // +inf
-        );
-        let zero = _mm_cmpeq_epi16(mag, _mm_setzero_si128());
-        let step = _mm_or_si128(_mm_srai_epi16::<15>(b), _mm_set1_epi16(1));
-        let r = _mm_add_epi16(b, step);
-        let r = _mm_blendv_epi8(r, _mm_set1_epi16(1), zero);
-        _mm256_cvtph_ps(_mm_blendv_epi8(r, b, keep))
-    }
-
-    /// [`next_down`] on the binary16 grid.
-    #[target_feature(enable = "avx2,f16c")]
-    fn next_down16(v: __m256) -> __m256 {
-        let sign = _mm256_set1_ps(-0.0);
-        _mm256_xor_ps(next_up16(_mm256_xor_ps(v, sign)), sign)
-    }
-
-    /// The slab stage table on 8 lanes, for either batch shape. `$load(column, i)` gives 8
-    /// binary32 lanes, `$round(x)` rounds a binary32 result to the format, `$store(column, i,
-    /// x)` writes 8 results, `$up` / `$down` step on the format's grid, `$nan` is the canonical
-    /// NaN as binary32.
+    /// The slab stage table on one vector per step, for either batch shape, in the ops of `$x`.
+    /// `$load(column, i)` gives the lanes as binary32, `$round(x)` rounds a binary32 result to
+    /// the format, `$store(column, i, x)` writes results, `$up` steps up on the format's grid,
+    /// `$bcast` broadcasts a ray value.
     macro_rules! slab_kernel {
-        ($s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $down:expr, $nan:expr, $bcast:expr) => {{
+        ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $bcast:expr) => {{
             // one loop per comparator and batch shape, so that neither is decided per vector
             let tof = $s.cfg.nan == SlabNan::TakeOnFalse;
             match ($rays, tof) {
-                (SlabRays::Pairs(r), false) => slab_kernel!(@loop $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $down, $nan, $bcast, false),
-                (SlabRays::Pairs(r), true) => slab_kernel!(@loop $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $down, $nan, $bcast, true),
-                (SlabRays::One(r), false) => slab_kernel!(@loop $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $down, $nan, $bcast, false),
-                (SlabRays::One(r), true) => slab_kernel!(@loop $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $down, $nan, $bcast, true),
+                (SlabRays::Pairs(r), false) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, false),
+                (SlabRays::Pairs(r), true) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, true),
+                (SlabRays::One(r), false) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, false),
+                (SlabRays::One(r), true) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, true),
             }
         }};
         // per-batch preparation, hoisted out of the loop: column pointers; for one ray, each
@@ -622,19 +998,19 @@ mod avx2 {
                 ($bcast($r.tmin), $bcast($r.tmax)),
             )
         }};
-        // axis a of lanes i..i + 8: (near-plane t, far-plane t)
-        (@plane pairs $prep:ident, $bmin:ident, $bmax:ident, $load:ident, $rd:ident, $a:expr, $i:ident) => {{
+        // axis a of lanes i..i + L: (near-plane t, far-plane t)
+        (@plane $x:ident, pairs $prep:ident, $bmin:ident, $bmax:ident, $load:ident, $rd:ident, $a:expr, $i:ident) => {{
             let (o, inv) = ($load($prep.0[$a], $i), $load($prep.1[$a], $i));
-            let tlo = $rd(_mm256_mul_ps($rd(_mm256_sub_ps($load($bmin[$a], $i), o)), inv));
-            let thi = $rd(_mm256_mul_ps($rd(_mm256_sub_ps($load($bmax[$a], $i), o)), inv));
-            // the sign bit of 1/d picks the near plane (blendv reads the sign bit)
-            (_mm256_blendv_ps(tlo, thi, inv), _mm256_blendv_ps(thi, tlo, inv))
+            let tlo = $rd($x::mul($rd($x::sub($load($bmin[$a], $i), o)), inv));
+            let thi = $rd($x::mul($rd($x::sub($load($bmax[$a], $i), o)), inv));
+            // the sign bit of 1/d picks the near plane
+            ($x::blend_sign(tlo, thi, inv), $x::blend_sign(thi, tlo, inv))
         }};
-        (@plane one $prep:ident, $bmin:ident, $bmax:ident, $load:ident, $rd:ident, $a:expr, $i:ident) => {{
+        (@plane $x:ident, one $prep:ident, $bmin:ident, $bmax:ident, $load:ident, $rd:ident, $a:expr, $i:ident) => {{
             let (o, inv) = ($prep.2 .0[$a], $prep.2 .1[$a]);
             (
-                $rd(_mm256_mul_ps($rd(_mm256_sub_ps($load($prep.0[$a], $i), o)), inv)),
-                $rd(_mm256_mul_ps($rd(_mm256_sub_ps($load($prep.1[$a], $i), o)), inv)),
+                $rd($x::mul($rd($x::sub($load($prep.0[$a], $i), o)), inv)),
+                $rd($x::mul($rd($x::sub($load($prep.1[$a], $i), o)), inv)),
             )
         }};
         // the t interval the chains start from
@@ -644,9 +1020,13 @@ mod avx2 {
         (@limits one $prep:ident, $load:ident, $i:ident) => {
             $prep.3
         };
-        (@loop $s:expr, $shape:ident $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $down:expr, $nan:expr, $bcast:expr, $tof:expr) => {{
+        (@loop $x:ident, $s:expr, $shape:ident $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $bcast:expr, $tof:expr) => {{
             let (s, boxes, out) = ($s, $boxes, $out);
-            let (load, rd, store, up, down, nan, bcast) = ($load, $round, $store, $up, $down, $nan, $bcast);
+            let (load, rd, store, up, bcast) = ($load, $round, $store, $up, $bcast);
+            // next-down is next-up mirrored through the sign (negation is exact)
+            let neg = |v| $x::xor(v, $x::splat(-0.0));
+            let down = |v| neg(up(neg(v)));
+            let nan = $x::splat_bits(0x7fc0_0000);
             let bmin = boxes.min.each_ref().map(|c| c.as_ptr());
             let bmax = boxes.max.each_ref().map(|c| c.as_ptr());
             let prep = slab_kernel!(@prep $shape $r, bmin, bmax, bcast);
@@ -657,20 +1037,20 @@ mod avx2 {
             while i < $full {
                 let (mut tn, mut tf) = slab_kernel!(@limits $shape prep, load, i);
                 let p = [
-                    slab_kernel!(@plane $shape prep, bmin, bmax, load, rd, 0, i),
-                    slab_kernel!(@plane $shape prep, bmin, bmax, load, rd, 1, i),
-                    slab_kernel!(@plane $shape prep, bmin, bmax, load, rd, 2, i),
+                    slab_kernel!(@plane $x, $shape prep, bmin, bmax, load, rd, 0, i),
+                    slab_kernel!(@plane $x, $shape prep, bmin, bmax, load, rd, 1, i),
+                    slab_kernel!(@plane $x, $shape prep, bmin, bmax, load, rd, 2, i),
                 ];
                 for (near, far) in p {
                     if $tof {
                         // t = (x <= t) ? t : x (near), (t <= x) ? t : x (far)
-                        tn = _mm256_blendv_ps(near, tn, _mm256_cmp_ps::<_CMP_LE_OQ>(near, tn));
-                        tf = _mm256_blendv_ps(far, tf, _mm256_cmp_ps::<_CMP_LE_OQ>(tf, far));
+                        tn = $x::blend(near, tn, $x::le(near, tn));
+                        tf = $x::blend(far, tf, $x::le(tf, far));
                     } else {
                         // t = (x > t) ? x : t (near), (x < t) ? x : t (far): exactly vmaxps(x, t)
                         // and vminps(x, t), which return the second operand on NaN or equality
-                        tn = _mm256_max_ps(near, tn);
-                        tf = _mm256_min_ps(far, tf);
+                        tn = $x::max(near, tn);
+                        tf = $x::min(far, tf);
                     }
                 }
                 for _ in 0..widen.unsigned_abs() {
@@ -682,129 +1062,128 @@ mod avx2 {
                         tf = down(tf);
                     }
                 }
-                let hit = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf)) as usize;
-                // SAFETY: lanes i..i + 8 are in bounds; the bytes written are 0 or 1.
-                unsafe { (o_hit.add(i) as *mut u64).write_unaligned(SPREAD[hit]) };
-                // NaN lanes are rare: canonicalise only when a movemask shows one
-                let (tn, tf) = if _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_UNORD_Q>(tn, tf)) == 0 {
+                // SAFETY: lanes i..i + L are in bounds.
+                unsafe { $x::flags(o_hit, i, $x::le(tn, tf)) };
+                // NaN lanes are rare: canonicalise only when a mask shows one
+                let (tn, tf) = if $x::bits($x::unord(tn, tf)) == 0 {
                     (tn, tf)
                 } else {
-                    (canon(tn, nan), canon(tf, nan))
+                    let canon = |x| $x::blend(x, nan, $x::unord(x, x));
+                    (canon(tn), canon(tf))
                 };
                 store(o_near, i, tn);
                 store(o_far, i, tf);
-                i += 8;
+                i += $x::LANES;
             }
         }};
     }
 
-    #[target_feature(enable = "avx2")]
-    pub(super) fn slab_f32(
-        s: &Slab<Ieee<F32Native>>,
-        rays: SlabRays<f32>,
-        boxes: &BoxesSoa<f32>,
-        out: &mut SlabOutSoa<f32>,
-        full: usize,
-    ) {
-        // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
-        slab_kernel!(
-            s,
-            rays,
-            boxes,
-            out,
-            full,
-            |c: *const f32, i: usize| unsafe { _mm256_loadu_ps(c.add(i)) },
-            |x: __m256| x,
-            |c: *mut f32, i: usize, x: __m256| unsafe { _mm256_storeu_ps(c.add(i), x) },
-            next_up,
-            next_down,
-            _mm256_castsi256_ps(_mm256_set1_epi32(0x7fc0_0000)),
-            |x: f32| _mm256_set1_ps(x)
-        );
+    /// The four kernels (RTI and slab, binary32 and binary16) of one instruction set.
+    macro_rules! kernels_for {
+        ($x:ident, $f32feat:literal, $f16feat:literal) => {
+            pub(in crate::simd) mod $x {
+                use super::super::isa::$x;
+                use super::*;
+
+                #[target_feature(enable = $f32feat)]
+                pub fn rti_f32(
+                    rti: &Rti<Ieee<F32Native>>,
+                    rays: &RaysSoa<f32>,
+                    tris: &TrisSoa<f32>,
+                    out: &mut HitsSoa<f32>,
+                    full: usize,
+                ) {
+                    // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
+                    rti_kernel!(
+                        $x,
+                        rti,
+                        rays,
+                        tris,
+                        out,
+                        full,
+                        |c: &Vec<f32>, i: usize| unsafe { $x::load32(c.as_ptr(), i) },
+                        |x| x,
+                        |c: &mut Vec<f32>, i: usize, x| unsafe { $x::store32(c.as_mut_ptr(), i, x) },
+                        rti.det_thr
+                    );
+                }
+
+                #[target_feature(enable = $f16feat)]
+                pub fn rti_f16(
+                    rti: &Rti<Ieee<F16Half>>,
+                    rays: &RaysSoa<f16>,
+                    tris: &TrisSoa<f16>,
+                    out: &mut HitsSoa<f16>,
+                    full: usize,
+                ) {
+                    // SAFETY (loads and stores): the caller checked that every column holds
+                    // `full` lanes; f16 is a 2-byte plain value.
+                    rti_kernel!(
+                        $x,
+                        rti,
+                        rays,
+                        tris,
+                        out,
+                        full,
+                        |c: &Vec<f16>, i: usize| unsafe { $x::load16(c.as_ptr(), i) },
+                        |v| $x::round16(v),
+                        |c: &mut Vec<f16>, i: usize, x| unsafe { $x::store16(c.as_mut_ptr(), i, x) },
+                        rti.det_thr.to_f32()
+                    );
+                }
+
+                #[target_feature(enable = $f32feat)]
+                pub fn slab_f32(
+                    s: &Slab<Ieee<F32Native>>,
+                    rays: SlabRays<f32>,
+                    boxes: &BoxesSoa<f32>,
+                    out: &mut SlabOutSoa<f32>,
+                    full: usize,
+                ) {
+                    // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
+                    slab_kernel!(
+                        $x,
+                        s,
+                        rays,
+                        boxes,
+                        out,
+                        full,
+                        |c: *const f32, i: usize| unsafe { $x::load32(c, i) },
+                        |x| x,
+                        |c: *mut f32, i: usize, x| unsafe { $x::store32(c, i, x) },
+                        |v| $x::next_up(v),
+                        |v| $x::splat(v)
+                    );
+                }
+
+                #[target_feature(enable = $f16feat)]
+                pub fn slab_f16(
+                    s: &Slab<Ieee<F16Half>>,
+                    rays: SlabRays<f16>,
+                    boxes: &BoxesSoa<f16>,
+                    out: &mut SlabOutSoa<f16>,
+                    full: usize,
+                ) {
+                    // SAFETY (loads and stores): the caller checked that every column holds
+                    // `full` lanes; f16 is a 2-byte plain value.
+                    slab_kernel!(
+                        $x,
+                        s,
+                        rays,
+                        boxes,
+                        out,
+                        full,
+                        |c: *const f16, i: usize| unsafe { $x::load16(c, i) },
+                        |v| $x::round16(v),
+                        |c: *mut f16, i: usize, x| unsafe { $x::store16(c, i, x) },
+                        |v| $x::next_up16(v),
+                        |x: f16| $x::splat(x.to_f32())
+                    );
+                }
+            }
+        };
     }
 
-    #[target_feature(enable = "avx2,f16c")]
-    pub(super) fn slab_f16(
-        s: &Slab<Ieee<F16Half>>,
-        rays: SlabRays<f16>,
-        boxes: &BoxesSoa<f16>,
-        out: &mut SlabOutSoa<f16>,
-        full: usize,
-    ) {
-        // SAFETY (loads and stores): the caller checked that every column holds `full` lanes;
-        // f16 is a 2-byte plain value.
-        slab_kernel!(
-            s,
-            rays,
-            boxes,
-            out,
-            full,
-            |c: *const f16, i: usize| unsafe { _mm256_cvtph_ps(_mm_loadu_si128(c.add(i) as *const __m128i)) },
-            |x: __m256| _mm256_cvtph_ps(_mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x)),
-            |c: *mut f16, i: usize, x: __m256| unsafe {
-                _mm_storeu_si128(c.add(i) as *mut __m128i, _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x))
-            },
-            next_up16,
-            next_down16,
-            _mm256_castsi256_ps(_mm256_set1_epi32(0x7fc0_0000)), // becomes 0x7e00 in binary16
-            |x: f16| _mm256_set1_ps(x.to_f32())
-        );
-    }
-
-    /// Replaces NaN lanes by `canonical`.
-    #[target_feature(enable = "avx2")]
-    fn canon(x: __m256, canonical: __m256) -> __m256 {
-        _mm256_blendv_ps(x, canonical, _mm256_cmp_ps::<_CMP_UNORD_Q>(x, x))
-    }
-
-    #[target_feature(enable = "avx2")]
-    pub(super) fn rti_f32(
-        rti: &Rti<Ieee<F32Native>>,
-        rays: &RaysSoa<f32>,
-        tris: &TrisSoa<f32>,
-        out: &mut HitsSoa<f32>,
-        full: usize,
-    ) {
-        let nan = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fc0_0000));
-        // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
-        rti_kernel!(
-            rti,
-            rays,
-            tris,
-            out,
-            full,
-            |c: &Vec<f32>, i: usize| unsafe { _mm256_loadu_ps(c.as_ptr().add(i)) },
-            |x: __m256| x,
-            |c: &mut Vec<f32>, i: usize, x: __m256| unsafe { _mm256_storeu_ps(c.as_mut_ptr().add(i), x) },
-            rti.det_thr,
-            nan
-        );
-    }
-
-    #[target_feature(enable = "avx2,f16c")]
-    pub(super) fn rti_f16(
-        rti: &Rti<Ieee<F16Half>>,
-        rays: &RaysSoa<f16>,
-        tris: &TrisSoa<f16>,
-        out: &mut HitsSoa<f16>,
-        full: usize,
-    ) {
-        let nan = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fc0_0000)); // becomes 0x7e00 in binary16
-                                                                       // SAFETY (loads and stores): the caller checked that every column holds `full` lanes;
-                                                                       // f16 is a 2-byte plain value.
-        rti_kernel!(
-            rti,
-            rays,
-            tris,
-            out,
-            full,
-            |c: &Vec<f16>, i: usize| unsafe { _mm256_cvtph_ps(_mm_loadu_si128(c.as_ptr().add(i) as *const __m128i)) },
-            |x: __m256| _mm256_cvtph_ps(_mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x)),
-            |c: &mut Vec<f16>, i: usize, x: __m256| unsafe {
-                _mm_storeu_si128(c.as_mut_ptr().add(i) as *mut __m128i, _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x))
-            },
-            rti.det_thr.to_f32(),
-            nan
-        );
-    }
+    kernels_for!(v8, "avx2", "avx2,f16c");
+    kernels_for!(v16, "avx512f", "avx512f,avx2");
 }

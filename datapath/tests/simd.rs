@@ -3,7 +3,7 @@
 use datapath::format::{DivMode, F16Half, F32Native, FpOpts, Ieee, NanMode, Subnormals};
 use datapath::rng::SplitMix64;
 use datapath::rti::{Cull, HitsSoa, RaysSoa, Rti, RtiConfig, TieRule, TrisSoa};
-use datapath::simd::{kernel_f16, kernel_f32, rti_batch_f16, rti_batch_f32, Kernel};
+use datapath::simd::{kernel_f16, kernel_f32, kernels_here, rti_batch_f16, rti_batch_f32, with_kernel_cap, Kernel};
 use datapath::Format;
 use proptest::prelude::*;
 
@@ -68,30 +68,80 @@ fn config(cull: bool, thr: f64) -> RtiConfig {
     RtiConfig { cull: if cull { Cull::Backface } else { Cull::TwoSided }, det_threshold: thr, tie: TieRule::First }
 }
 
+/// Runs `batch` on every kernel this machine has (each under a cap, checking that the cap's
+/// kernel is the one that ran) and compares it with the scalar model's bits.
+fn on_every_kernel<O>(
+    scalar: &O,
+    mut batch: impl FnMut(&mut O) -> Kernel,
+    mut fresh: impl FnMut() -> O,
+    same: impl Fn(&O, &O) -> Result<(), TestCaseError>,
+) -> Result<(), TestCaseError> {
+    for k in kernels_here() {
+        let mut out = fresh();
+        let ran = with_kernel_cap(k, || batch(&mut out));
+        prop_assert_eq!(ran, k);
+        same(scalar, &out)?;
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
     #[test]
-    fn f32_kernel_matches_the_scalar_model(seed in any::<u64>(), n in 0usize..200, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-6), Just(0.5)]) {
+    fn f32_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-6), Just(0.5)]) {
         let f = Ieee::new(F32Native, FpOpts { div: if divide { DivMode::Divide } else { DivMode::RecipMul }, ..FpOpts::default() });
         let rti = Rti::new(f, config(cull, thr));
         let (rays, tris) = columns(&f, n, seed, &F32_SPECIALS);
-        let (mut a, mut b) = (HitsSoa::with_len(n), HitsSoa::with_len(n));
+        let mut a = HitsSoa::with_len(n);
         rti.batch(&rays, &tris, &mut a);
-        rti_batch_f32(&rti, &rays, &tris, &mut b);
-        same(&f, &a, &b)?;
+        on_every_kernel(&a, |b| rti_batch_f32(&rti, &rays, &tris, b), || HitsSoa::with_len(n), |a, b| same(&f, a, b))?;
     }
 
     #[test]
-    fn f16_kernel_matches_the_scalar_model(seed in any::<u64>(), n in 0usize..200, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-3), Just(0.5)]) {
+    fn f16_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-3), Just(0.5)]) {
         let f = Ieee::new(F16Half, FpOpts { div: if divide { DivMode::Divide } else { DivMode::RecipMul }, ..FpOpts::default() });
         let rti = Rti::new(f, config(cull, thr));
         let (rays, tris) = columns(&f, n, seed, &F16_SPECIALS);
-        let (mut a, mut b) = (HitsSoa::with_len(n), HitsSoa::with_len(n));
+        let mut a = HitsSoa::with_len(n);
         rti.batch(&rays, &tris, &mut a);
-        rti_batch_f16(&rti, &rays, &tris, &mut b);
-        same(&f, &a, &b)?;
+        on_every_kernel(&a, |b| rti_batch_f16(&rti, &rays, &tris, b), || HitsSoa::with_len(n), |a, b| same(&f, a, b))?;
     }
+}
+
+#[test]
+fn the_kernels_here_are_the_ones_the_machine_has_and_a_cap_is_restored() {
+    let k = kernels_here();
+    assert_eq!(k[0], Kernel::Scalar);
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::is_x86_feature_detected as has;
+        assert_eq!(k.contains(&Kernel::Avx2), has!("avx2") && has!("f16c"));
+        assert_eq!(k.contains(&Kernel::Avx512), has!("avx512f") && has!("avx2") && has!("f16c"));
+    }
+    // `RAYPIPE_EXPECT_KERNEL=avx512` (set by `emu/avx512`, which runs these tests under
+    // an emulator) makes
+    // a machine without the kernel a failure instead of a silent skip
+    if let Ok(want) = std::env::var("RAYPIPE_EXPECT_KERNEL") {
+        let want = match want.as_str() {
+            "avx2" => Kernel::Avx2,
+            "avx512" => Kernel::Avx512,
+            other => panic!("unknown kernel {other:?}"),
+        };
+        assert!(k.contains(&want), "{want:?} expected, this machine has {k:?}");
+    }
+    let f = Ieee::new(F32Native, FpOpts::default());
+    let rti = Rti::new(f, RtiConfig::default());
+    let best = *k.last().unwrap();
+    assert_eq!(kernel_f32(&rti), best);
+    assert_eq!(with_kernel_cap(Kernel::Scalar, || kernel_f32(&rti)), Kernel::Scalar);
+    // nested caps, and a cap left by a panic, are undone
+    with_kernel_cap(Kernel::Avx2, || {
+        assert_eq!(with_kernel_cap(Kernel::Scalar, || kernel_f32(&rti)), Kernel::Scalar);
+        assert_eq!(kernel_f32(&rti), best.min(Kernel::Avx2));
+    });
+    assert!(std::panic::catch_unwind(|| with_kernel_cap(Kernel::Scalar, || panic!("inside"))).is_err());
+    assert_eq!(kernel_f32(&rti), best);
 }
 
 #[test]
@@ -100,10 +150,9 @@ fn the_kernels_run_where_the_machine_has_them_and_hit_often_enough_to_matter() {
     let f16f = Ieee::new(F16Half, FpOpts::default());
     #[cfg(target_arch = "x86_64")]
     {
-        let avx2 = std::arch::is_x86_feature_detected!("avx2");
-        let f16c = std::arch::is_x86_feature_detected!("f16c");
-        assert_eq!(kernel_f32(&Rti::new(f32f, RtiConfig::default())) == Kernel::Avx2, avx2);
-        assert_eq!(kernel_f16(&Rti::new(f16f, RtiConfig::default())) == Kernel::Avx2, avx2 && f16c);
+        let best = *kernels_here().last().unwrap();
+        assert_eq!(kernel_f32(&Rti::new(f32f, RtiConfig::default())), best);
+        assert_eq!(kernel_f16(&Rti::new(f16f, RtiConfig::default())), best);
     }
     // formats the kernels do not model fall back to the scalar model
     let ftz = Ieee::new(F32Native, FpOpts { subnormals: Subnormals::Ftz, ..FpOpts::default() });
@@ -211,15 +260,14 @@ mod slab {
     {
         let s = Slab::new(f, SlabConfig::named(variant).unwrap());
         let (rays, boxes) = batch(&s, seed, n);
-        let (mut a, mut b) = (SlabOutSoa::with_len(n), SlabOutSoa::with_len(n));
+        let mut a = SlabOutSoa::with_len(n);
         s.batch(&rays, &boxes, &mut a);
-        pairs(&s, &rays, &boxes, &mut b);
-        same(&f, &a, &b)?;
+        let fresh = || SlabOutSoa::with_len(n);
+        on_every_kernel(&a, |b| pairs(&s, &rays, &boxes, b), fresh, |a, b| same(&f, a, b))?;
         if n > 0 {
             let ray = rays.get(seed as usize % n);
             s.batch_ray(&ray, &boxes, &mut a);
-            one(&s, &ray, &boxes, &mut b);
-            same(&f, &a, &b)?;
+            on_every_kernel(&a, |b| one(&s, &ray, &boxes, b), fresh, |a, b| same(&f, a, b))?;
         }
         Ok(())
     }
@@ -230,12 +278,12 @@ mod slab {
         #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
         #[test]
-        fn f32_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..200, v in 0usize..4) {
+        fn f32_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..4) {
             check(Ieee::new(F32Native, FpOpts::default()), VARIANTS[v], seed, n, slab_batch_f32, slab_ray_f32)?;
         }
 
         #[test]
-        fn f16_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..200, v in 0usize..4) {
+        fn f16_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..4) {
             check(Ieee::new(F16Half, FpOpts::default()), VARIANTS[v], seed, n, slab_batch_f16, slab_ray_f16)?;
         }
     }
@@ -244,14 +292,10 @@ mod slab {
     fn the_slab_kernels_run_and_the_directed_variant_stays_scalar() {
         let f = Ieee::new(F32Native, FpOpts::default());
         let h = Ieee::new(F16Half, FpOpts::default());
-        #[cfg(target_arch = "x86_64")]
-        {
-            let avx2 = std::arch::is_x86_feature_detected!("avx2");
-            let f16c = std::arch::is_x86_feature_detected!("f16c");
-            let named = |v| SlabConfig::named(v).unwrap();
-            assert_eq!(slab_kernel_f32(&Slab::new(f, named("conservative"))) == Kernel::Avx2, avx2);
-            assert_eq!(slab_kernel_f16(&Slab::new(h, named("conservative"))) == Kernel::Avx2, avx2 && f16c);
-        }
+        let best = *kernels_here().last().unwrap();
+        let named = |v| SlabConfig::named(v).unwrap();
+        assert_eq!(slab_kernel_f32(&Slab::new(f, named("conservative"))), best);
+        assert_eq!(slab_kernel_f16(&Slab::new(h, named("conservative"))), best);
         let directed = SlabConfig::named("directed").unwrap();
         assert_eq!(slab_kernel_f32(&Slab::new(f, directed)), Kernel::Scalar);
         assert_eq!(slab_kernel_f16(&Slab::new(h, directed)), Kernel::Scalar);
@@ -323,10 +367,7 @@ mod generic {
     /// model otherwise, with the scalar model's bits either way.
     #[test]
     fn the_generic_dispatch_picks_the_kernel_by_format() {
-        #[cfg(target_arch = "x86_64")]
-        let simd = std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("f16c");
-        #[cfg(not(target_arch = "x86_64"))]
-        let simd = false;
+        let best = *kernels_here().last().unwrap();
         for name in ["f32", "fp16", "bf16", "q8.24:divide"] {
             let any: AnyFormat = name.parse().unwrap();
             with_format!(any, |f| {
@@ -337,8 +378,8 @@ mod generic {
                 rti.batch(&rays, &tris, &mut a);
                 let k = rti_batch(&rti, &rays, &tris, &mut b);
                 same(&f, &a, &b).unwrap();
-                let expect_simd = simd && (name == "f32" || name == "fp16");
-                assert_eq!(k == Kernel::Avx2, expect_simd, "{name}");
+                let expect = if name == "f32" || name == "fp16" { best } else { Kernel::Scalar };
+                assert_eq!(k, expect, "{name}");
                 let s = Slab::new(f, SlabConfig::named("conservative").unwrap());
                 let (mut sr, mut sb) = (SlabRaysSoa::default(), datapath::slab::BoxesSoa::default());
                 for i in 0..77 {
@@ -352,7 +393,7 @@ mod generic {
                 s.batch(&sr, &sb, &mut x);
                 let k = slab_batch(&s, &sr, &sb, &mut y);
                 assert_eq!(x.hit, y.hit);
-                assert_eq!(k == Kernel::Avx2, expect_simd, "{name}");
+                assert_eq!(k, expect, "{name}");
             });
         }
     }
