@@ -479,6 +479,29 @@ mod isa {
         _mm256_blendv_epi8(r, b, keep)
     }
 
+    /// The binary operations and compares of an ISA table: `name = intrinsic` (for compares,
+    /// `name = intrinsic::<predicate>`), each a one-instruction function.
+    macro_rules! table_ops {
+        ($feat:literal, $v:ty, $m:ty; $($(#[$doc:meta])* $name:ident = $intr:ident;)* ; $($(#[$cdoc:meta])* $cname:ident = $cmp:ident::<$pred:ident>;)*) => {
+            $(
+                $(#[$doc])*
+                #[inline]
+                #[target_feature(enable = $feat)]
+                pub fn $name(a: $v, b: $v) -> $v {
+                    $intr(a, b)
+                }
+            )*
+            $(
+                $(#[$cdoc])*
+                #[inline]
+                #[target_feature(enable = $feat)]
+                pub fn $cname(a: $v, b: $v) -> $m {
+                    $cmp::<$pred>(a, b)
+                }
+            )*
+        };
+    }
+
     /// AVX2 (+ F16C for binary16): 8 lanes, a mask is a vector of all-ones / all-zeros lanes.
     pub(super) mod v8 {
         use half::f16;
@@ -487,69 +510,46 @@ mod isa {
         pub const LANES: usize = 8;
         /// A mask.
         pub type M = __m256;
+        table_ops!("avx2", __m256, M;
+            /// a + b, rounded to binary32.
+            add = _mm256_add_ps;
+            /// a − b, rounded to binary32.
+            sub = _mm256_sub_ps;
+            /// a × b, rounded to binary32.
+            mul = _mm256_mul_ps;
+            /// a ÷ b, rounded to binary32.
+            div = _mm256_div_ps;
+            /// `a > b ? a : b` (vmaxps: the second operand on NaN or equality).
+            max = _mm256_max_ps;
+            /// `a < b ? a : b` (vminps).
+            min = _mm256_min_ps;
+            ;
+            /// Lanes where a ≤ b (false on NaN).
+            le = _mm256_cmp_ps::<_CMP_LE_OQ>;
+            /// Lanes where a < b (false on NaN).
+            lt = _mm256_cmp_ps::<_CMP_LT_OQ>;
+            /// Lanes where a or b is NaN.
+            unord = _mm256_cmp_ps::<_CMP_UNORD_Q>;
+        );
+        /// Every lane x.
         #[inline]
         #[target_feature(enable = "avx2")]
         pub fn splat(x: f32) -> __m256 {
             _mm256_set1_ps(x)
         }
+        /// Every lane the binary32 with these bits.
         #[inline]
         #[target_feature(enable = "avx2")]
         pub fn splat_bits(x: u32) -> __m256 {
             _mm256_castsi256_ps(_mm256_set1_epi32(x as i32))
         }
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn add(a: __m256, b: __m256) -> __m256 {
-            _mm256_add_ps(a, b)
-        }
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn sub(a: __m256, b: __m256) -> __m256 {
-            _mm256_sub_ps(a, b)
-        }
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn mul(a: __m256, b: __m256) -> __m256 {
-            _mm256_mul_ps(a, b)
-        }
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn div(a: __m256, b: __m256) -> __m256 {
-            _mm256_div_ps(a, b)
-        }
-        /// `a > b ? a : b` (vmaxps: the second operand on NaN or equality).
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn max(a: __m256, b: __m256) -> __m256 {
-            _mm256_max_ps(a, b)
-        }
-        /// `a < b ? a : b` (vminps).
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn min(a: __m256, b: __m256) -> __m256 {
-            _mm256_min_ps(a, b)
-        }
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn le(a: __m256, b: __m256) -> M {
-            _mm256_cmp_ps::<_CMP_LE_OQ>(a, b)
-        }
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn lt(a: __m256, b: __m256) -> M {
-            _mm256_cmp_ps::<_CMP_LT_OQ>(a, b)
-        }
-        /// Lanes where a or b is NaN.
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn unord(a: __m256, b: __m256) -> M {
-            _mm256_cmp_ps::<_CMP_UNORD_Q>(a, b)
-        }
+        /// Both masks.
         #[inline]
         #[target_feature(enable = "avx2")]
         pub fn and_m(a: M, b: M) -> M {
             _mm256_and_ps(a, b)
         }
+        /// Either mask.
         #[inline]
         #[target_feature(enable = "avx2")]
         pub fn or_m(a: M, b: M) -> M {
@@ -585,6 +585,7 @@ mod isa {
         pub fn abs(x: __m256) -> __m256 {
             _mm256_andnot_ps(_mm256_set1_ps(-0.0), x)
         }
+        /// a ⊕ b, bitwise.
         #[inline]
         #[target_feature(enable = "avx2")]
         pub fn xor(a: __m256, b: __m256) -> __m256 {
@@ -671,71 +672,48 @@ mod isa {
         pub const LANES: usize = 16;
         /// A mask.
         pub type M = __mmask16;
+        table_ops!("avx512f", __m512, M;
+            /// a + b, rounded to binary32.
+            add = _mm512_add_ps;
+            /// a − b, rounded to binary32.
+            sub = _mm512_sub_ps;
+            /// a × b, rounded to binary32.
+            mul = _mm512_mul_ps;
+            /// a ÷ b, rounded to binary32.
+            div = _mm512_div_ps;
+            /// `a > b ? a : b` (vmaxps: the second operand on NaN or equality).
+            max = _mm512_max_ps;
+            /// `a < b ? a : b` (vminps).
+            min = _mm512_min_ps;
+            ;
+            /// Lanes where a ≤ b (false on NaN).
+            le = _mm512_cmp_ps_mask::<_CMP_LE_OQ>;
+            /// Lanes where a < b (false on NaN).
+            lt = _mm512_cmp_ps_mask::<_CMP_LT_OQ>;
+            /// Lanes where a or b is NaN.
+            unord = _mm512_cmp_ps_mask::<_CMP_UNORD_Q>;
+        );
         /// vcvtps2ph: round to nearest even, exceptions suppressed (flags are not modelled).
         const NEAREST: i32 = _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC;
+        /// Every lane x.
         #[inline]
         #[target_feature(enable = "avx512f")]
         pub fn splat(x: f32) -> __m512 {
             _mm512_set1_ps(x)
         }
+        /// Every lane the binary32 with these bits.
         #[inline]
         #[target_feature(enable = "avx512f")]
         pub fn splat_bits(x: u32) -> __m512 {
             _mm512_castsi512_ps(_mm512_set1_epi32(x as i32))
         }
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn add(a: __m512, b: __m512) -> __m512 {
-            _mm512_add_ps(a, b)
-        }
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn sub(a: __m512, b: __m512) -> __m512 {
-            _mm512_sub_ps(a, b)
-        }
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn mul(a: __m512, b: __m512) -> __m512 {
-            _mm512_mul_ps(a, b)
-        }
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn div(a: __m512, b: __m512) -> __m512 {
-            _mm512_div_ps(a, b)
-        }
-        /// `a > b ? a : b` (vmaxps: the second operand on NaN or equality).
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn max(a: __m512, b: __m512) -> __m512 {
-            _mm512_max_ps(a, b)
-        }
-        /// `a < b ? a : b` (vminps).
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn min(a: __m512, b: __m512) -> __m512 {
-            _mm512_min_ps(a, b)
-        }
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn le(a: __m512, b: __m512) -> M {
-            _mm512_cmp_ps_mask::<_CMP_LE_OQ>(a, b)
-        }
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn lt(a: __m512, b: __m512) -> M {
-            _mm512_cmp_ps_mask::<_CMP_LT_OQ>(a, b)
-        }
-        /// Lanes where a or b is NaN.
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn unord(a: __m512, b: __m512) -> M {
-            _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(a, b)
-        }
+        /// Both masks.
         #[inline]
         #[target_feature(enable = "avx512f")]
         pub fn and_m(a: M, b: M) -> M {
             a & b
         }
+        /// Either mask.
         #[inline]
         #[target_feature(enable = "avx512f")]
         pub fn or_m(a: M, b: M) -> M {
@@ -772,6 +750,7 @@ mod isa {
         pub fn abs(x: __m512) -> __m512 {
             _mm512_castsi512_ps(_mm512_and_si512(_mm512_castps_si512(x), _mm512_set1_epi32(i32::MAX)))
         }
+        /// a ⊕ b, bitwise.
         #[inline]
         #[target_feature(enable = "avx512f")]
         pub fn xor(a: __m512, b: __m512) -> __m512 {
