@@ -33,13 +33,19 @@ fn bench_slab(c: &mut Criterion) {
                 }
                 let mut out = SlabOutSoa::with_len(N);
                 let id = format!("{}/{v}", f.name());
-                g.bench_function(BenchmarkId::new("fastest_pairs", &id), |b| {
-                    b.iter(|| datapath::simd::slab_batch(&s, black_box(&rs), black_box(&bs), &mut out))
-                });
+                // the fastest path on every kernel this machine has, each under its cap (the
+                // directed variant and other formats run the scalar model whatever the cap)
                 let ray = rs.get(0);
-                g.bench_function(BenchmarkId::new("fastest_one_ray", &id), |b| {
-                    b.iter(|| datapath::simd::slab_ray(&s, black_box(&ray), black_box(&bs), &mut out))
-                });
+                for k in datapath::simd::kernels_here().into_iter().filter(|&k| k != datapath::simd::Kernel::Scalar) {
+                    datapath::simd::with_kernel_cap(k, || {
+                        g.bench_function(BenchmarkId::new(format!("fastest_pairs_{k:?}"), &id), |b| {
+                            b.iter(|| datapath::simd::slab_batch(&s, black_box(&rs), black_box(&bs), &mut out))
+                        });
+                        g.bench_function(BenchmarkId::new(format!("fastest_one_ray_{k:?}"), &id), |b| {
+                            b.iter(|| datapath::simd::slab_ray(&s, black_box(&ray), black_box(&bs), &mut out))
+                        });
+                    });
+                }
                 g.bench_function(BenchmarkId::new("scalar_pairs", &id), |b| {
                     b.iter(|| s.batch(black_box(&rs), black_box(&bs), &mut out))
                 });

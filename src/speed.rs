@@ -208,6 +208,17 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         k[1] = rti_batch_f16(&r16, &rays16, &tris16, &mut o16)
     }));
     push(row("rti fp16 scalar model", pairs, RTI_OPS, 3, || r16.batch(&rays16, &tris16, &mut o16)));
+    // on a machine with AVX-512, the AVX2 kernels too (against the same, AVX-512, peak)
+    if datapath::simd::kernels_here().contains(&Kernel::Avx512) {
+        datapath::simd::with_kernel_cap(Kernel::Avx2, || {
+            push(row("rti f32 kernel (AVX2, capped)", pairs, RTI_OPS, 7, || {
+                rti_batch_f32(&r32, &rays32, &tris32, &mut o32);
+            }));
+            push(row("rti fp16 kernel (AVX2, capped)", pairs, RTI_OPS, 7, || {
+                rti_batch_f16(&r16, &rays16, &tris16, &mut o16);
+            }));
+        });
+    }
     let c16: Vec<([half::f16; 6], [half::f16; 9])> = cases
         .iter()
         .map(|(r, t)| {
