@@ -66,18 +66,23 @@ pub fn with_kernel_cap<R>(cap: Kernel, f: impl FnOnce() -> R) -> R {
 
 /// The kernels this machine can run, narrowest first (`Scalar` always).
 pub fn kernels_here() -> Vec<Kernel> {
-    let mut k = vec![Kernel::Scalar];
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::is_x86_feature_detected as has;
-        if has!("avx2") && has!("f16c") {
-            k.push(Kernel::Avx2);
+    [Kernel::Scalar, Kernel::Avx2, Kernel::Avx512].into_iter().filter(|&k| k <= widest_here()).collect()
+}
+
+/// The widest kernel this machine can run, detected once.
+fn widest_here() -> Kernel {
+    static WIDEST: std::sync::OnceLock<Kernel> = std::sync::OnceLock::new();
+    *WIDEST.get_or_init(|| {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::is_x86_feature_detected as has;
+            if has!("avx2") && has!("f16c") {
+                // the AVX-512 kernels use AVX2 for the binary16 step
+                return if has!("avx512f") { Kernel::Avx512 } else { Kernel::Avx2 };
+            }
         }
-        if has!("avx512f") && has!("avx2") && has!("f16c") {
-            k.push(Kernel::Avx512);
-        }
-    }
-    k
+        Kernel::Scalar
+    })
 }
 
 /// The kernels model this binary32 / binary16 format: IEEE subnormals and canonical NaN.
@@ -87,9 +92,8 @@ fn eligible<B: crate::format::IeeeBackend>(f: &Ieee<B>) -> bool {
 
 /// The widest kernel this machine has within this thread's cap, if `eligible`.
 fn best_kernel(eligible: bool) -> Kernel {
-    let cap = CAP.with(|c| c.get());
     match eligible {
-        true => kernels_here().into_iter().filter(|&k| k <= cap).max().unwrap_or(Kernel::Scalar),
+        true => widest_here().min(CAP.with(|c| c.get())),
         false => Kernel::Scalar,
     }
 }
