@@ -453,3 +453,20 @@ fn verify_and_vectors_follow_a_plan() {
     let bad = temp_file("bad.json", "{}");
     assert_clear_error(&raypipe(&["verify", "--plan", bad.to_str().unwrap()]), "not a plan");
 }
+
+#[test]
+fn speed_fractions_are_each_rows_rate_over_the_one_peak_it_prints() {
+    let o = raypipe(&["speed", "--pairs", "64", "--json"]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let peak = v["peak_gops"].as_f64().unwrap() * 1e9;
+    let rows = v["rows"].as_array().unwrap();
+    assert!(rows.len() >= 10 && peak > 0.0);
+    for r in rows {
+        let (m, ops, frac) =
+            (r["mtests_per_s"].as_f64().unwrap(), r["ops"].as_f64().unwrap(), r["fraction_of_peak"].as_f64().unwrap());
+        let want = m * 1e6 * ops / peak;
+        assert!((frac - want).abs() <= 1e-9 * want.max(1e-12), "{r}");
+        assert!(frac > 0.0 && frac < 1.5, "{r}");
+    }
+}

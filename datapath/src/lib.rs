@@ -1,4 +1,4 @@
-//! Bit-accurate models of ray-tracing hardware datapaths: number formats ([`format`]), the
+//! Bit-accurate models of ray-tracing hardware datapaths: number formats ([`format`](mod@format)), the
 //! latency-reordered Möller–Trumbore ray–triangle pipeline ([`rti`]) with per-stage probes
 //! ([`probe`]), and its error bounds ([`bound`]).
 #![warn(missing_docs)]

@@ -2,7 +2,7 @@
 //! runtime dispatch.
 //!
 //! One kernel body per unit (the `rti_kernel!` and `slab_kernel!` macros), written in the
-//! operations of an [`isa`] module, is instantiated for binary32 and binary16 on AVX2 (+ F16C
+//! operations of an `isa` module, is instantiated for binary32 and binary16 on AVX2 (+ F16C
 //! for binary16; 8 tests per vector) and on AVX-512F (16 tests per vector), in the stage
 //! table's exact operation order with separate multiplies and adds (no FMA). binary16 computes
 //! every operation in binary32 and rounds it to binary16 at once (`vcvtps2ph` nearest-even,
