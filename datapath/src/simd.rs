@@ -9,8 +9,12 @@
 //! then back): binary32's 24 bits are at least 2·11 + 2, so this double rounding is innocuous
 //! for + − × ÷ and the result is the correctly rounded binary16 operation, subnormals and
 //! overflow included; compares and min/max of binary16 values held in binary32 are exact.
-//! NaN payloads never influence a non-NaN result or a compare, so the kernels canonicalise NaN
-//! only where a value leaves them, and only when a mask shows a NaN lane.
+//! NaN payloads never influence a non-NaN result or a compare, so the RTI kernels canonicalise
+//! NaN only where a value leaves them (every RTI output is arithmetic), and only when a mask
+//! shows a NaN lane. A slab output NaN may be arithmetic (canonical in the model) or a NaN t
+//! interval passed through the comparators with its payload, so a slab vector with a NaN lane
+//! is done again by the scalar model; a one-ray batch with the plain comparator and a number
+//! interval cannot make one and skips the check.
 //!
 //! The slab kernels take either pairs (ray i against box i) or one ray against every box (a
 //! node's children, a level): the second reads only the six box columns and picks each axis's
@@ -970,6 +974,7 @@ mod kernels {
                 $r.inv_d.each_ref().map(|c| c.as_ptr()),
                 $r.tmin.as_ptr(),
                 $r.tmax.as_ptr(),
+                true, // a lane's t interval may be NaN
             )
         };
         (@prep one $r:ident, $bmin:ident, $bmax:ident, $bcast:ident) => {{
@@ -979,6 +984,7 @@ mod kernels {
                 std::array::from_fn::<_, 3, _>(|a| if neg[a] { $bmin[a] } else { $bmax[a] }),
                 ($r.o.map($bcast), $r.inv_d.map($bcast)),
                 ($bcast($r.tmin), $bcast($r.tmax)),
+                $r.tmin.is_nan() || $r.tmax.is_nan(),
             )
         }};
         // axis a of lanes i..i + L: (near-plane t, far-plane t)
@@ -996,6 +1002,13 @@ mod kernels {
                 $rd($x::mul($rd($x::sub($load($prep.1[$a], $i), o)), inv)),
             )
         }};
+        // the batch's rays again, for the scalar model
+        (@rays pairs $r:ident) => {
+            SlabRays::Pairs($r)
+        };
+        (@rays one $r:ident) => {
+            SlabRays::One($r)
+        };
         // the t interval the chains start from
         (@limits pairs $prep:ident, $load:ident, $i:ident) => {
             ($load($prep.2, $i), $load($prep.3, $i))
@@ -1009,13 +1022,20 @@ mod kernels {
             // next-down is next-up mirrored through the sign (negation is exact)
             let neg = |v| $x::xor(v, $x::splat(-0.0));
             let down = |v| neg(up(neg(v)));
-            let nan = $x::splat_bits(0x7fc0_0000);
             let bmin = boxes.min.each_ref().map(|c| c.as_ptr());
             let bmax = boxes.max.each_ref().map(|c| c.as_ptr());
             let prep = slab_kernel!(@prep $shape $r, bmin, bmax, bcast);
             let _ = bcast; // the pairs shape broadcasts nothing
             let (o_hit, o_near, o_far) = (out.hit.as_mut_ptr(), out.t_near.as_mut_ptr(), out.t_far.as_mut_ptr());
             let widen = s.cfg.widen_ulps;
+            // vmaxps / vminps return their second operand (the running t) when either is NaN,
+            // and the widening steps keep a number a number, so the plain comparator's chains
+            // end in NaN only if they start from a NaN t interval: a one-ray batch with a
+            // number interval needs no NaN check per vector (take-on-false chains can take a
+            // NaN plane and always check)
+            let check_nan = $tof || prep.4;
+            let (r, model) = ($r, s);
+            let mut nan_seen = 0;
             let mut i = 0;
             while i < $full {
                 let (mut tn, mut tf) = slab_kernel!(@limits $shape prep, load, i);
@@ -1047,18 +1067,55 @@ mod kernels {
                 }
                 // SAFETY: lanes i..i + L are in bounds.
                 unsafe { $x::flags(o_hit, i, $x::le(tn, tf)) };
-                // NaN lanes are rare: canonicalise only when a mask shows one
-                let (tn, tf) = if $x::bits($x::unord(tn, tf)) == 0 {
-                    (tn, tf)
-                } else {
-                    let canon = |x| $x::blend(x, nan, $x::unord(x, x));
-                    (canon(tn), canon(tf))
-                };
                 store(o_near, i, tn);
                 store(o_far, i, tf);
+                // NaN lanes are rare, and their bits depend on where the NaN came from (the
+                // model canonicalises an arithmetic NaN but passes a NaN t interval through a
+                // comparator as it is, payload and all, which binary16's widening would quiet):
+                // noted here, done again by the scalar model after the loop
+                if check_nan {
+                    nan_seen |= $x::bits($x::unord(tn, tf));
+                }
                 i += $x::LANES;
             }
+            if nan_seen != 0 {
+                // SAFETY: lanes 0..full are in bounds (as above).
+                unsafe { slab_redo(model, slab_kernel!(@rays $shape r), boxes, (o_hit, o_near, o_far), $full) };
+            }
         }};
+    }
+
+    /// The lanes of `0..full` with a NaN output, again by the scalar model (the slab kernels'
+    /// rare NaN path, kept out of their loops).
+    ///
+    /// # Safety
+    /// The output pointers must be valid for lanes `0..full`.
+    #[cold]
+    #[inline(never)]
+    pub(super) unsafe fn slab_redo<F: crate::Format>(
+        s: &Slab<F>,
+        rays: SlabRays<F::V>,
+        boxes: &BoxesSoa<F::V>,
+        (hit, near, far): (*mut bool, *mut F::V, *mut F::V),
+        full: usize,
+    ) {
+        for k in 0..full {
+            // SAFETY: k is in bounds (the caller).
+            let nan = unsafe { s.fmt.is_nan(*near.add(k)) || s.fmt.is_nan(*far.add(k)) };
+            if nan {
+                let ray = match rays {
+                    SlabRays::Pairs(r) => r.get(k),
+                    SlabRays::One(r) => *r,
+                };
+                let o = s.test(&ray, &boxes.get(k));
+                // SAFETY: as above.
+                unsafe {
+                    *hit.add(k) = o.hit;
+                    *near.add(k) = o.t_near;
+                    *far.add(k) = o.t_far;
+                }
+            }
+        }
     }
 
     /// The four kernels (RTI and slab, binary32 and binary16) of one instruction set.
