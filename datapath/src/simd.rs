@@ -12,9 +12,9 @@
 //! NaN payloads never influence a non-NaN result or a compare, so the RTI kernels canonicalise
 //! NaN only where a value leaves them (every RTI output is arithmetic), and only when a mask
 //! shows a NaN lane. A slab output NaN may be arithmetic (canonical in the model) or a NaN t
-//! interval passed through the comparators with its payload, so a slab vector with a NaN lane
-//! is done again by the scalar model; a one-ray batch with the plain comparator and a number
-//! interval cannot make one and skips the check.
+//! interval passed through the comparators with its payload, so the scalar model redoes a
+//! slab batch's NaN lanes after the loop; a one-ray batch with the plain comparator and a
+//! number interval cannot make one and skips the check.
 //!
 //! The slab kernels take either pairs (ray i against box i) or one ray against every box (a
 //! node's children, a level): the second reads only the six box columns and picks each axis's
