@@ -28,6 +28,9 @@ pub struct SpeedRow {
     pub mtests_per_s: f64,
     /// Floating-point ops per test.
     pub ops: f64,
+    /// The peak the fraction is taken against: "binary32", or "binary16" (the AVX512-FP16
+    /// peak, for binary16 rows on a machine that has it).
+    pub peak: String,
     /// Throughput × ops / the peak of its precision.
     pub fraction_of_peak: f64,
 }
@@ -43,6 +46,8 @@ pub struct SpeedReport {
     pub kernels: [String; 2],
     /// Measured no-FMA peak, giga lane-ops per second (binary32, widest vector unit found).
     pub peak_gops: f64,
+    /// Measured no-FMA binary16 peak (AVX512-FP16 `vaddph` / `vmulph`), where the machine has it.
+    pub peak16_gops: Option<f64>,
     /// Rows.
     pub rows: Vec<SpeedRow>,
 }
@@ -63,6 +68,17 @@ fn peak(secs: f64) -> f64 {
         }
     }
     peak_scalar(secs)
+}
+
+/// The binary16 no-FMA peak on AVX512-FP16, where the machine has it: lane-ops per second.
+fn peak16(secs: f64) -> Option<f64> {
+    #[cfg(target_arch = "x86_64")]
+    if datapath::simd::kernels_here().contains(&Kernel::Avx512Fp16) {
+        // SAFETY: AVX512-FP16 (with AVX-512F and BW) detected.
+        return Some(unsafe { peak_avx512fp16(secs) });
+    }
+    let _ = secs;
+    None
 }
 
 /// Runs `burst` (which performs `per_burst` operations) repeatedly for about `secs`: operations per second.
@@ -120,6 +136,15 @@ macro_rules! peak_simd {
 
 peak_simd!(peak_avx2, "avx2", _mm256_set1_ps, _mm256_add_ps, _mm256_mul_ps, 8);
 peak_simd!(peak_avx512, "avx512f", _mm512_set1_ps, _mm512_add_ps, _mm512_mul_ps, 16);
+peak_simd!(peak_avx512fp16, "avx512fp16,avx512bw,avx512f", set1_ph, _mm512_add_ph, _mm512_mul_ph, 32);
+
+/// Every binary16 lane x (a binary32 value rounded by `half`): the peak loop's constants.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+fn set1_ph(x: f32) -> std::arch::x86_64::__m512h {
+    use std::arch::x86_64::*;
+    _mm512_castsi512_ph(_mm512_set1_epi16(half::f16::from_f32(x).to_bits() as i16))
+}
 
 /// Best of `reps` timings of `f` over `n` tests, each repeating `f` for at least 20 ms
 /// (a small working set stays in cache): million tests per second.
@@ -128,16 +153,20 @@ fn rate(n: usize, reps: usize, mut f: impl FnMut()) -> f64 {
 }
 
 /// One implementation measured beside the peak: `reps` times, a 20 ms timing of `f` between
-/// two 5 ms peak bursts, so that both are sampled across the run's clock changes. Returns the
-/// row with its best rate (its fraction of peak is set by [`speed`] against the run's best
-/// peak) and the best peak burst seen.
-fn row(name: &str, n: usize, ops: f64, reps: usize, mut f: impl FnMut()) -> (SpeedRow, f64) {
-    let (mut m, mut p) = (0.0f64, peak(0.005));
+/// two 5 ms peak bursts (binary32, and binary16 where AVX512-FP16 exists), so that both are
+/// sampled across the run's clock changes. Returns the row with its best rate (its fraction of
+/// peak is set by [`speed`] against the run's best peak of its precision) and the best peak
+/// bursts seen.
+fn row(name: &str, n: usize, ops: f64, reps: usize, mut f: impl FnMut()) -> (SpeedRow, [f64; 2]) {
+    let burst = || [peak(0.005), peak16(0.005).unwrap_or(0.0)];
+    let (mut m, mut p) = (0.0f64, burst());
     for _ in 0..reps {
         m = m.max(timed(0.02, n as u64, &mut f));
-        p = p.max(peak(0.005));
+        let q = burst();
+        p = [p[0].max(q[0]), p[1].max(q[1])];
     }
-    (SpeedRow { name: name.into(), mtests_per_s: m / 1e6, ops, fraction_of_peak: 0.0 }, p)
+    let peak = if name.contains("fp16") && p[1] > 0.0 { "binary16" } else { "binary32" };
+    (SpeedRow { name: name.into(), mtests_per_s: m / 1e6, ops, peak: peak.into(), fraction_of_peak: 0.0 }, p)
 }
 
 /// The RTI input columns of `cases` in the unit's format.
@@ -184,7 +213,7 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     }
     let mut rows = Vec::new();
     let mut peaks = Vec::new();
-    let mut push = |(row, p): (SpeedRow, f64)| {
+    let mut push = |(row, p): (SpeedRow, [f64; 2])| {
         rows.push(row);
         peaks.push(p);
     };
@@ -205,6 +234,15 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         k[1] = rti_batch_f16(&r16, &rays16, &tris16, &mut o16)
     }));
     push(row("rti fp16 scalar model", pairs, RTI_OPS, 3, || r16.batch(&rays16, &tris16, &mut o16)));
+    // on a machine with AVX512-FP16, the AVX-512F binary16 kernel too (binary16 through
+    // conversions, against the same, AVX512-FP16, peak)
+    if datapath::simd::kernels_here().contains(&Kernel::Avx512Fp16) {
+        datapath::simd::with_kernel_cap(Kernel::Avx512, || {
+            push(row("rti fp16 kernel (AVX-512F, capped)", pairs, RTI_OPS, 7, || {
+                rti_batch_f16(&r16, &rays16, &tris16, &mut o16);
+            }));
+        });
+    }
     // on a machine with AVX-512, the AVX2 kernels too (against the same, AVX-512, peak)
     if datapath::simd::kernels_here().contains(&Kernel::Avx512) {
         datapath::simd::with_kernel_cap(Kernel::Avx2, || {
@@ -297,11 +335,20 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     }
     // every fraction against the one, best, peak of the run: the best rate over the best peak
     // (a ratio taken per timing would reward a peak burst that the shared machine slowed)
-    let peak = peaks.iter().copied().fold(0.0, f64::max);
+    let peak = peaks.iter().map(|p| p[0]).fold(0.0, f64::max);
+    let peak16 = peaks.iter().map(|p| p[1]).fold(0.0, f64::max);
     for r in &mut rows {
-        r.fraction_of_peak = r.mtests_per_s * 1e6 * r.ops / peak;
+        let p = if r.peak == "binary16" { peak16 } else { peak };
+        r.fraction_of_peak = r.mtests_per_s * 1e6 * r.ops / p;
     }
-    SpeedReport { pairs, seed, kernels: k.map(|k| format!("{k:?}")), peak_gops: peak / 1e9, rows }
+    SpeedReport {
+        pairs,
+        seed,
+        kernels: k.map(|k| format!("{k:?}")),
+        peak_gops: peak / 1e9,
+        peak16_gops: (peak16 > 0.0).then_some(peak16 / 1e9),
+        rows,
+    }
 }
 
 /// Textbook Möller–Trumbore in `half`'s f16 (every operation rounded by the crate).
@@ -327,13 +374,20 @@ fn half_mt(r: &[half::f16; 6], v: &[half::f16; 9]) -> bool {
 
 /// The measurement as a markdown table.
 pub fn render(s: &SpeedReport) -> String {
+    let p16 = s.peak16_gops.map_or(String::new(), |p| format!(", {p:.1} G lane-ops/s (binary16, AVX512-FP16)"));
     let mut out = format!(
-        "raypipe speed: {} pairs (built-in scene, seed {}), one thread; kernels: f32 {}, fp16 {}; measured no-FMA peak {:.1} G lane-ops/s (binary32)\n\n",
+        "raypipe speed: {} pairs (built-in scene, seed {}), one thread; kernels: f32 {}, fp16 {}; measured no-FMA peak {:.1} G lane-ops/s (binary32){p16}\n\n",
         s.pairs, s.seed, s.kernels[0], s.kernels[1], s.peak_gops
     );
-    out += "| implementation | M tests/s | ops/test | fraction of peak |\n|---|---:|---:|---:|\n";
+    let with16 = s.peak16_gops.is_some();
+    out += if with16 {
+        "| implementation | M tests/s | ops/test | fraction of peak | peak |\n|---|---:|---:|---:|---|\n"
+    } else {
+        "| implementation | M tests/s | ops/test | fraction of peak |\n|---|---:|---:|---:|\n"
+    };
     for r in &s.rows {
-        out += &format!("| {} | {:.1} | {} | {:.3} |\n", r.name, r.mtests_per_s, r.ops, r.fraction_of_peak);
+        out += &format!("| {} | {:.1} | {} | {:.3} |", r.name, r.mtests_per_s, r.ops, r.fraction_of_peak);
+        out += &if with16 { format!(" {} |\n", r.peak) } else { "\n".into() };
     }
     out
 }

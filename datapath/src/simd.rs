@@ -48,11 +48,13 @@ pub enum Kernel {
     Avx2,
     /// AVX-512F (binary32 and binary16, the latter through its conversions), 16 lanes.
     Avx512,
+    /// AVX512-FP16: binary16 arithmetic natively, 32 lanes (binary32 runs its AVX-512F kernel).
+    Avx512Fp16,
 }
 
 thread_local! {
     /// The widest kernel this thread's dispatch may choose.
-    static CAP: std::cell::Cell<Kernel> = const { std::cell::Cell::new(Kernel::Avx512) };
+    static CAP: std::cell::Cell<Kernel> = const { std::cell::Cell::new(Kernel::Avx512Fp16) };
 }
 
 /// Runs `f` with this thread's dispatch limited to kernels no wider than `cap` (to test or
@@ -70,7 +72,10 @@ pub fn with_kernel_cap<R>(cap: Kernel, f: impl FnOnce() -> R) -> R {
 
 /// The kernels this machine can run, narrowest first (`Scalar` always).
 pub fn kernels_here() -> Vec<Kernel> {
-    [Kernel::Scalar, Kernel::Avx2, Kernel::Avx512].into_iter().filter(|&k| k <= widest_here()).collect()
+    [Kernel::Scalar, Kernel::Avx2, Kernel::Avx512, Kernel::Avx512Fp16]
+        .into_iter()
+        .filter(|&k| k <= widest_here())
+        .collect()
 }
 
 /// The widest kernel this machine can run, detected once.
@@ -82,7 +87,11 @@ fn widest_here() -> Kernel {
             use std::arch::is_x86_feature_detected as has;
             if has!("avx2") && has!("f16c") {
                 // the AVX-512 kernels use AVX2 for the binary16 step
-                return if has!("avx512f") { Kernel::Avx512 } else { Kernel::Avx2 };
+                return match (has!("avx512f"), has!("avx512bw") && has!("avx512fp16")) {
+                    (true, true) => Kernel::Avx512Fp16,
+                    (true, false) => Kernel::Avx512,
+                    _ => Kernel::Avx2,
+                };
             }
         }
         Kernel::Scalar
@@ -94,22 +103,28 @@ fn eligible<B: crate::format::IeeeBackend>(f: &Ieee<B>) -> bool {
     f.opts.subnormals == Subnormals::Ieee && f.opts.nan == NanMode::Canonical
 }
 
-/// The widest kernel this machine has within this thread's cap, if `eligible`.
-fn best_kernel(eligible: bool) -> Kernel {
+/// The widest kernel this machine has within this thread's cap and `useful` (the widest
+/// kernel the format has), if `eligible`.
+fn best_kernel(eligible: bool, useful: Kernel) -> Kernel {
     match eligible {
-        true => widest_here().min(CAP.with(|c| c.get())),
+        true => widest_here().min(CAP.with(|c| c.get())).min(useful),
         false => Kernel::Scalar,
     }
 }
 
+/// The widest kernel binary32 has (AVX512-FP16 adds nothing to binary32).
+const WIDEST_F32: Kernel = Kernel::Avx512;
+/// The widest kernel binary16 has.
+const WIDEST_F16: Kernel = Kernel::Avx512Fp16;
+
 /// The kernel `rti_batch_f32` uses for this unit on this machine (and this thread's cap).
 pub fn kernel_f32(rti: &Rti<Ieee<F32Native>>) -> Kernel {
-    best_kernel(eligible(&rti.fmt) && rti.det_thr >= 0.0)
+    best_kernel(eligible(&rti.fmt) && rti.det_thr >= 0.0, WIDEST_F32)
 }
 
 /// The kernel `rti_batch_f16` uses for this unit on this machine (and this thread's cap).
 pub fn kernel_f16(rti: &Rti<Ieee<F16Half>>) -> Kernel {
-    best_kernel(eligible(&rti.fmt) && rti.det_thr.to_f32() >= 0.0)
+    best_kernel(eligible(&rti.fmt) && rti.det_thr.to_f32() >= 0.0, WIDEST_F16)
 }
 
 /// The signature of an RTI kernel: lanes `0..full` of every column.
@@ -131,14 +146,19 @@ fn rti_columns_ok<V>(rays: &RaysSoa<V>, tris: &TrisSoa<V>, out: &HitsSoa<V>, n: 
         && [&out.t, &out.u, &out.v].iter().all(|c| c.len() == n)
 }
 
-/// The kernel of `table` (AVX2, AVX-512) that `which` names, and its lanes per vector.
+/// A format's kernels: AVX2, AVX-512F and, for binary16, AVX512-FP16.
 #[cfg(target_arch = "x86_64")]
-fn pick<K>(which: Kernel, table: [K; 2]) -> Option<(K, usize)> {
-    let [v8, v16] = table;
+type Table<K> = (K, K, Option<K>);
+
+/// The kernel of `table` that `which` names, and its lanes per vector.
+#[cfg(target_arch = "x86_64")]
+fn pick<K>(which: Kernel, table: Table<K>) -> Option<(K, usize)> {
+    let (v8, v16, v32h) = table;
     match which {
         Kernel::Scalar => None,
         Kernel::Avx2 => Some((v8, isa::v8::LANES)),
         Kernel::Avx512 => Some((v16, isa::v16::LANES)),
+        Kernel::Avx512Fp16 => v32h.map(|k| (k, isa::v32h::LANES)),
     }
 }
 
@@ -150,7 +170,7 @@ fn rti_dispatch<F: crate::Format>(
     tris: &TrisSoa<F::V>,
     out: &mut HitsSoa<F::V>,
     which: Kernel,
-    #[cfg(target_arch = "x86_64")] table: [RtiKernelFn<F>; 2],
+    #[cfg(target_arch = "x86_64")] table: Table<RtiKernelFn<F>>,
 ) -> Kernel {
     let n = rays.len();
     assert!(tris.len() == n && out.len() == n, "batch lengths differ");
@@ -186,7 +206,7 @@ pub fn rti_batch_f32(
         out,
         which,
         #[cfg(target_arch = "x86_64")]
-        [kernels::v8::rti_f32, kernels::v16::rti_f32],
+        (kernels::v8::rti_f32, kernels::v16::rti_f32, None),
     )
 }
 
@@ -208,19 +228,19 @@ pub fn rti_batch_f16(
         out,
         which,
         #[cfg(target_arch = "x86_64")]
-        [kernels::v8::rti_f16, kernels::v16::rti_f16],
+        (kernels::v8::rti_f16, kernels::v16::rti_f16, Some(kernels::v32h::rti_f16)),
     )
 }
 
 /// The kernel `slab_batch_f32` / `slab_ray_f32` use for this unit on this machine (the
 /// round-to-nearest variants; the directed one runs the scalar model).
 pub fn slab_kernel_f32(s: &Slab<Ieee<F32Native>>) -> Kernel {
-    best_kernel(eligible(&s.fmt) && !s.cfg.directed)
+    best_kernel(eligible(&s.fmt) && !s.cfg.directed, WIDEST_F32)
 }
 
 /// The kernel `slab_batch_f16` / `slab_ray_f16` use for this unit on this machine.
 pub fn slab_kernel_f16(s: &Slab<Ieee<F16Half>>) -> Kernel {
-    best_kernel(eligible(&s.fmt) && !s.cfg.directed)
+    best_kernel(eligible(&s.fmt) && !s.cfg.directed, WIDEST_F16)
 }
 
 /// Every box and output column holds `n` slots.
@@ -261,7 +281,7 @@ fn slab_dispatch<F: crate::Format>(
     boxes: &BoxesSoa<F::V>,
     out: &mut SlabOutSoa<F::V>,
     which: Kernel,
-    #[cfg(target_arch = "x86_64")] table: [SlabKernelFn<F>; 2],
+    #[cfg(target_arch = "x86_64")] table: Table<SlabKernelFn<F>>,
 ) -> Kernel {
     let n = out.hit.len();
     let rays_ok = match rays {
@@ -296,7 +316,7 @@ fn slab_dispatch<F: crate::Format>(
 
 /// A typed slab entry point: the unit's kernel choice, then [`slab_dispatch`].
 macro_rules! slab_entry {
-    ($(#[$doc:meta])* $name:ident, $fmt:ty, $v:ty, $rays:ty, $shape:ident, $which:ident, $kernel:ident) => {
+    ($(#[$doc:meta])* $name:ident, $fmt:ty, $v:ty, $rays:ty, $shape:ident, $which:ident, $kernel:ident, $fp16:expr) => {
         $(#[$doc])*
         ///
         /// # Panics
@@ -310,7 +330,7 @@ macro_rules! slab_entry {
                 out,
                 which,
                 #[cfg(target_arch = "x86_64")]
-                [kernels::v8::$kernel, kernels::v16::$kernel],
+                (kernels::v8::$kernel, kernels::v16::$kernel, $fp16),
             )
         }
     };
@@ -318,19 +338,19 @@ macro_rules! slab_entry {
 
 slab_entry!(
     /// [`Slab::batch`] for binary32 on the fastest kernel available; the same bits.
-    slab_batch_f32, Ieee<F32Native>, f32, SlabRaysSoa<f32>, Pairs, slab_kernel_f32, slab_f32
+    slab_batch_f32, Ieee<F32Native>, f32, SlabRaysSoa<f32>, Pairs, slab_kernel_f32, slab_f32, None
 );
 slab_entry!(
     /// [`Slab::batch_ray`] (one ray, many boxes) for binary32 on the fastest kernel available; the same bits.
-    slab_ray_f32, Ieee<F32Native>, f32, SlabRay<f32>, One, slab_kernel_f32, slab_f32
+    slab_ray_f32, Ieee<F32Native>, f32, SlabRay<f32>, One, slab_kernel_f32, slab_f32, None
 );
 slab_entry!(
     /// [`Slab::batch`] for binary16 on the fastest kernel available; the same bits.
-    slab_batch_f16, Ieee<F16Half>, f16, SlabRaysSoa<f16>, Pairs, slab_kernel_f16, slab_f16
+    slab_batch_f16, Ieee<F16Half>, f16, SlabRaysSoa<f16>, Pairs, slab_kernel_f16, slab_f16, Some(kernels::v32h::slab_f16)
 );
 slab_entry!(
     /// [`Slab::batch_ray`] (one ray, many boxes) for binary16 on the fastest kernel available; the same bits.
-    slab_ray_f16, Ieee<F16Half>, f16, SlabRay<f16>, One, slab_kernel_f16, slab_f16
+    slab_ray_f16, Ieee<F16Half>, f16, SlabRay<f16>, One, slab_kernel_f16, slab_f16, Some(kernels::v32h::slab_f16)
 );
 
 /// The body of a format-generic dispatch: calls `$f32` (or `$f16`) when the unit and its
@@ -545,6 +565,18 @@ mod isa {
         pub fn splat(x: f32) -> __m256 {
             _mm256_set1_ps(x)
         }
+        /// Every lane binary32's canonical NaN (`vcvtps2ph` makes it binary16's 0x7e00).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn canonical_nan() -> __m256 {
+            splat_bits(0x7fc0_0000)
+        }
+        /// Every lane the binary16 value x, held in binary32 (exact).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn splat16(x: f16) -> __m256 {
+            splat(x.to_f32())
+        }
         /// Every lane the binary32 with these bits.
         #[inline]
         #[target_feature(enable = "avx2")]
@@ -556,12 +588,6 @@ mod isa {
         #[target_feature(enable = "avx2")]
         pub fn and_m(a: M, b: M) -> M {
             _mm256_and_ps(a, b)
-        }
-        /// Either mask.
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn or_m(a: M, b: M) -> M {
-            _mm256_or_ps(a, b)
         }
         /// The mask as lane bits (lane k in bit k).
         #[inline]
@@ -598,6 +624,12 @@ mod isa {
         #[target_feature(enable = "avx2")]
         pub fn xor(a: __m256, b: __m256) -> __m256 {
             _mm256_xor_ps(a, b)
+        }
+        /// Either mask.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn or_m(a: M, b: M) -> M {
+            _mm256_or_ps(a, b)
         }
         /// Writes the mask's lanes as bools 0 / 1 to `p[i..i + 8]`.
         ///
@@ -709,6 +741,18 @@ mod isa {
         pub fn splat(x: f32) -> __m512 {
             _mm512_set1_ps(x)
         }
+        /// Every lane binary32's canonical NaN (`vcvtps2ph` makes it binary16's 0x7e00).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn canonical_nan() -> __m512 {
+            splat_bits(0x7fc0_0000)
+        }
+        /// Every lane the binary16 value x, held in binary32 (exact).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn splat16(x: f16) -> __m512 {
+            splat(x.to_f32())
+        }
         /// Every lane the binary32 with these bits.
         #[inline]
         #[target_feature(enable = "avx512f")]
@@ -720,12 +764,6 @@ mod isa {
         #[target_feature(enable = "avx512f")]
         pub fn and_m(a: M, b: M) -> M {
             a & b
-        }
-        /// Either mask.
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn or_m(a: M, b: M) -> M {
-            a | b
         }
         /// The mask as lane bits (lane k in bit k).
         #[inline]
@@ -763,6 +801,12 @@ mod isa {
         #[target_feature(enable = "avx512f")]
         pub fn xor(a: __m512, b: __m512) -> __m512 {
             _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(a), _mm512_castps_si512(b)))
+        }
+        /// Either mask.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn or_m(a: M, b: M) -> M {
+            a | b
         }
         /// Writes the mask's lanes as bools 0 / 1 to `p[i..i + 16]`.
         ///
@@ -833,6 +877,175 @@ mod isa {
             _mm512_cvtph_ps(super::step_up16(_mm512_cvtps_ph::<NEAREST>(v)))
         }
     }
+    /// The binary16 next-up step on 32 binary16 encodings, as [`step_up16`] (AVX512BW).
+    #[inline]
+    #[target_feature(enable = "avx512bw,avx512f")]
+    pub(super) fn step_up16x32(b: std::arch::x86_64::__m512i) -> std::arch::x86_64::__m512i {
+        use std::arch::x86_64::*;
+        let mag = _mm512_and_si512(b, _mm512_set1_epi16(0x7fff));
+        let keep = _mm512_cmpgt_epi16_mask(mag, _mm512_set1_epi16(0x7c00)) // NaN
+            | _mm512_cmpeq_epi16_mask(b, _mm512_set1_epi16(0x7c00)); // +inf
+        let zero = _mm512_cmpeq_epi16_mask(mag, _mm512_setzero_si512());
+        // negative: bits - 1, positive: bits + 1
+        let step = _mm512_or_si512(_mm512_srai_epi16::<15>(b), _mm512_set1_epi16(1));
+        let r = _mm512_add_epi16(b, step);
+        let r = _mm512_mask_blend_epi16(zero, r, _mm512_set1_epi16(1));
+        _mm512_mask_blend_epi16(keep, r, b)
+    }
+
+    /// AVX512-FP16: 32 binary16 lanes computed natively (`vaddph` … `vdivph`, each correctly
+    /// rounded to binary16, round to nearest even from MXCSR's default, subnormals always kept:
+    /// the FP16 instructions ignore MXCSR.DAZ / FTZ), a mask is a `__mmask32`. Only the binary16
+    /// kernels use it: loads, stores and the rounding step are identities.
+    pub(super) mod v32h {
+        use half::f16;
+        use std::arch::x86_64::*;
+        /// Lanes per vector.
+        pub const LANES: usize = 32;
+        /// A mask.
+        pub type M = __mmask32;
+        table_ops!("avx512fp16,avx512bw,avx512f", __m512h, M;
+            /// a + b, rounded to binary16.
+            add = _mm512_add_ph;
+            /// a − b, rounded to binary16.
+            sub = _mm512_sub_ph;
+            /// a × b, rounded to binary16.
+            mul = _mm512_mul_ph;
+            /// a ÷ b, rounded to binary16.
+            div = _mm512_div_ph;
+            /// `a > b ? a : b` (vmaxph: the second operand on NaN or equality, as vmaxps).
+            max = _mm512_max_ph;
+            /// `a < b ? a : b` (vminph).
+            min = _mm512_min_ph;
+            ;
+            /// Lanes where a ≤ b (false on NaN).
+            le = _mm512_cmp_ph_mask::<_CMP_LE_OQ>;
+            /// Lanes where a < b (false on NaN).
+            lt = _mm512_cmp_ph_mask::<_CMP_LT_OQ>;
+            /// Lanes where a or b is NaN.
+            unord = _mm512_cmp_ph_mask::<_CMP_UNORD_Q>;
+        );
+        /// Every lane the binary16 with these bits.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        fn splat_bits(x: u16) -> __m512h {
+            _mm512_castsi512_ph(_mm512_set1_epi16(x as i16))
+        }
+        /// Every lane x, a binary16 value (0, ±1, −0, a det threshold read from binary16).
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn splat(x: f32) -> __m512h {
+            let h = f16::from_f32(x);
+            debug_assert!(h.to_f32().to_bits() == x.to_bits(), "{x} is not a binary16 value");
+            splat_bits(h.to_bits())
+        }
+        /// Every lane the binary16 x, bits and all.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn splat16(x: f16) -> __m512h {
+            splat_bits(x.to_bits())
+        }
+        /// Every lane binary16's canonical NaN, 0x7e00.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn canonical_nan() -> __m512h {
+            splat_bits(0x7e00)
+        }
+        /// Both masks.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn and_m(a: M, b: M) -> M {
+            a & b
+        }
+        /// The mask as lane bits (lane k in bit k).
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn bits(m: M) -> u32 {
+            m
+        }
+        /// `m ? b : a` per lane.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn blend(a: __m512h, b: __m512h, m: M) -> __m512h {
+            _mm512_mask_blend_ph(m, a, b)
+        }
+        /// `sign(x) ? b : a` per lane.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn blend_sign(a: __m512h, b: __m512h, x: __m512h) -> __m512h {
+            _mm512_mask_blend_ph(_mm512_movepi16_mask(_mm512_castph_si512(x)), a, b)
+        }
+        /// The bits of `a` and `b` combined by a 512-bit logic instruction.
+        macro_rules! bits_op {
+            ($op:ident, $a:expr, $b:expr) => {
+                _mm512_castsi512_ph($op(_mm512_castph_si512($a), $b))
+            };
+        }
+        /// The sign bits of x (everything else cleared).
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn sign(x: __m512h) -> __m512h {
+            bits_op!(_mm512_and_si512, x, _mm512_set1_epi16(i16::MIN))
+        }
+        /// |x| by clearing the sign bit.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn abs(x: __m512h) -> __m512h {
+            bits_op!(_mm512_and_si512, x, _mm512_set1_epi16(i16::MAX))
+        }
+        /// a ⊕ b, bitwise.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn xor(a: __m512h, b: __m512h) -> __m512h {
+            bits_op!(_mm512_xor_si512, a, _mm512_castph_si512(b))
+        }
+        /// Either mask.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn or_m(a: M, b: M) -> M {
+            a | b
+        }
+        /// Writes the mask's lanes as bools 0 / 1 to `p[i..i + 32]`.
+        ///
+        /// # Safety
+        /// `p[i..i + 32]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub unsafe fn flags(p: *mut bool, i: usize, m: M) {
+            for k in 0..4 {
+                // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
+                unsafe {
+                    (p.add(i + 8 * k) as *mut u64).write_unaligned(super::SPREAD[(m >> (8 * k) & 0xff) as usize])
+                };
+            }
+        }
+        /// # Safety
+        /// `p[i..i + 32]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub unsafe fn load16(p: *const f16, i: usize) -> __m512h {
+            unsafe { _mm512_castsi512_ph(_mm512_loadu_si512(p.add(i) as *const __m512i)) }
+        }
+        /// # Safety
+        /// `p[i..i + 32]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub unsafe fn store16(p: *mut f16, i: usize, x: __m512h) {
+            unsafe { _mm512_storeu_si512(p.add(i) as *mut __m512i, _mm512_castph_si512(x)) }
+        }
+        /// The lanes are binary16 already: nothing to round.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn round16(x: __m512h) -> __m512h {
+            x
+        }
+        /// The next binary16 encoding above each lane, as [`super::v8::next_up16`].
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn next_up16(v: __m512h) -> __m512h {
+            _mm512_castsi512_ph(super::step_up16x32(_mm512_castph_si512(v)))
+        }
+    }
 }
 
 /// The kernel bodies, instantiated for each instruction set in [`isa`].
@@ -866,8 +1079,8 @@ mod kernels {
             let thr = $x::splat($thr);
             let zero = $x::splat(0.0);
             let one = $x::splat(1.0);
-            // binary32's canonical NaN; vcvtps2ph makes it binary16's 0x7e00
-            let nan = $x::splat_bits(0x7fc0_0000);
+            // the canonical NaN of the lanes' encoding (stored as the format's canonical NaN)
+            let nan = $x::canonical_nan();
             const L: usize = $x::LANES;
             // Two passes over blocks of BLOCK vectors (software pipelining): the first runs
             // stages 1-6 and keeps det, u', v' and t'; the second runs stage 7, divides and
@@ -1118,112 +1331,124 @@ mod kernels {
         }
     }
 
-    /// The four kernels (RTI and slab, binary32 and binary16) of one instruction set.
+    /// The kernels (RTI and slab) of one instruction set: binary32 and binary16, or binary16 only.
     macro_rules! kernels_for {
         ($x:ident, $f32feat:literal, $f16feat:literal) => {
             pub(in crate::simd) mod $x {
                 use super::super::isa::$x;
                 use super::*;
+                kernels_for!(@f32 $x, $f32feat);
+                kernels_for!(@f16 $x, $f16feat);
+            }
+        };
+        ($x:ident, binary16 $f16feat:literal) => {
+            pub(in crate::simd) mod $x {
+                use super::super::isa::$x;
+                use super::*;
+                kernels_for!(@f16 $x, $f16feat);
+            }
+        };
+        (@f32 $x:ident, $f32feat:literal) => {
+            #[target_feature(enable = $f32feat)]
+            pub fn rti_f32(
+                rti: &Rti<Ieee<F32Native>>,
+                rays: &RaysSoa<f32>,
+                tris: &TrisSoa<f32>,
+                out: &mut HitsSoa<f32>,
+                full: usize,
+            ) {
+                // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
+                rti_kernel!(
+                    $x,
+                    rti,
+                    rays,
+                    tris,
+                    out,
+                    full,
+                    |c: &Vec<f32>, i: usize| unsafe { $x::load32(c.as_ptr(), i) },
+                    |x| x,
+                    |c: &mut Vec<f32>, i: usize, x| unsafe { $x::store32(c.as_mut_ptr(), i, x) },
+                    rti.det_thr
+                );
+            }
 
-                #[target_feature(enable = $f32feat)]
-                pub fn rti_f32(
-                    rti: &Rti<Ieee<F32Native>>,
-                    rays: &RaysSoa<f32>,
-                    tris: &TrisSoa<f32>,
-                    out: &mut HitsSoa<f32>,
-                    full: usize,
-                ) {
-                    // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
-                    rti_kernel!(
-                        $x,
-                        rti,
-                        rays,
-                        tris,
-                        out,
-                        full,
-                        |c: &Vec<f32>, i: usize| unsafe { $x::load32(c.as_ptr(), i) },
-                        |x| x,
-                        |c: &mut Vec<f32>, i: usize, x| unsafe { $x::store32(c.as_mut_ptr(), i, x) },
-                        rti.det_thr
-                    );
-                }
+            #[target_feature(enable = $f32feat)]
+            pub fn slab_f32(
+                s: &Slab<Ieee<F32Native>>,
+                rays: SlabRays<f32>,
+                boxes: &BoxesSoa<f32>,
+                out: &mut SlabOutSoa<f32>,
+                full: usize,
+            ) {
+                // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
+                slab_kernel!(
+                    $x,
+                    s,
+                    rays,
+                    boxes,
+                    out,
+                    full,
+                    |c: *const f32, i: usize| unsafe { $x::load32(c, i) },
+                    |x| x,
+                    |c: *mut f32, i: usize, x| unsafe { $x::store32(c, i, x) },
+                    |v| $x::next_up(v),
+                    |v| $x::splat(v)
+                );
+            }
+        };
+        (@f16 $x:ident, $f16feat:literal) => {
+            #[target_feature(enable = $f16feat)]
+            pub fn rti_f16(
+                rti: &Rti<Ieee<F16Half>>,
+                rays: &RaysSoa<f16>,
+                tris: &TrisSoa<f16>,
+                out: &mut HitsSoa<f16>,
+                full: usize,
+            ) {
+                // SAFETY (loads and stores): the caller checked that every column holds
+                // `full` lanes; f16 is a 2-byte plain value.
+                rti_kernel!(
+                    $x,
+                    rti,
+                    rays,
+                    tris,
+                    out,
+                    full,
+                    |c: &Vec<f16>, i: usize| unsafe { $x::load16(c.as_ptr(), i) },
+                    |v| $x::round16(v),
+                    |c: &mut Vec<f16>, i: usize, x| unsafe { $x::store16(c.as_mut_ptr(), i, x) },
+                    rti.det_thr.to_f32()
+                );
+            }
 
-                #[target_feature(enable = $f16feat)]
-                pub fn rti_f16(
-                    rti: &Rti<Ieee<F16Half>>,
-                    rays: &RaysSoa<f16>,
-                    tris: &TrisSoa<f16>,
-                    out: &mut HitsSoa<f16>,
-                    full: usize,
-                ) {
-                    // SAFETY (loads and stores): the caller checked that every column holds
-                    // `full` lanes; f16 is a 2-byte plain value.
-                    rti_kernel!(
-                        $x,
-                        rti,
-                        rays,
-                        tris,
-                        out,
-                        full,
-                        |c: &Vec<f16>, i: usize| unsafe { $x::load16(c.as_ptr(), i) },
-                        |v| $x::round16(v),
-                        |c: &mut Vec<f16>, i: usize, x| unsafe { $x::store16(c.as_mut_ptr(), i, x) },
-                        rti.det_thr.to_f32()
-                    );
-                }
-
-                #[target_feature(enable = $f32feat)]
-                pub fn slab_f32(
-                    s: &Slab<Ieee<F32Native>>,
-                    rays: SlabRays<f32>,
-                    boxes: &BoxesSoa<f32>,
-                    out: &mut SlabOutSoa<f32>,
-                    full: usize,
-                ) {
-                    // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
-                    slab_kernel!(
-                        $x,
-                        s,
-                        rays,
-                        boxes,
-                        out,
-                        full,
-                        |c: *const f32, i: usize| unsafe { $x::load32(c, i) },
-                        |x| x,
-                        |c: *mut f32, i: usize, x| unsafe { $x::store32(c, i, x) },
-                        |v| $x::next_up(v),
-                        |v| $x::splat(v)
-                    );
-                }
-
-                #[target_feature(enable = $f16feat)]
-                pub fn slab_f16(
-                    s: &Slab<Ieee<F16Half>>,
-                    rays: SlabRays<f16>,
-                    boxes: &BoxesSoa<f16>,
-                    out: &mut SlabOutSoa<f16>,
-                    full: usize,
-                ) {
-                    // SAFETY (loads and stores): the caller checked that every column holds
-                    // `full` lanes; f16 is a 2-byte plain value.
-                    slab_kernel!(
-                        $x,
-                        s,
-                        rays,
-                        boxes,
-                        out,
-                        full,
-                        |c: *const f16, i: usize| unsafe { $x::load16(c, i) },
-                        |v| $x::round16(v),
-                        |c: *mut f16, i: usize, x| unsafe { $x::store16(c, i, x) },
-                        |v| $x::next_up16(v),
-                        |x: f16| $x::splat(x.to_f32())
-                    );
-                }
+            #[target_feature(enable = $f16feat)]
+            pub fn slab_f16(
+                s: &Slab<Ieee<F16Half>>,
+                rays: SlabRays<f16>,
+                boxes: &BoxesSoa<f16>,
+                out: &mut SlabOutSoa<f16>,
+                full: usize,
+            ) {
+                // SAFETY (loads and stores): the caller checked that every column holds
+                // `full` lanes; f16 is a 2-byte plain value.
+                slab_kernel!(
+                    $x,
+                    s,
+                    rays,
+                    boxes,
+                    out,
+                    full,
+                    |c: *const f16, i: usize| unsafe { $x::load16(c, i) },
+                    |v| $x::round16(v),
+                    |c: *mut f16, i: usize, x| unsafe { $x::store16(c, i, x) },
+                    |v| $x::next_up16(v),
+                    |x: f16| $x::splat16(x)
+                );
             }
         };
     }
 
     kernels_for!(v8, "avx2", "avx2,f16c");
     kernels_for!(v16, "avx512f", "avx512f,avx2");
+    kernels_for!(v32h, binary16 "avx512fp16,avx512bw,avx512f");
 }
