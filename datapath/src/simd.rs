@@ -507,26 +507,37 @@ mod isa {
         _mm256_blendv_epi8(r, b, keep)
     }
 
-    /// The binary operations and compares of an ISA table: `name = intrinsic` (for compares,
-    /// `name = intrinsic::<predicate>`), each a one-instruction function.
+    /// The binary operations and compares of an ISA table, each a one-instruction function:
+    /// `$prec` names the arithmetic's rounding, `cmp` is the compare taking a predicate.
     macro_rules! table_ops {
-        ($feat:literal, $v:ty, $m:ty; $($(#[$doc:meta])* $name:ident = $intr:ident;)* ; $($(#[$cdoc:meta])* $cname:ident = $cmp:ident::<$pred:ident>;)*) => {
-            $(
-                $(#[$doc])*
-                #[inline]
-                #[target_feature(enable = $feat)]
-                pub fn $name(a: $v, b: $v) -> $v {
-                    $intr(a, b)
-                }
-            )*
-            $(
-                $(#[$cdoc])*
-                #[inline]
-                #[target_feature(enable = $feat)]
-                pub fn $cname(a: $v, b: $v) -> $m {
-                    $cmp::<$pred>(a, b)
-                }
-            )*
+        ($feat:literal, $v:ty, $m:ty, $prec:literal;
+         add = $add:ident, sub = $sub:ident, mul = $mul:ident, div = $div:ident,
+         max = $max:ident, min = $min:ident, cmp = $cmp:ident) => {
+            table_ops!(@op $feat, $v, add, $add, concat!("a + b, rounded to ", $prec, "."));
+            table_ops!(@op $feat, $v, sub, $sub, concat!("a − b, rounded to ", $prec, "."));
+            table_ops!(@op $feat, $v, mul, $mul, concat!("a × b, rounded to ", $prec, "."));
+            table_ops!(@op $feat, $v, div, $div, concat!("a ÷ b, rounded to ", $prec, "."));
+            table_ops!(@op $feat, $v, max, $max, "`a > b ? a : b` (the second operand on NaN or equality, ±0 included).");
+            table_ops!(@op $feat, $v, min, $min, "`a < b ? a : b` (the second operand on NaN or equality, ±0 included).");
+            table_ops!(@cmp $feat, $v, $m, le, $cmp, _CMP_LE_OQ, "Lanes where a ≤ b (false on NaN).");
+            table_ops!(@cmp $feat, $v, $m, lt, $cmp, _CMP_LT_OQ, "Lanes where a < b (false on NaN).");
+            table_ops!(@cmp $feat, $v, $m, unord, $cmp, _CMP_UNORD_Q, "Lanes where a or b is NaN.");
+        };
+        (@op $feat:literal, $v:ty, $name:ident, $intr:ident, $doc:expr) => {
+            #[doc = $doc]
+            #[inline]
+            #[target_feature(enable = $feat)]
+            pub fn $name(a: $v, b: $v) -> $v {
+                $intr(a, b)
+            }
+        };
+        (@cmp $feat:literal, $v:ty, $m:ty, $name:ident, $cmp:ident, $pred:ident, $doc:expr) => {
+            #[doc = $doc]
+            #[inline]
+            #[target_feature(enable = $feat)]
+            pub fn $name(a: $v, b: $v) -> $m {
+                $cmp::<$pred>(a, b)
+            }
         };
     }
 
@@ -538,27 +549,9 @@ mod isa {
         pub const LANES: usize = 8;
         /// A mask.
         pub type M = __m256;
-        table_ops!("avx2", __m256, M;
-            /// a + b, rounded to binary32.
-            add = _mm256_add_ps;
-            /// a − b, rounded to binary32.
-            sub = _mm256_sub_ps;
-            /// a × b, rounded to binary32.
-            mul = _mm256_mul_ps;
-            /// a ÷ b, rounded to binary32.
-            div = _mm256_div_ps;
-            /// `a > b ? a : b` (vmaxps: the second operand on NaN or equality).
-            max = _mm256_max_ps;
-            /// `a < b ? a : b` (vminps).
-            min = _mm256_min_ps;
-            ;
-            /// Lanes where a ≤ b (false on NaN).
-            le = _mm256_cmp_ps::<_CMP_LE_OQ>;
-            /// Lanes where a < b (false on NaN).
-            lt = _mm256_cmp_ps::<_CMP_LT_OQ>;
-            /// Lanes where a or b is NaN.
-            unord = _mm256_cmp_ps::<_CMP_UNORD_Q>;
-        );
+        table_ops!("avx2", __m256, M, "binary32";
+            add = _mm256_add_ps, sub = _mm256_sub_ps, mul = _mm256_mul_ps, div = _mm256_div_ps,
+            max = _mm256_max_ps, min = _mm256_min_ps, cmp = _mm256_cmp_ps);
         /// Every lane x.
         #[inline]
         #[target_feature(enable = "avx2")]
@@ -712,27 +705,9 @@ mod isa {
         pub const LANES: usize = 16;
         /// A mask.
         pub type M = __mmask16;
-        table_ops!("avx512f", __m512, M;
-            /// a + b, rounded to binary32.
-            add = _mm512_add_ps;
-            /// a − b, rounded to binary32.
-            sub = _mm512_sub_ps;
-            /// a × b, rounded to binary32.
-            mul = _mm512_mul_ps;
-            /// a ÷ b, rounded to binary32.
-            div = _mm512_div_ps;
-            /// `a > b ? a : b` (vmaxps: the second operand on NaN or equality).
-            max = _mm512_max_ps;
-            /// `a < b ? a : b` (vminps).
-            min = _mm512_min_ps;
-            ;
-            /// Lanes where a ≤ b (false on NaN).
-            le = _mm512_cmp_ps_mask::<_CMP_LE_OQ>;
-            /// Lanes where a < b (false on NaN).
-            lt = _mm512_cmp_ps_mask::<_CMP_LT_OQ>;
-            /// Lanes where a or b is NaN.
-            unord = _mm512_cmp_ps_mask::<_CMP_UNORD_Q>;
-        );
+        table_ops!("avx512f", __m512, M, "binary32";
+            add = _mm512_add_ps, sub = _mm512_sub_ps, mul = _mm512_mul_ps, div = _mm512_div_ps,
+            max = _mm512_max_ps, min = _mm512_min_ps, cmp = _mm512_cmp_ps_mask);
         /// vcvtps2ph: round to nearest even, exceptions suppressed (flags are not modelled).
         const NEAREST: i32 = _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC;
         /// Every lane x.
@@ -904,27 +879,9 @@ mod isa {
         pub const LANES: usize = 32;
         /// A mask.
         pub type M = __mmask32;
-        table_ops!("avx512fp16,avx512bw,avx512f", __m512h, M;
-            /// a + b, rounded to binary16.
-            add = _mm512_add_ph;
-            /// a − b, rounded to binary16.
-            sub = _mm512_sub_ph;
-            /// a × b, rounded to binary16.
-            mul = _mm512_mul_ph;
-            /// a ÷ b, rounded to binary16.
-            div = _mm512_div_ph;
-            /// `a > b ? a : b` (vmaxph: the second operand on NaN or equality, as vmaxps).
-            max = _mm512_max_ph;
-            /// `a < b ? a : b` (vminph).
-            min = _mm512_min_ph;
-            ;
-            /// Lanes where a ≤ b (false on NaN).
-            le = _mm512_cmp_ph_mask::<_CMP_LE_OQ>;
-            /// Lanes where a < b (false on NaN).
-            lt = _mm512_cmp_ph_mask::<_CMP_LT_OQ>;
-            /// Lanes where a or b is NaN.
-            unord = _mm512_cmp_ph_mask::<_CMP_UNORD_Q>;
-        );
+        table_ops!("avx512fp16,avx512bw,avx512f", __m512h, M, "binary16";
+            add = _mm512_add_ph, sub = _mm512_sub_ph, mul = _mm512_mul_ph, div = _mm512_div_ph,
+            max = _mm512_max_ph, min = _mm512_min_ph, cmp = _mm512_cmp_ph_mask);
         /// Every lane the binary16 with these bits.
         #[inline]
         #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
@@ -1349,64 +1306,22 @@ mod kernels {
             }
         };
         (@f32 $x:ident, $f32feat:literal) => {
-            #[target_feature(enable = $f32feat)]
-            pub fn rti_f32(
-                rti: &Rti<Ieee<F32Native>>,
-                rays: &RaysSoa<f32>,
-                tris: &TrisSoa<f32>,
-                out: &mut HitsSoa<f32>,
-                full: usize,
-            ) {
-                // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
-                rti_kernel!(
-                    $x,
-                    rti,
-                    rays,
-                    tris,
-                    out,
-                    full,
-                    |c: &Vec<f32>, i: usize| unsafe { $x::load32(c.as_ptr(), i) },
-                    |x| x,
-                    |c: &mut Vec<f32>, i: usize, x| unsafe { $x::store32(c.as_mut_ptr(), i, x) },
-                    rti.det_thr
-                );
-            }
-
-            #[target_feature(enable = $f32feat)]
-            pub fn slab_f32(
-                s: &Slab<Ieee<F32Native>>,
-                rays: SlabRays<f32>,
-                boxes: &BoxesSoa<f32>,
-                out: &mut SlabOutSoa<f32>,
-                full: usize,
-            ) {
-                // SAFETY (loads and stores): the caller checked that every column holds `full` lanes.
-                slab_kernel!(
-                    $x,
-                    s,
-                    rays,
-                    boxes,
-                    out,
-                    full,
-                    |c: *const f32, i: usize| unsafe { $x::load32(c, i) },
-                    |x| x,
-                    |c: *mut f32, i: usize, x| unsafe { $x::store32(c, i, x) },
-                    |v| $x::next_up(v),
-                    |v| $x::splat(v)
-                );
-            }
+            kernels_for!(@format $x, $f32feat, rti_f32, slab_f32, Ieee<F32Native>, f32, load32, store32,
+                |x| x, |v| $x::next_up(v), |x: f32| $x::splat(x), |r: &Rti<Ieee<F32Native>>| r.det_thr);
         };
         (@f16 $x:ident, $f16feat:literal) => {
-            #[target_feature(enable = $f16feat)]
-            pub fn rti_f16(
-                rti: &Rti<Ieee<F16Half>>,
-                rays: &RaysSoa<f16>,
-                tris: &TrisSoa<f16>,
-                out: &mut HitsSoa<f16>,
-                full: usize,
-            ) {
+            kernels_for!(@format $x, $f16feat, rti_f16, slab_f16, Ieee<F16Half>, f16, load16, store16,
+                |v| $x::round16(v), |v| $x::next_up16(v), |x: f16| $x::splat16(x),
+                |r: &Rti<Ieee<F16Half>>| r.det_thr.to_f32());
+        };
+        // one format's RTI and slab kernels: its column type, loads and stores, rounding, grid
+        // step, ray broadcast and det threshold (as the lanes hold it)
+        (@format $x:ident, $feat:literal, $rti:ident, $slab:ident, $fmt:ty, $v:ty, $load:ident, $store:ident,
+         $round:expr, $up:expr, $bcast:expr, $thr:expr) => {
+            #[target_feature(enable = $feat)]
+            pub fn $rti(rti: &Rti<$fmt>, rays: &RaysSoa<$v>, tris: &TrisSoa<$v>, out: &mut HitsSoa<$v>, full: usize) {
                 // SAFETY (loads and stores): the caller checked that every column holds
-                // `full` lanes; f16 is a 2-byte plain value.
+                // `full` lanes; the column types are plain values.
                 rti_kernel!(
                     $x,
                     rti,
@@ -1414,23 +1329,16 @@ mod kernels {
                     tris,
                     out,
                     full,
-                    |c: &Vec<f16>, i: usize| unsafe { $x::load16(c.as_ptr(), i) },
-                    |v| $x::round16(v),
-                    |c: &mut Vec<f16>, i: usize, x| unsafe { $x::store16(c.as_mut_ptr(), i, x) },
-                    rti.det_thr.to_f32()
+                    |c: &Vec<$v>, i: usize| unsafe { $x::$load(c.as_ptr(), i) },
+                    $round,
+                    |c: &mut Vec<$v>, i: usize, x| unsafe { $x::$store(c.as_mut_ptr(), i, x) },
+                    ($thr)(rti)
                 );
             }
 
-            #[target_feature(enable = $f16feat)]
-            pub fn slab_f16(
-                s: &Slab<Ieee<F16Half>>,
-                rays: SlabRays<f16>,
-                boxes: &BoxesSoa<f16>,
-                out: &mut SlabOutSoa<f16>,
-                full: usize,
-            ) {
-                // SAFETY (loads and stores): the caller checked that every column holds
-                // `full` lanes; f16 is a 2-byte plain value.
+            #[target_feature(enable = $feat)]
+            pub fn $slab(s: &Slab<$fmt>, rays: SlabRays<$v>, boxes: &BoxesSoa<$v>, out: &mut SlabOutSoa<$v>, full: usize) {
+                // SAFETY (loads and stores): as above.
                 slab_kernel!(
                     $x,
                     s,
@@ -1438,11 +1346,11 @@ mod kernels {
                     boxes,
                     out,
                     full,
-                    |c: *const f16, i: usize| unsafe { $x::load16(c, i) },
-                    |v| $x::round16(v),
-                    |c: *mut f16, i: usize, x| unsafe { $x::store16(c, i, x) },
-                    |v| $x::next_up16(v),
-                    |x: f16| $x::splat16(x)
+                    |c: *const $v, i: usize| unsafe { $x::$load(c, i) },
+                    $round,
+                    |c: *mut $v, i: usize, x| unsafe { $x::$store(c, i, x) },
+                    $up,
+                    $bcast
                 );
             }
         };
