@@ -1,8 +1,10 @@
 //! criterion benchmarks of the RTI models (pairwise batch path) against baselines: the golden
 //! f64 reference, a plain scalar f32 Möller–Trumbore and a `half`-crate scalar fp16 one.
 //! Run: `cargo bench --bench rti` (`RAYPIPE_PLAN=plan.json` benches only a plan's formats).
+//! Last, the run measures this machine's no-FMA add / multiply peak and prints each
+//! implementation's throughput as a fraction of it (the `raypipe speed` table).
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use criterion::{criterion_group, BenchmarkId, Criterion, Throughput};
 use datapath::rng::SplitMix64;
 use datapath::rti::{HitsSoa, RaysSoa, Rti, RtiConfig, TrisSoa};
 use datapath::{with_format, AnyFormat, Format};
@@ -145,4 +147,14 @@ criterion_group! {
     config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(2)).warm_up_time(std::time::Duration::from_millis(500));
     targets = bench_models
 }
-criterion_main!(benches);
+/// criterion's main, then this machine's no-FMA peak and every RTI / slab implementation's
+/// throughput as a fraction of it (`raypipe speed`'s table, 512 cached pairs, seed 1), unless
+/// criterion was only asked to list or filter.
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+    let args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
+    if args.is_empty() {
+        println!("\n{}", raypipe::speed::render(&raypipe::speed::speed(512, 1)));
+    }
+}
