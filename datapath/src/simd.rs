@@ -3,12 +3,15 @@
 //!
 //! One kernel body per unit (the `rti_kernel!` and `slab_kernel!` macros), written in the
 //! operations of an `isa` module, is instantiated for binary32 and binary16 on AVX2 (+ F16C
-//! for binary16; 8 tests per vector) and on AVX-512F (16 tests per vector), in the stage
-//! table's exact operation order with separate multiplies and adds (no FMA). binary16 computes
-//! every operation in binary32 and rounds it to binary16 at once (`vcvtps2ph` nearest-even,
-//! then back): binary32's 24 bits are at least 2·11 + 2, so this double rounding is innocuous
-//! for + − × ÷ and the result is the correctly rounded binary16 operation, subnormals and
-//! overflow included; compares and min/max of binary16 values held in binary32 are exact.
+//! for binary16; 8 tests per vector) and on AVX-512F (16 tests per vector), and for binary16
+//! on AVX512-FP16 (32 tests per vector), in the stage table's exact operation order with
+//! separate multiplies and adds (no FMA). On AVX2 and AVX-512F, binary16 computes every
+//! operation in binary32 and rounds it to binary16 at once (`vcvtps2ph` nearest-even, then
+//! back): binary32's 24 bits are at least 2·11 + 2, so this double rounding is innocuous for
+//! + − × ÷ and the result is the correctly rounded binary16 operation, subnormals and overflow
+//! included; compares and min/max of binary16 values held in binary32 are exact. On
+//! AVX512-FP16 the operations are binary16's own (`vaddph` … `vdivph`, correctly rounded,
+//! subnormals always kept).
 //! NaN payloads never influence a non-NaN result or a compare, so the RTI kernels canonicalise
 //! NaN only where a value leaves them (every RTI output is arithmetic), and only when a mask
 //! shows a NaN lane. A slab output NaN may be arithmetic (canonical in the model) or a NaN t
@@ -29,10 +32,8 @@
 //!
 //! The dispatch takes the widest kernel the machine has ([`kernels_here`]), within this
 //! thread's cap ([`with_kernel_cap`]), so every kernel can be tested and timed on one machine.
-//! The AVX-512 kernels are tested by the same property tests as the AVX2 ones, on an emulated
-//! AVX-512 machine (`emu/avx512`) when the host has none. There is no AVX512-FP16 kernel
-//! (native binary16 arithmetic): no emulator available here implements it, and an untested
-//! kernel is not offered; binary16 runs on AVX-512F through the conversions above.
+//! The AVX-512F and AVX512-FP16 kernels are tested by the same property tests as the AVX2
+//! ones, on an emulated machine with both (`emu/avx512`, Bochs 3.0) when the host has neither.
 
 use crate::format::{DivMode, F16Half, F32Native, Ieee, NanMode, Subnormals};
 use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
