@@ -8,8 +8,8 @@
 //! separate multiplies and adds (no FMA). On AVX2 and AVX-512F, binary16 computes every
 //! operation in binary32 and rounds it to binary16 at once (`vcvtps2ph` nearest-even, then
 //! back): binary32's 24 bits are at least 2·11 + 2, so this double rounding is innocuous for
-//! + − × ÷ and the result is the correctly rounded binary16 operation, subnormals and overflow
-//! included; compares and min/max of binary16 values held in binary32 are exact. On
+//! the four operations (+ − × ÷) and the result is the correctly rounded binary16 operation,
+//! subnormals and overflow included; compares and min/max of binary16 values held in binary32 are exact. On
 //! AVX512-FP16 the operations are binary16's own (`vaddph` … `vdivph`, correctly rounded,
 //! subnormals always kept).
 //! NaN payloads never influence a non-NaN result or a compare, so the RTI kernels canonicalise
