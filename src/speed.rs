@@ -113,15 +113,16 @@ fn peak_scalar(secs: f64) -> f64 {
     r
 }
 
-/// A vector peak loop: 12 independent add-then-multiply chains, kept in registers.
+/// A vector peak loop: 12 independent add-then-multiply chains, kept in registers. `$a` and
+/// `$m` keep every value normal in the lanes' format (near 1, neither growing nor decaying).
 macro_rules! peak_simd {
-    ($name:ident, $feat:literal, $set1:ident, $add:ident, $mul:ident, $lanes:expr) => {
+    ($name:ident, $feat:literal, $set1:ident, $add:ident, $mul:ident, $lanes:expr, $a:expr, $m:expr) => {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
         fn $name(secs: f64) -> f64 {
             use std::arch::x86_64::*;
-            let a = $set1(black_box(-1e-7));
-            let m = $set1(black_box(1.000_000_1));
+            let a = $set1(black_box($a));
+            let m = $set1(black_box($m));
             let mut acc = [$set1(1.0); 12];
             let iters = 10_000u64;
             let r = timed(secs, iters * 12 * 2 * $lanes, || {
@@ -139,9 +140,19 @@ macro_rules! peak_simd {
     };
 }
 
-peak_simd!(peak_avx2, "avx2", _mm256_set1_ps, _mm256_add_ps, _mm256_mul_ps, 8);
-peak_simd!(peak_avx512, "avx512f", _mm512_set1_ps, _mm512_add_ps, _mm512_mul_ps, 16);
-peak_simd!(peak_avx512fp16, "avx512fp16,avx512bw,avx512f", set1_ph, _mm512_add_ph, _mm512_mul_ph, 32);
+peak_simd!(peak_avx2, "avx2", _mm256_set1_ps, _mm256_add_ps, _mm256_mul_ps, 8, -1e-7, 1.000_000_1);
+peak_simd!(peak_avx512, "avx512f", _mm512_set1_ps, _mm512_add_ps, _mm512_mul_ps, 16, -1e-7, 1.000_000_1);
+// binary16: −1e-7 would be a subnormal there (and 1.0000001 would be 1), so −2^-11 and 1 + 2^-10
+peak_simd!(
+    peak_avx512fp16,
+    "avx512fp16,avx512bw,avx512f",
+    set1_ph,
+    _mm512_add_ph,
+    _mm512_mul_ph,
+    32,
+    -1.0 / 2048.0,
+    1.0 + 1.0 / 1024.0
+);
 
 /// Every binary16 lane x (a binary32 value rounded by `half`): the peak loop's constants.
 #[cfg(target_arch = "x86_64")]
