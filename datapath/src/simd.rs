@@ -9,9 +9,9 @@
 //! operation in binary32 and rounds it to binary16 at once (`vcvtps2ph` nearest-even, then
 //! back): binary32's 24 bits are at least 2·11 + 2, so this double rounding is innocuous for
 //! the four operations (+ − × ÷) and the result is the correctly rounded binary16 operation,
-//! subnormals and overflow included; compares and min/max of binary16 values held in binary32 are exact. On
-//! AVX512-FP16 the operations are binary16's own (`vaddph` … `vdivph`, correctly rounded,
-//! subnormals always kept).
+//! subnormals and overflow included; compares and min/max of binary16 values held in binary32
+//! are exact. On AVX512-FP16 the operations are binary16's own (`vaddph` … `vdivph`, correctly
+//! rounded, subnormals always kept).
 //! NaN payloads never influence a non-NaN result or a compare, so the RTI kernels canonicalise
 //! NaN only where a value leaves them (every RTI output is arithmetic), and only when a mask
 //! shows a NaN lane. A slab output NaN may be arithmetic (canonical in the model) or a NaN t
@@ -114,9 +114,9 @@ fn best_kernel(eligible: bool, useful: Kernel) -> Kernel {
 }
 
 /// The widest kernel binary32 has (AVX512-FP16 adds nothing to binary32).
-const WIDEST_F32: Kernel = Kernel::Avx512;
+pub const WIDEST_F32: Kernel = Kernel::Avx512;
 /// The widest kernel binary16 has.
-const WIDEST_F16: Kernel = Kernel::Avx512Fp16;
+pub const WIDEST_F16: Kernel = Kernel::Avx512Fp16;
 
 /// The kernel `rti_batch_f32` uses for this unit on this machine (and this thread's cap).
 pub fn kernel_f32(rti: &Rti<Ieee<F32Native>>) -> Kernel {

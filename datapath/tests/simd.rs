@@ -3,7 +3,9 @@
 use datapath::format::{DivMode, F16Half, F32Native, FpOpts, Ieee, NanMode, Subnormals};
 use datapath::rng::SplitMix64;
 use datapath::rti::{Cull, HitsSoa, RaysSoa, Rti, RtiConfig, TieRule, TrisSoa};
-use datapath::simd::{kernel_f16, kernel_f32, kernels_here, rti_batch_f16, rti_batch_f32, with_kernel_cap, Kernel};
+use datapath::simd::{
+    kernel_f16, kernel_f32, kernels_here, rti_batch_f16, rti_batch_f32, with_kernel_cap, Kernel, WIDEST_F16, WIDEST_F32,
+};
 use datapath::Format;
 use proptest::prelude::*;
 
@@ -67,11 +69,6 @@ const F16_SPECIALS: [u64; 12] = [0, 0x8000, 1, 0x8001, 0x03ff, 0x0400, 0x7bff, 0
 fn config(cull: bool, thr: f64) -> RtiConfig {
     RtiConfig { cull: if cull { Cull::Backface } else { Cull::TwoSided }, det_threshold: thr, tie: TieRule::First }
 }
-
-/// The widest kernel binary32 has (AVX512-FP16 runs binary32 on its AVX-512F kernel).
-const WIDEST_F32: Kernel = Kernel::Avx512;
-/// The widest kernel binary16 has.
-const WIDEST_F16: Kernel = Kernel::Avx512Fp16;
 
 /// Runs `batch` on every kernel this machine has (each under a cap, checking that the cap's
 /// kernel, or the format's `widest` below it, is the one that ran) and compares it with the
