@@ -12,6 +12,11 @@ use golden::{Faces, Ray64, Tri64};
 use half::f16;
 use std::hint::black_box;
 
+/// Large blocks (the batch columns) at staggered page offsets, so that a kernel's columns do
+/// not share cache sets (see [`datapath::alloc`]).
+#[global_allocator]
+static ALLOC: datapath::alloc::Staggered = datapath::alloc::Staggered;
+
 const N: usize = 4096;
 
 fn cases() -> Vec<(Ray64, Tri64)> {

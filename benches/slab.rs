@@ -8,6 +8,11 @@ use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa, SLAB_V
 use datapath::{with_format, AnyFormat, Format};
 use std::hint::black_box;
 
+/// Large blocks (the batch columns) at staggered page offsets, so that a kernel's columns do
+/// not share cache sets (see [`datapath::alloc`]).
+#[global_allocator]
+static ALLOC: datapath::alloc::Staggered = datapath::alloc::Staggered;
+
 const N: usize = 4096;
 
 fn bench_slab(c: &mut Criterion) {

@@ -11,6 +11,11 @@ use datapath::slab::{Aabb, Slab, SlabConfig};
 use golden::bvh::stack_traverse;
 use std::hint::black_box;
 
+/// Large blocks (the batch columns) at staggered page offsets, so that a kernel's columns do
+/// not share cache sets (see [`datapath::alloc`]).
+#[global_allocator]
+static ALLOC: datapath::alloc::Staggered = datapath::alloc::Staggered;
+
 const RAYS: usize = 4096;
 
 fn bench_traversals(c: &mut Criterion) {

@@ -11,6 +11,11 @@ use raypipe::verify::{render, verify, VerifyConfig};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// Large blocks (the batch columns) at staggered page offsets, so that a kernel's columns do
+/// not share cache sets (see [`datapath::alloc`]).
+#[global_allocator]
+static ALLOC: datapath::alloc::Staggered = datapath::alloc::Staggered;
+
 /// Default formats of `raypipe verify`.
 const DEFAULT_FORMATS: [&str; 5] = ["f32", "fp16", "bf16", "e8m16", "q8.24:divide"];
 

@@ -6,6 +6,7 @@ use datapath::format::{F16Half, F32Native, FpOpts, Ieee};
 use datapath::rng::SplitMix64;
 use datapath::rti::{HitsSoa, RaysSoa, Rti, RtiConfig, TrisSoa};
 use datapath::simd::{rti_batch_f16, rti_batch_f32, Kernel};
+use datapath::slab::{BoxesSoa, Slab, SlabRaysSoa};
 use datapath::Format;
 use golden::{Ray64, Tri64};
 use serde::Serialize;
@@ -195,6 +196,19 @@ fn columns<F: Format>(rti: &Rti<F>, cases: &[(Ray64, Tri64)]) -> (RaysSoa<F::V>,
     (rays, tris)
 }
 
+/// The slab unit's input columns for `cases`: each ray and its triangle's bounding box (the
+/// empty box where the format cannot hold it).
+fn slab_columns<F: Format>(s: &Slab<F>, cases: &[(Ray64, Tri64)]) -> (SlabRaysSoa<F::V>, BoxesSoa<F::V>) {
+    let (mut rs, mut bs) = (SlabRaysSoa::default(), BoxesSoa::default());
+    for (ray, tri) in cases {
+        rs.push(&s.prepare(ray.o, ray.d, ray.tmin, ray.tmax));
+        let lo = std::array::from_fn(|a| tri.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min));
+        let hi = std::array::from_fn(|a| tri.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max));
+        bs.push(&s.store_box(lo, hi).unwrap_or_else(|_| s.empty_box()));
+    }
+    (rs, bs)
+}
+
 /// `pairs` seeded rays of the built-in scene, each paired with its target triangle.
 fn scene_cases(pairs: usize, seed: u64) -> Vec<(Ray64, Tri64)> {
     let scene = crate::scene::Scene::builtin();
@@ -285,15 +299,9 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     // every box (the shape a node's or a level's children have)
     for (name, any) in [("f32", datapath::AnyFormat::F32(f32f)), ("fp16", datapath::AnyFormat::F16(f16f))] {
         datapath::with_format!(any, |f| {
-            use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa};
+            use datapath::slab::{Slab, SlabConfig, SlabOutSoa};
             let s = Slab::new(f, SlabConfig::default());
-            let (mut rs, mut bs) = (SlabRaysSoa::default(), BoxesSoa::default());
-            for (ray, tri) in &cases {
-                rs.push(&s.prepare(ray.o, ray.d, ray.tmin, ray.tmax));
-                let lo = std::array::from_fn(|a| tri.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min));
-                let hi = std::array::from_fn(|a| tri.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max));
-                bs.push(&s.store_box(lo, hi).unwrap_or_else(|_| s.empty_box()));
-            }
+            let (rs, bs) = slab_columns(&s, &cases);
             let mut out = SlabOutSoa::with_len(pairs);
             push(row(&format!("slab {name} kernel (dispatch, plain)"), pairs, SLAB_OPS, 7, || {
                 datapath::simd::slab_batch(&s, &rs, &bs, &mut out);
@@ -347,6 +355,39 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
                 );
             }));
             black_box(sink);
+        }
+    }
+    // column placement: 128 Ki pairs (columns of 512 KiB, beyond L2) with the columns at
+    // staggered page offsets (this binary's allocator) and all at one page offset (where the
+    // system allocator puts such blocks), for the RTI and the slab pairs kernels
+    if pairs > 0 && datapath::alloc::is_global() {
+        use datapath::alloc::{with_placement, Placement};
+        use datapath::slab::{Slab, SlabConfig, SlabOutSoa};
+        let mid = 1 << 17;
+        let s = Slab::new(f32f, SlabConfig::default());
+        let (rays, tris) = columns(&r32, &cases);
+        let (srays, sboxes) = slab_columns(&s, &cases);
+        for (label, place) in
+            [("staggered columns", Placement::Staggered), ("columns at one page offset", Placement::SamePageOffset)]
+        {
+            let (br, bt, mut bo, sr, sb, mut so) = with_placement(place, || {
+                let (mut br, mut bt) = (RaysSoa::with_capacity(mid), TrisSoa::with_capacity(mid));
+                let (mut sr, mut sb) = (SlabRaysSoa::default(), BoxesSoa::default());
+                for i in 0..mid {
+                    br.push(&rays.get(i % pairs));
+                    bt.push(&tris.get(i % pairs));
+                    sr.push(&srays.get(i % pairs));
+                    sb.push(&sboxes.get(i % pairs));
+                }
+                (br, bt, HitsSoa::with_len(mid), sr, sb, SlabOutSoa::with_len(mid))
+            });
+            push(row(&format!("rti f32 kernel, 128 Ki pairs, {label}"), mid, RTI_OPS, 3, || {
+                rti_batch_f32(&r32, &br, &bt, &mut bo);
+            }));
+            push(row(&format!("slab f32 kernel, 128 Ki pairs, {label}"), mid, SLAB_OPS, 3, || {
+                datapath::simd::slab_batch(&s, &sr, &sb, &mut so);
+            }));
+            // (freed here, before the next placement's columns are made)
         }
     }
     // every fraction against the one, best, peak of the run: the best rate over the best peak

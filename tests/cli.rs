@@ -480,4 +480,12 @@ fn speed_fractions_are_each_rows_rate_over_the_one_peak_it_prints() {
         assert!((frac - want).abs() <= 1e-9 * want.max(1e-12), "{r}");
         assert!(frac > 0.0 && frac < 1.5, "{r}");
     }
+    // the binary's allocator staggers columns, so both placements are measured
+    let names: Vec<&str> = rows.iter().map(|r| r["name"].as_str().unwrap()).collect();
+    for kernel in ["rti", "slab"] {
+        for place in ["staggered columns", "columns at one page offset"] {
+            let want = format!("{kernel} f32 kernel, 128 Ki pairs, {place}");
+            assert!(names.contains(&want.as_str()), "{want} missing from {names:?}");
+        }
+    }
 }

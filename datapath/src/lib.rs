@@ -3,6 +3,7 @@
 //! ([`probe`]), and its error bounds ([`bound`]).
 #![warn(missing_docs)]
 
+pub mod alloc;
 pub mod bound;
 pub mod bvh;
 pub mod format;
