@@ -260,9 +260,7 @@ pub fn markdown(r: &Report) -> String {
 
 /// Writes `report.md`, `report.json`, `report_rti.svg` and `report_slab.svg` into `dir`.
 pub fn write(r: &Report, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, String> {
-    use plotters::prelude::*;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let err = |e: &dyn std::fmt::Display| e.to_string();
     let mut out = Vec::new();
     let md = dir.join("report.md");
     std::fs::write(&md, markdown(r)).map_err(|e| format!("{}: {e}", md.display()))?;
@@ -277,41 +275,93 @@ pub fn write(r: &Report, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf
             continue;
         }
         let path = dir.join(format!("report_{unit}.svg"));
-        // error on a log scale, with exact zero drawn at the floor
-        let floor = 1e-7f64;
-        let y = |p: &Point| p.error_rate.max(floor).log10();
-        let xmax = pts.iter().map(|p| p.ns_per_test).fold(0.0, f64::max) * 1.15 + 1e-9;
-        let ymax = pts.iter().map(|p| y(p)).fold(floor.log10(), f64::max) + 0.5;
-        {
-            let root = SVGBackend::new(&path, (760, 480)).into_drawing_area();
-            root.fill(&WHITE).map_err(|e| err(&e))?;
-            let mut chart = ChartBuilder::on(&root)
-                .caption(format!("{unit}: time per test vs error (Pareto front in red)"), ("sans-serif", 18))
-                .margin(14)
-                .x_label_area_size(40)
-                .y_label_area_size(64)
-                .build_cartesian_2d(0.0..xmax, (floor.log10() - 0.3)..ymax)
-                .map_err(|e| err(&e))?;
-            chart
-                .configure_mesh()
-                .x_desc("ns per test (one thread)")
-                .y_desc("log10 error rate (1e-7 = none seen)")
-                .draw()
-                .map_err(|e| err(&e))?;
-            let mut front: Vec<(f64, f64)> = pts.iter().filter(|p| p.pareto).map(|p| (p.ns_per_test, y(p))).collect();
-            front.sort_by(|a, b| a.0.total_cmp(&b.0));
-            chart.draw_series(LineSeries::new(front, RED.stroke_width(2))).map_err(|e| err(&e))?;
-            for p in &pts {
-                let c = if p.pareto { RED } else { BLUE };
-                let at = (p.ns_per_test, y(p));
-                chart.draw_series(std::iter::once(Circle::new(at, 4, c.filled()))).map_err(|e| err(&e))?;
-                chart
-                    .draw_series(std::iter::once(Text::new(p.variant.clone(), at, ("sans-serif", 11))))
-                    .map_err(|e| err(&e))?;
-            }
-            root.present().map_err(|e| err(&e))?;
-        }
+        plot(&path, unit, &pts).map_err(|e| format!("{}: {e}", path.display()))?;
         out.push(path);
     }
     Ok(out)
+}
+
+/// Error rates below this (none seen) are drawn at it.
+const ERR_FLOOR: f64 = 1e-7;
+
+/// One unit's plot: time per test against error rate, both on log scales, the Pareto front in
+/// red, each point labelled where its label overlaps no earlier one.
+fn plot(path: &std::path::Path, unit: &str, pts: &[&Point]) -> Result<(), String> {
+    use plotters::prelude::*;
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let (w, h) = (900u32, 560u32);
+    let x = |p: &Point| p.ns_per_test.max(1e-3).log10();
+    let y = |p: &Point| p.error_rate.max(ERR_FLOOR).log10();
+    let span = |v: Vec<f64>, pad: f64| {
+        let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &c| (a.min(c), b.max(c)));
+        (lo - pad)..(hi + pad).max(lo + 2.0 * pad)
+    };
+    let xs = span(pts.iter().map(|p| x(p)).collect(), 0.25);
+    let ys = span(pts.iter().map(|p| y(p)).collect(), 0.3);
+    // one significant digit where the axis spans decades, two where it spans less
+    let digits = if ys.end - ys.start < 2.0 { 1 } else { 0 };
+    let root = SVGBackend::new(path, (w, h)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("{unit}: time per test vs error (Pareto front in red)"), ("sans-serif", 18))
+        .margin(14)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(xs, ys)
+        .map_err(|e| err(&e))?;
+    let pow = |v: &f64| {
+        let e = 10f64.powf(*v);
+        if e >= 10.0 {
+            format!("{e:.0}")
+        } else {
+            format!("{e:.2}")
+        }
+    };
+    let floor = format!("{ERR_FLOOR:.0e} = none seen");
+    chart
+        .configure_mesh()
+        .x_desc("ns per test (one thread, log scale)")
+        .y_desc(format!("error rate (log scale; {floor})"))
+        .x_label_formatter(&pow)
+        .y_label_formatter(&|v| format!("{:.*e}", digits, 10f64.powf(*v)))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let mut front: Vec<(f64, f64)> = pts.iter().filter(|p| p.pareto).map(|p| (x(p), y(p))).collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    chart.draw_series(LineSeries::new(front, RED.stroke_width(2))).map_err(|e| err(&e))?;
+    // labels: the first of a few offsets whose box overlaps no dot and no placed label, else
+    // none (the table names every point)
+    // (every dot is an obstacle from the start)
+    let mut placed: Vec<(i32, i32, i32, i32)> = pts
+        .iter()
+        .map(|p| {
+            let (px, py) = chart.backend_coord(&(x(p), y(p)));
+            (px - 5, py - 5, px + 5, py + 5)
+        })
+        .collect();
+    let mut order: Vec<&&Point> = pts.iter().collect();
+    order.sort_by(|a, b| (b.pareto, -a.ns_per_test).partial_cmp(&(a.pareto, -b.ns_per_test)).unwrap());
+    for p in order {
+        let c = if p.pareto { RED } else { BLUE };
+        let at = (x(p), y(p));
+        let (px, py) = chart.backend_coord(&at);
+        let (tw, th) = (6 * p.variant.chars().count() as i32, 12);
+        let free = [(7, -6), (7, 6), (7, -18), (7, 18), (-tw - 7, -6), (-tw - 7, 6)].into_iter().find(|&(dx, dy)| {
+            let r = (px + dx, py + dy, px + dx + tw, py + dy + th);
+            r.2 < w as i32 && r.0 > 0 && !placed.iter().any(|q| r.0 < q.2 && q.0 < r.2 && r.1 < q.3 && q.1 < r.3)
+        });
+        let dot = EmptyElement::at(at) + Circle::new((0, 0), 4, c.filled());
+        match free {
+            Some((dx, dy)) => {
+                placed.push((px + dx, py + dy, px + dx + tw, py + dy + th));
+                let label = Text::new(p.variant.clone(), (dx, dy), ("sans-serif", 11));
+                chart.draw_series(std::iter::once(dot + label)).map_err(|e| err(&e))?;
+            }
+            None => {
+                chart.draw_series(std::iter::once(dot)).map_err(|e| err(&e))?;
+            }
+        }
+    }
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
 }

@@ -36,7 +36,15 @@ fn points_pareto_front_and_files() {
     let files = write(&r, &dir).unwrap();
     assert_eq!(files.len(), 4);
     assert!(std::fs::read_to_string(dir.join("report.md")).unwrap().contains("| rti | f32 | 32 |"));
-    assert!(std::fs::read_to_string(dir.join("report_slab.svg")).unwrap().contains("bf16 directed"));
+    // every point drawn, and labelled where its label overlaps no other (the table names all)
+    for unit in ["rti", "slab"] {
+        let svg = std::fs::read_to_string(dir.join(format!("report_{unit}.svg"))).unwrap();
+        let pts: Vec<&str> = r.points.iter().filter(|p| p.unit == unit).map(|p| p.variant.as_str()).collect();
+        assert_eq!(svg.matches("<circle").count(), pts.len(), "{unit}");
+        let texts: Vec<&str> =
+            svg.split("<text").skip(1).filter_map(|t| t.split(['>', '<']).nth(1)).map(str::trim).collect();
+        assert!(texts.iter().any(|t| pts.contains(t)), "{unit}: no point labelled in {texts:?}");
+    }
     assert!(report(&ReportConfig { rays: 0, ..cfg.clone() }, &[Scene::builtin()]).is_err());
     assert!(report(&ReportConfig { variants: vec!["nope".into()], ..cfg }, &[Scene::builtin()]).is_err());
 }

@@ -58,14 +58,7 @@ fn placed() -> usize {
 /// Runs `f` with large blocks this thread allocates placed by `p`, then restores the
 /// previous placement (also if `f` panics).
 pub fn with_placement<R>(p: Placement, f: impl FnOnce() -> R) -> R {
-    struct Restore(Placement);
-    impl Drop for Restore {
-        fn drop(&mut self) {
-            PLACEMENT.with(|c| c.set(self.0));
-        }
-    }
-    let _restore = Restore(PLACEMENT.with(|c| c.replace(p)));
-    f()
+    crate::scoped(&PLACEMENT, p, f)
 }
 
 /// Whether [`Staggered`] is this program's global allocator (a large block allocated by

@@ -14,3 +14,20 @@ pub mod simd;
 pub mod slab;
 
 pub use format::{AnyFormat, Format};
+
+/// Runs `f` with this thread's `key` set to `v`, then restores the previous value (also if
+/// `f` panics): the per-thread settings (kernel cap, column placement).
+pub(crate) fn scoped<T: Copy + 'static, R>(
+    key: &'static std::thread::LocalKey<std::cell::Cell<T>>,
+    v: T,
+    f: impl FnOnce() -> R,
+) -> R {
+    struct Restore<T: Copy + 'static>(&'static std::thread::LocalKey<std::cell::Cell<T>>, T);
+    impl<T: Copy + 'static> Drop for Restore<T> {
+        fn drop(&mut self) {
+            self.0.with(|c| c.set(self.1));
+        }
+    }
+    let _restore = Restore(key, key.with(|c| c.replace(v)));
+    f()
+}

@@ -61,14 +61,7 @@ thread_local! {
 /// Runs `f` with this thread's dispatch limited to kernels no wider than `cap` (to test or
 /// time a narrower kernel on a wider machine); the previous cap is restored afterwards.
 pub fn with_kernel_cap<R>(cap: Kernel, f: impl FnOnce() -> R) -> R {
-    struct Restore(Kernel);
-    impl Drop for Restore {
-        fn drop(&mut self) {
-            CAP.with(|c| c.set(self.0));
-        }
-    }
-    let _restore = Restore(CAP.with(|c| c.replace(cap)));
-    f()
+    crate::scoped(&CAP, cap, f)
 }
 
 /// The kernels this machine can run, narrowest first (`Scalar` always).
