@@ -6,7 +6,7 @@ use datapath::format::{F16Half, F32Native, FpOpts, Ieee};
 use datapath::rng::SplitMix64;
 use datapath::rti::{HitsSoa, RaysSoa, Rti, RtiConfig, TrisSoa};
 use datapath::simd::{rti_batch_f16, rti_batch_f32, Kernel};
-use datapath::slab::{BoxesSoa, Slab, SlabRaysSoa};
+use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa};
 use datapath::Format;
 use golden::{Ray64, Tri64};
 use serde::Serialize;
@@ -299,7 +299,6 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     // every box (the shape a node's or a level's children have)
     for (name, any) in [("f32", datapath::AnyFormat::F32(f32f)), ("fp16", datapath::AnyFormat::F16(f16f))] {
         datapath::with_format!(any, |f| {
-            use datapath::slab::{Slab, SlabConfig, SlabOutSoa};
             let s = Slab::new(f, SlabConfig::default());
             let (rs, bs) = slab_columns(&s, &cases);
             let mut out = SlabOutSoa::with_len(pairs);
@@ -319,11 +318,10 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     // streamed through L1-sized chunks gathered from the scene (gather included)
     {
         let big = 1 << 20;
-        let (rays, tris) = columns(&r32, &cases);
         let (mut br, mut bt) = (RaysSoa::with_capacity(big), TrisSoa::with_capacity(big));
         for i in 0..big {
-            br.push(&rays.get(i % pairs.max(1)));
-            bt.push(&tris.get(i % pairs.max(1)));
+            br.push(&rays32.get(i % pairs.max(1)));
+            bt.push(&tris32.get(i % pairs.max(1)));
         }
         let mut bo = HitsSoa::with_len(big);
         if pairs > 0 {
@@ -342,9 +340,9 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
                             let from = (range.start + k) % pairs;
                             let m = (pairs - from).min(range.len() - k);
                             let cols = rs.o.iter_mut().chain(&mut rs.d).chain([&mut rs.tmin, &mut rs.tmax]);
-                            let srcs = rays.o.iter().chain(&rays.d).chain([&rays.tmin, &rays.tmax]);
+                            let srcs = rays32.o.iter().chain(&rays32.d).chain([&rays32.tmin, &rays32.tmax]);
                             for (dst, src) in
-                                cols.chain(ts.v.iter_mut().flatten()).zip(srcs.chain(tris.v.iter().flatten()))
+                                cols.chain(ts.v.iter_mut().flatten()).zip(srcs.chain(tris32.v.iter().flatten()))
                             {
                                 dst[k..k + m].copy_from_slice(&src[from..from + m]);
                             }
@@ -362,10 +360,8 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     // system allocator puts such blocks), for the RTI and the slab pairs kernels
     if pairs > 0 && datapath::alloc::is_global() {
         use datapath::alloc::{with_placement, Placement};
-        use datapath::slab::{Slab, SlabConfig, SlabOutSoa};
         let mid = 1 << 17;
         let s = Slab::new(f32f, SlabConfig::default());
-        let (rays, tris) = columns(&r32, &cases);
         let (srays, sboxes) = slab_columns(&s, &cases);
         for (label, place) in
             [("staggered columns", Placement::Staggered), ("columns at one page offset", Placement::SamePageOffset)]
@@ -374,8 +370,8 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
                 let (mut br, mut bt) = (RaysSoa::with_capacity(mid), TrisSoa::with_capacity(mid));
                 let (mut sr, mut sb) = (SlabRaysSoa::default(), BoxesSoa::default());
                 for i in 0..mid {
-                    br.push(&rays.get(i % pairs));
-                    bt.push(&tris.get(i % pairs));
+                    br.push(&rays32.get(i % pairs));
+                    bt.push(&tris32.get(i % pairs));
                     sr.push(&srays.get(i % pairs));
                     sb.push(&sboxes.get(i % pairs));
                 }
