@@ -285,7 +285,8 @@ pub fn write(r: &Report, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf
 const ERR_FLOOR: f64 = 1e-7;
 
 /// One unit's plot: time per test against error rate, both on log scales, the Pareto front in
-/// red, each point labelled where its label overlaps no earlier one.
+/// red, every point labelled beside its dot where that overlaps no other dot or label, and
+/// named under the plot otherwise.
 fn plot(path: &std::path::Path, unit: &str, pts: &[&Point]) -> Result<(), String> {
     use plotters::prelude::*;
     let err = |e: &dyn std::fmt::Display| e.to_string();
@@ -305,7 +306,7 @@ fn plot(path: &std::path::Path, unit: &str, pts: &[&Point]) -> Result<(), String
     let mut chart = ChartBuilder::on(&root)
         .caption(format!("{unit}: time per test vs error (Pareto front in red)"), ("sans-serif", 18))
         .margin(14)
-        .x_label_area_size(40)
+        .x_label_area_size(56)
         .y_label_area_size(70)
         .build_cartesian_2d(xs, ys)
         .map_err(|e| err(&e))?;
@@ -329,38 +330,39 @@ fn plot(path: &std::path::Path, unit: &str, pts: &[&Point]) -> Result<(), String
     let mut front: Vec<(f64, f64)> = pts.iter().filter(|p| p.pareto).map(|p| (x(p), y(p))).collect();
     front.sort_by(|a, b| a.0.total_cmp(&b.0));
     chart.draw_series(LineSeries::new(front, RED.stroke_width(2))).map_err(|e| err(&e))?;
-    // labels: the first of a few offsets whose box overlaps no dot and no placed label, else
-    // none (the table names every point)
-    // (every dot is an obstacle from the start)
-    let mut placed: Vec<(i32, i32, i32, i32)> = pts
-        .iter()
-        .map(|p| {
-            let (px, py) = chart.backend_coord(&(x(p), y(p)));
-            (px - 5, py - 5, px + 5, py + 5)
-        })
-        .collect();
-    let mut order: Vec<&&Point> = pts.iter().collect();
-    order.sort_by(|a, b| (b.pareto, -a.ns_per_test).partial_cmp(&(a.pareto, -b.ns_per_test)).unwrap());
-    for p in order {
-        let c = if p.pareto { RED } else { BLUE };
-        let at = (x(p), y(p));
-        let (px, py) = chart.backend_coord(&at);
-        let (tw, th) = (6 * p.variant.chars().count() as i32, 12);
+    // labels: at the first of six offsets whose box overlaps no dot and no placed label; a
+    // point with none free is named in a line under the plot instead. The Pareto points are
+    // placed first, then the fastest
+    let at: Vec<(f64, f64)> = pts.iter().map(|p| (x(p), y(p))).collect();
+    let px: Vec<(i32, i32)> = at.iter().map(|c| chart.backend_coord(c)).collect();
+    let mut placed: Vec<(i32, i32, i32, i32)> = px.iter().map(|&(x, y)| (x - 5, y - 5, x + 5, y + 5)).collect();
+    let mut order: Vec<usize> = (0..pts.len()).collect();
+    order.sort_by(|&a, &b| pts[b].pareto.cmp(&pts[a].pareto).then(pts[a].ns_per_test.total_cmp(&pts[b].ns_per_test)));
+    let mut crowded = Vec::new();
+    for i in order {
+        let p = pts[i];
+        let ((x0, y0), (tw, th)) = (px[i], (6 * p.variant.chars().count() as i32, 12));
         let free = [(7, -6), (7, 6), (7, -18), (7, 18), (-tw - 7, -6), (-tw - 7, 6)].into_iter().find(|&(dx, dy)| {
-            let r = (px + dx, py + dy, px + dx + tw, py + dy + th);
+            let r = (x0 + dx, y0 + dy, x0 + dx + tw, y0 + dy + th);
             r.2 < w as i32 && r.0 > 0 && !placed.iter().any(|q| r.0 < q.2 && q.0 < r.2 && r.1 < q.3 && q.1 < r.3)
         });
-        let dot = EmptyElement::at(at) + Circle::new((0, 0), 4, c.filled());
+        let c = if p.pareto { RED } else { BLUE };
+        let dot = EmptyElement::at(at[i]) + Circle::new((0, 0), 4, c.filled());
         match free {
             Some((dx, dy)) => {
-                placed.push((px + dx, py + dy, px + dx + tw, py + dy + th));
+                placed.push((x0 + dx, y0 + dy, x0 + dx + tw, y0 + dy + th));
                 let label = Text::new(p.variant.clone(), (dx, dy), ("sans-serif", 11));
                 chart.draw_series(std::iter::once(dot + label)).map_err(|e| err(&e))?;
             }
             None => {
                 chart.draw_series(std::iter::once(dot)).map_err(|e| err(&e))?;
+                crowded.push(p.variant.as_str());
             }
         }
+    }
+    if !crowded.is_empty() {
+        let note = format!("not labelled (crowded): {}", crowded.join(", "));
+        root.draw(&Text::new(note, (14, h as i32 - 16), ("sans-serif", 10))).map_err(|e| err(&e))?;
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())

@@ -36,14 +36,21 @@ fn points_pareto_front_and_files() {
     let files = write(&r, &dir).unwrap();
     assert_eq!(files.len(), 4);
     assert!(std::fs::read_to_string(dir.join("report.md")).unwrap().contains("| rti | f32 | 32 |"));
-    // every point drawn, and labelled where its label overlaps no other (the table names all)
+    // every point drawn, and named: beside its dot, or in the line under the plot
     for unit in ["rti", "slab"] {
         let svg = std::fs::read_to_string(dir.join(format!("report_{unit}.svg"))).unwrap();
         let pts: Vec<&str> = r.points.iter().filter(|p| p.unit == unit).map(|p| p.variant.as_str()).collect();
         assert_eq!(svg.matches("<circle").count(), pts.len(), "{unit}");
         let texts: Vec<&str> =
             svg.split("<text").skip(1).filter_map(|t| t.split(['>', '<']).nth(1)).map(str::trim).collect();
-        assert!(texts.iter().any(|t| pts.contains(t)), "{unit}: no point labelled in {texts:?}");
+        let crowded: Vec<&str> = texts
+            .iter()
+            .filter_map(|t| t.strip_prefix("not labelled (crowded): "))
+            .flat_map(|l| l.split(", "))
+            .collect();
+        for v in &pts {
+            assert!(texts.contains(v) || crowded.contains(v), "{unit}: {v} not named in {texts:?}");
+        }
     }
     assert!(report(&ReportConfig { rays: 0, ..cfg.clone() }, &[Scene::builtin()]).is_err());
     assert!(report(&ReportConfig { variants: vec!["nope".into()], ..cfg }, &[Scene::builtin()]).is_err());
