@@ -153,7 +153,10 @@ pub fn explain_slab<F: Format>(
     let q = |x: f64| f.to_f64(f.from_f64(x));
     let (oq, dq) = (ray.o.map(q), ray.d.map(q));
     let g = golden::slab_f64(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi);
-    let exact = golden::slab_exact(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi);
+    let exact = match golden::slab_exact(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi) {
+        Some(e) => e.to_string(),
+        None => "none (a quantised origin or direction component is not finite)".into(),
+    };
     let _ = writeln!(t, "\nmodel : hit {} t_near {:e} t_far {:e}", out.hit, f.to_f64(out.t_near), f.to_f64(out.t_far));
     let _ = writeln!(
         t,

@@ -444,10 +444,11 @@ fn run() -> Result<bool, String> {
                 }
                 "slab" => {
                     let b = parse_list("--box", aabb.as_deref().ok_or("--unit slab needs --box")?, 6)?;
-                    let sc = SlabConfig::named(&variant)?;
                     let (lo, hi) = ([b[0], b[1], b[2]], [b[3], b[4], b[5]]);
-                    let text =
-                        with_format!(format, |f| raypipe::explain::explain_slab(&Slab::new(f, sc), &ray, lo, hi))?;
+                    let text = with_format!(format, |f| {
+                        let sc = SlabConfig::named_for(&variant, &f)?;
+                        raypipe::explain::explain_slab(&Slab::new(f, sc), &ray, lo, hi)
+                    })?;
                     print!("{text}");
                 }
                 other => return Err(format!("unknown unit '{other}'; units: rti, slab")),
@@ -608,7 +609,7 @@ fn run() -> Result<bool, String> {
             let cfg = raypipe::stress::StressConfig { formats: format, variants: variant, count: count as usize, seed };
             let rep = raypipe::stress::stress(&cfg)?;
             emit(json, &rep, raypipe::stress::render)?;
-            Ok(true)
+            Ok(rep.passed)
         }
         Some(Cmd::Stages { unit, div }) => {
             let d = match div.as_str() {

@@ -64,7 +64,7 @@ pub fn render<F: Format>(
     out: &Path,
 ) -> Result<RenderReport, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
-    let sc = SlabConfig::named(variant)?;
+    let sc = SlabConfig::named_for(variant, &f)?;
     let slab = Slab::new(f, sc);
     let rti = Rti::new(f, RtiConfig::default());
     let b = build(scene, leaf_size);

@@ -44,8 +44,10 @@ pub const RTI_STRESS: [(&str, &str); 13] = [
     ("inf_nan", "one input +inf, -inf or NaN (no exact decision; the model's hits are counted)"),
 ];
 
-/// Slab stress classes.
-pub const SLAB_STRESS: [(&str, &str); 8] = [
+/// Slab stress classes. The last seven hunt for the misses of a conservative variant at the
+/// edges of the format: reciprocals that overflow or lose precision, subtracts that overflow
+/// or saturate, and boxes at the format's maximum.
+pub const SLAB_STRESS: [(&str, &str); 15] = [
     ("origin_on_face", "origin on a face plane, a direction component +0 or -0"),
     ("grazing", "aimed at a face, edge or corner point of the box"),
     ("inside", "origin inside the box"),
@@ -54,7 +56,28 @@ pub const SLAB_STRESS: [(&str, &str); 8] = [
     ("tiny", "box of size 2^-20"),
     ("axis_parallel", "axis-parallel direction"),
     ("inf_nan", "one ray input +inf, -inf or NaN (no exact decision; the model's hits are counted)"),
+    ("subnormal_d", "a direction component of 1 to 8 smallest steps (subnormal; 1/d overflows), the box's slab on that axis at t in [0.5, 4]"),
+    ("tiny_d", "a direction component of 1 to 64 smallest normals (fixed point: steps), the box's slab at t in [0.5, 4]"),
+    ("huge_d", "a direction component within 2^4 of the format's maximum (1/d subnormal or a few steps), the box at t ~ 1/|d|"),
+    ("zero_inf_d", "direction components +0, -0, +inf or -inf (inf: no exact decision), origin inside, on a face or outside"),
+    ("near_max", "box planes and origin near +-max on one axis: plane minus origin overflows (floats) or saturates (fixed point)"),
+    ("max_planes", "box planes at exactly +-max on an axis, origin inside or outside"),
+    ("mixed_edges", "two of the above edges at once on different axes"),
 ];
+
+/// The format's scales the edge classes draw from: the least positive value `s`, the least
+/// normal `n` (fixed point: both the step) and the largest finite `m`.
+#[derive(Clone, Copy)]
+struct Scales {
+    s: f64,
+    n: f64,
+    m: f64,
+}
+
+fn scales<F: Format>(f: &F) -> Scales {
+    let e = datapath::format::edges(f);
+    Scales { s: e.least, n: e.min_normal, m: e.max }
+}
 
 /// Failures of one RTI class in one format.
 #[derive(Clone, Debug, Serialize)]
@@ -86,8 +109,14 @@ pub struct SlabStressRow {
     pub format: String,
     /// Variant.
     pub variant: String,
+    /// The variant promises never to miss in this format.
+    pub conservative: bool,
     /// Ray–box tests.
     pub tests: u64,
+    /// Cases whose box the format cannot store (fixed point beyond the range): not tested.
+    pub unstorable: u64,
+    /// Decided tests whose exact decision is a hit (the misses a conservative variant must not make).
+    pub exact_hits: u64,
     /// Non-finite ray input (no exact decision).
     pub undecided: u64,
     /// Exact hit of the unrounded box, model miss.
@@ -109,6 +138,10 @@ pub struct StressReport {
     pub rti: Vec<RtiStressRow>,
     /// Slab rows, class-major.
     pub slab: Vec<SlabStressRow>,
+    /// Format–variant pairs not run: the variant promises conservativeness the format cannot give.
+    pub refused: Vec<String>,
+    /// No variant that promises conservativeness missed a box the exact decision hits.
+    pub passed: bool,
 }
 
 /// One RTI case: a ray and candidate triangles; `mesh` marks a watertightness case.
@@ -299,7 +332,10 @@ fn rti_rows<F: Format>(f: F, cfg: &StressConfig) -> Vec<RtiStressRow> {
         .collect()
 }
 
-fn slab_case(class: usize, r: &mut SplitMix64) -> ([f64; 8], [f64; 3], [f64; 3]) {
+fn slab_case(class: usize, r: &mut SplitMix64, sc: Scales) -> ([f64; 8], [f64; 3], [f64; 3]) {
+    if class >= 8 {
+        return slab_edge_case(class, r, sc);
+    }
     let (scale, center) = match class {
         4 => ((-6f64).exp2(), unit(r).map(|x| 512.0 * x)),
         5 => ((-20f64).exp2(), [0.0; 3]),
@@ -354,11 +390,134 @@ fn slab_case(class: usize, r: &mut SplitMix64) -> ([f64; 8], [f64; 3], [f64; 3])
     ([o[0], o[1], o[2], d[0], d[1], d[2], 0.0, f64::INFINITY], lo, hi)
 }
 
-fn slab_rows<F: Format>(f: F, variant: &str, cfg: &StressConfig) -> Result<Vec<SlabStressRow>, String> {
+/// A random sign.
+fn sign(r: &mut SplitMix64) -> f64 {
+    if r.below(2) == 0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+/// The edge classes (8 and up): a ray that hits a box on the ordinary axes at t* and whose
+/// special axis (or two) is built from the format's scales.
+fn slab_edge_case(class: usize, r: &mut SplitMix64, sc: Scales) -> ([f64; 8], [f64; 3], [f64; 3]) {
+    // t stays well inside every format's range (q1.F holds t < 1)
+    let tcap = (sc.m / 2.0).min(8.0);
+    let (t1, t2) = {
+        let a = r.range(0.0625, 0.5) * tcap;
+        (a, a * r.range(1.0, 2.0))
+    };
+    let tmid = (t1 + t2) / 2.0;
+    // ordinary axes: a box of half-width w around the point the ray reaches at tmid
+    let w = (sc.m / 8.0).min(1.0) * r.range(0.05, 0.5);
+    let mut lo = [0.0; 3];
+    let mut hi = [0.0; 3];
+    let mut o = [0.0; 3];
+    let mut d = [0.0; 3];
+    for a in 0..3 {
+        let p = r.range(-0.5, 0.5) * w;
+        lo[a] = p - w;
+        hi[a] = p + w;
+        d[a] = r.range(-1.0, 1.0) * w / tcap;
+        o[a] = p - d[a] * tmid;
+    }
+    let kinds: Vec<usize> = if class == 14 {
+        let k1 = 8 + r.below(6) as usize;
+        let k2 = 8 + r.below(6) as usize;
+        vec![k1, k2]
+    } else {
+        vec![class]
+    };
+    let first = r.below(3) as usize;
+    for (j, &kind) in kinds.iter().enumerate() {
+        let a = (first + j) % 3;
+        match kind {
+            // tiny components: the slab at t in [t1, t2] scaled by d
+            8 | 9 => {
+                let k = if kind == 8 { sc.s * (1.0 + r.below(8) as f64) } else { sc.n * r.range(1.0, 64.0) };
+                let da = sign(r) * k;
+                d[a] = da;
+                o[a] = 0.0;
+                let (x, y) = (da * t1, da * t2);
+                (lo[a], hi[a]) = (x.min(y), x.max(y));
+            }
+            // huge components: the box at t ~ 1/|d|, i.e. one unit or so from the origin
+            10 => {
+                let da = sign(r) * sc.m * (-(r.range(0.0, 4.0))).exp2();
+                d[a] = da;
+                o[a] = 0.0;
+                let u = (sc.m / 4.0).min(2.0);
+                let (x, y) = (da.signum() * u * r.range(0.1, 0.5), da.signum() * u * r.range(0.5, 1.0));
+                (lo[a], hi[a]) = (x.min(y), x.max(y));
+            }
+            // zero and infinite components, the origin inside, on a face or outside
+            11 => {
+                d[a] = if r.below(10) < 7 { sign(r) * 0.0 } else { sign(r) * f64::INFINITY };
+                o[a] = match r.below(3) {
+                    0 => r.range(lo[a], hi[a]),
+                    1 => {
+                        if r.below(2) == 0 {
+                            lo[a]
+                        } else {
+                            hi[a]
+                        }
+                    }
+                    _ => hi[a] + w * r.range(0.01, 1.0),
+                };
+            }
+            // planes near +-max, the origin near the opposite end: b - o beyond the range
+            12 => {
+                let s = sign(r);
+                if r.below(2) == 0 {
+                    // a box beyond the middle, the origin near the opposite end
+                    let (x, y) = (r.range(0.3, 0.9) * sc.m, r.range(0.3, 0.9) * sc.m);
+                    (lo[a], hi[a]) = if s > 0.0 { (x.min(y), x.max(y)) } else { (-x.max(y), -x.min(y)) };
+                    o[a] = -s * r.range(0.3, 0.95) * sc.m;
+                } else {
+                    // a box across the middle, the origin on (or just before) its near plane:
+                    // the far plane's difference exceeds the range
+                    let (x, y) = (r.range(0.55, 0.95) * sc.m, r.range(0.55, 0.95) * sc.m);
+                    (lo[a], hi[a]) = (-x, y);
+                    let before = if r.below(2) == 0 { 0.0 } else { r.range(0.0, 0.04) * sc.m };
+                    o[a] = if s > 0.0 { lo[a] - before } else { hi[a] + before };
+                    // leave the slab just after tmid, and cross the other axes' slabs in a
+                    // narrow window around tmid: a shrunken exit misses them
+                    let far = if s > 0.0 { hi[a] } else { lo[a] };
+                    d[a] = ((far - o[a]) / (1.1 * tmid)).clamp(-sc.m, sc.m);
+                    if kinds.len() == 1 {
+                        for b in (0..3).filter(|&b| b != a) {
+                            d[b] = sign(r) * w * r.range(2.0, 4.0) / tmid;
+                            o[b] = (lo[b] + hi[b]) / 2.0 - d[b] * tmid;
+                        }
+                    }
+                    continue;
+                }
+                // reach the middle of the slab at tmid
+                d[a] = ((lo[a] + hi[a]) / 2.0 - o[a]) / tmid;
+                d[a] = d[a].clamp(-sc.m, sc.m);
+            }
+            // planes at exactly +-max
+            _ => {
+                (lo[a], hi[a]) = match r.below(3) {
+                    0 => (-sc.m, sc.m),
+                    1 => (r.range(0.0, 0.5) * sc.m, sc.m),
+                    _ => (-sc.m, -r.range(0.0, 0.5) * sc.m),
+                };
+                o[a] = if r.below(2) == 0 { r.range(lo[a], hi[a]) } else { -hi[a].signum() * r.range(0.5, 1.0) * sc.m };
+                d[a] = (((lo[a] + hi[a]) / 2.0 - o[a]) / tmid).clamp(-sc.m, sc.m);
+            }
+        }
+    }
+    ([o[0], o[1], o[2], d[0], d[1], d[2], 0.0, f64::INFINITY], lo, hi)
+}
+
+fn slab_rows<F: Format>(f: F, sc: SlabConfig, variant: &str, cfg: &StressConfig) -> Vec<SlabStressRow> {
     use rayon::prelude::*;
-    let s = Slab::new(f, SlabConfig::named(variant)?);
+    let s = Slab::new(f, sc);
+    let scl = scales(&f);
     let q = |x: f64| f.to_f64(f.from_f64(x));
-    Ok((0..SLAB_STRESS.len())
+    (0..SLAB_STRESS.len())
         .into_par_iter()
         .map(|class| {
             let mut r = class_rng(cfg.seed, 2, class);
@@ -366,18 +525,24 @@ fn slab_rows<F: Format>(f: F, variant: &str, cfg: &StressConfig) -> Result<Vec<S
                 class: SLAB_STRESS[class].0.into(),
                 format: f.name(),
                 variant: variant.into(),
+                conservative: sc.is_conservative(&f),
                 tests: 0,
                 undecided: 0,
+                unstorable: 0,
+                exact_hits: 0,
                 false_misses: 0,
                 false_hits: 0,
                 undecided_hits: 0,
             };
             for _ in 0..cfg.count {
-                let (x, lo, hi) = slab_case(class, &mut r);
+                let (x, lo, hi) = slab_case(class, &mut r, scl);
                 // the box corners as the format holds them, so that a point on a face (origin
                 // or aim) stays on it after quantisation; store_box keeps them exactly
                 let (lo, hi) = (lo.map(q), hi.map(q));
-                let Ok(b) = s.store_box(lo, hi) else { continue };
+                let Ok(b) = s.store_box(lo, hi) else {
+                    row.unstorable += 1;
+                    continue;
+                };
                 let sr = s.prepare([x[0], x[1], x[2]], [x[3], x[4], x[5]], x[6], x[7]);
                 let hit = s.test(&sr, &b).hit;
                 row.tests += 1;
@@ -387,13 +552,18 @@ fn slab_rows<F: Format>(f: F, variant: &str, cfg: &StressConfig) -> Result<Vec<S
                     row.undecided_hits += hit as u64;
                     continue;
                 }
-                let e = golden::slab_exact(oq, dq, q(x[6]), q(x[7]), lo, hi);
+                let Some(e) = golden::slab_exact(oq, dq, q(x[6]), q(x[7]), lo, hi) else {
+                    row.undecided += 1;
+                    row.undecided_hits += hit as u64;
+                    continue;
+                };
+                row.exact_hits += e as u64;
                 row.false_misses += (e && !hit) as u64;
                 row.false_hits += (!e && hit) as u64;
             }
             row
         })
-        .collect())
+        .collect()
 }
 
 /// Runs the suite.
@@ -403,13 +573,22 @@ pub fn stress(cfg: &StressConfig) -> Result<StressReport, String> {
     }
     let mut rti = Vec::new();
     let mut slab = Vec::new();
+    let mut refused = Vec::new();
+    for v in &cfg.variants {
+        SlabConfig::named(v)?;
+    }
     for f in &cfg.formats {
         rti.extend(with_format!(*f, |f| rti_rows(f, cfg)));
         for v in &cfg.variants {
-            slab.extend(with_format!(*f, |f| slab_rows(f, v, cfg))?);
+            let named = SlabConfig::named(v)?;
+            match with_format!(*f, |f| named.for_format(v, &f)) {
+                Ok(sc) => slab.extend(with_format!(*f, |f| slab_rows(f, sc, v, cfg))),
+                Err(why) => refused.push(why),
+            }
         }
     }
-    Ok(StressReport { seed: cfg.seed, count: cfg.count, rti, slab })
+    let passed = slab.iter().all(|x| !x.conservative || x.false_misses == 0);
+    Ok(StressReport { seed: cfg.seed, count: cfg.count, rti, slab, refused, passed })
 }
 
 /// The report as markdown tables.
@@ -422,12 +601,29 @@ pub fn render(r: &StressReport) -> String {
             x.class, x.format, x.tests, x.false_misses, x.false_hits, x.cracks, x.undecided, x.undecided_hits
         );
     }
-    s += "\n| slab class | format | variant | tests | false misses | false hits | undecided (model hits) |\n|---|---|---|---:|---:|---:|---:|\n";
+    s += "\n| slab class | format | variant | tests | exact hits | false misses | false hits | undecided (model hits) | unstorable |\n|---|---|---|---:|---:|---:|---:|---:|---:|\n";
     for x in &r.slab {
+        let flag = if x.conservative && x.false_misses > 0 { " VIOLATION" } else { "" };
         s += &format!(
-            "| {} | {} | {} | {} | {} | {} | {} ({}) |\n",
-            x.class, x.format, x.variant, x.tests, x.false_misses, x.false_hits, x.undecided, x.undecided_hits
+            "| {} | {} | {} | {} | {} | {}{flag} | {} | {} ({}) | {} |\n",
+            x.class,
+            x.format,
+            x.variant,
+            x.tests,
+            x.exact_hits,
+            x.false_misses,
+            x.false_hits,
+            x.undecided,
+            x.undecided_hits,
+            x.unstorable
         );
     }
+    for why in &r.refused {
+        s += &format!("\nnot run: {why}\n");
+    }
+    s += &format!(
+        "\nproperty (no conservative or directed variant misses a box the exact decision hits): {}\n",
+        if r.passed { "PASS" } else { "FAIL" }
+    );
     s
 }

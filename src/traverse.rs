@@ -119,6 +119,9 @@ pub fn rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray64> {
 /// Runs the equivalence check.
 pub fn traverse(cfg: &TraverseConfig, scene: &Scene) -> Result<TraverseReport, String> {
     let sc = SlabConfig::named(&cfg.variant)?;
+    for f in &cfg.formats {
+        with_format!(*f, |f| sc.for_format(&cfg.variant, &f).map(|_| ()))?;
+    }
     let b = build(scene, cfg.leaf_size);
     let hw = b.layout_ids(cfg.levels)?;
     let tree = b.golden_tree();

@@ -1197,7 +1197,14 @@ mod kernels {
             // end in NaN only if they start from a NaN t interval: a one-ray batch with a
             // number interval needs no NaN check per vector (take-on-false chains can take a
             // NaN plane and always check)
-            let check_nan = $tof || prep.4;
+            // the conservative variant's guard: a stage-1 subtract that overflowed is NaN in the
+            // model, and the plane it feeds is dropped; the kernel leaves it ±∞, which differs
+            // from dropping it only when it leaves t_near = +∞ or t_far = −∞. Lanes with a
+            // non-finite chain end (before widening) are marked NaN and redone by the model
+            // (the reciprocal's guard is applied when the ray is prepared)
+            let guard = s.cfg.guard;
+            let zero = $x::splat(0.0);
+            let check_nan = $tof || prep.4 || guard;
             let (r, model) = ($r, s);
             let mut nan_seen = 0;
             let mut i = 0;
@@ -1220,6 +1227,7 @@ mod kernels {
                         tf = $x::min(far, tf);
                     }
                 }
+                let ends = (tn, tf);
                 for _ in 0..widen.unsigned_abs() {
                     if widen > 0 {
                         tn = down(tn);
@@ -1228,6 +1236,10 @@ mod kernels {
                         tn = up(tn);
                         tf = down(tf);
                     }
+                }
+                if guard {
+                    let unbounded = $x::unord($x::mul(ends.0, zero), $x::mul(ends.1, zero));
+                    tn = $x::blend(tn, $x::canonical_nan(), unbounded);
                 }
                 // SAFETY: lanes i..i + L are in bounds.
                 unsafe { $x::flags(o_hit, i, $x::le(tn, tf)) };

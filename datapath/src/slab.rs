@@ -10,8 +10,37 @@
 //! `t_near` (widened) is the entry distance that orders children.
 //!
 //! Comparators are written out: no `min`/`max` (which treat NaN and ±0 in ways hardware does
-//! not). NaN arises only from `0 × ∞`: the origin exactly on a slab plane of an axis whose
-//! direction component is ±0 (`inv_d = ±∞`).
+//! not). With number inputs a NaN arises from `0 × ∞` (the origin exactly on a slab plane of
+//! an axis whose direction component is ±0, so `inv_d = ±∞`) and, in the `conservative`
+//! variant, from the guard (below); a NaN input (origin, direction, box, t interval) gives NaN
+//! signals too, and a NaN direction component can still hit (its axis is ignored).
+//!
+//! # Why `conservative` never misses (IEEE formats with gradual underflow)
+//! Write `t = (b − o)/d` for the exact plane distance of finite inputs and
+//! `t_c = (b ⊖ o) ⊗ (1 ⊘ d)` for the computed one (`⊗ (1 ⊘ d)` is one reciprocal and one
+//! multiply in both division modes: `1 ⊗ r = r`). Each rounding to nearest has relative error
+//! at most `u = 2^-(M+1)` while its result is a normal number, a subtract is exact when its
+//! result is subnormal, and a multiply whose result is subnormal adds at most half a
+//! subnormal step `s`. The **guard** (stage 0 and stage 1) removes the two cases where that
+//! model fails: a reciprocal of a finite nonzero `d` that is not a normal number (`1 ⊘ d`
+//! overflowed to ±∞, or is subnormal or zero: its error is absolute, not relative) and a
+//! subtract of finite operands that overflowed to ±∞. Either becomes the canonical NaN, the
+//! products it feeds are NaN, and the `Ignore` comparator drops them: that axis (reciprocal) or
+//! that plane (subtract) imposes no constraint, which only widens the interval. Every other
+//! finite product obeys `|t_c − t| ≤ γ₃|t| + s/2` with `γ₃ = 3u/(1 − 3u)`. Then
+//! `γ₃|t| + s/2 < 4 ulp(t_c)` for every computed `t_c`: for a normal `t_c`,
+//! `ulp(t_c) ≥ u|t_c|` and `|t| ≤ |t_c|/(1 − γ₃)`, so the error is below `3.01 u|t_c|`, and
+//! four steps toward −∞ from a power of two `2^e` still cover `4 · 2^(e−M−1) ≥ 3.01u·2^e`;
+//! for a subnormal `t_c`, steps are `s` and the error is below `1.5 s + s/2 = 2s`. A product
+//! that overflowed to ±∞ from finite factors has `|t|` above the largest finite value, so one
+//! step toward zero (±∞ → ±max) is already on the right side. Widening the accumulated
+//! `t_near` by 4 steps toward −∞ (IEEE nextDown) and `t_far` by 4 toward +∞ (nextUp) widens
+//! every candidate by at least its error (the steps are monotone), so the widened interval
+//! contains the exact one: an exact hit is never missed. A `d = ±0` axis is exact
+//! (`1 ⊘ ±0 = ±∞`, and `b ⊖ o` has the sign of `b − o` and is zero only when `b = o`, a NaN
+//! product the comparator drops: the closed box's face). Under flush-to-zero a subnormal
+//! difference becomes zero and the argument fails, and fixed point has no ∞ to overflow to:
+//! `conservative` refuses both (use `directed`).
 
 use crate::format::Format;
 use crate::probe::{NoProbe, Probe};
@@ -58,13 +87,15 @@ pub struct SlabConfig {
     /// Directed interval arithmetic instead of round-to-nearest (see [`Slab::trace_directed`]):
     /// conservative in every format, fixed point and flush-to-zero included.
     pub directed: bool,
+    /// The conservative variant's guard (IEEE float formats only; no effect in fixed point): a
+    /// reciprocal `1 ⊘ d` of a finite nonzero `d` that is not a normal number, and a stage-1
+    /// subtract of finite operands that overflowed to ±∞, become the canonical NaN (see the
+    /// module docs).
+    pub guard: bool,
 }
 
-/// Widening that makes the float slab test conservative: the exact t = (b − o)/d and the
-/// computed ((b ⊖ o) ⊗ (1 ⊘ d)) differ by at most γ₃·|t| (three roundings, IEEE subnormals
-/// add at most half a subnormal step each) and γ₃|t| < 4 ulp(t_c) for every computed t_c —
-/// including just below a power of two and across a binade step-down (steps there are halved
-/// but 4 of them still cover 3u·2^e·(1+γ₃)). Overflow to ∞ only widens the interval.
+/// Widening that, with the guard, makes the float slab test conservative (the proof is in the
+/// module docs): every guarded computed distance is within 4 grid steps of the exact one.
 pub const CONSERVATIVE_ULPS: i32 = 4;
 
 /// The stage table of the round-to-nearest slab datapath (variants plain, conservative,
@@ -80,6 +111,8 @@ pub const SLAB_TABLE: [SigDef; 39] = [
     s(0, "inv_dx", Op::Div, "one", "pdx"),
     s(0, "inv_dy", Op::Div, "one", "pdy"),
     s(0, "inv_dz", Op::Div, "one", "pdz"),
+    // (guard, conservative only: 1 ⊘ pd of a finite nonzero pd that is not a normal number
+    // is the canonical NaN; a subtract of finite operands that gives ±∞ is the canonical NaN)
     s(1, "lox", Op::Sub, "minx", "ox"),
     s(1, "hix", Op::Sub, "maxx", "ox"),
     s(1, "loy", Op::Sub, "miny", "oy"),
@@ -103,14 +136,18 @@ pub const SLAB_TABLE: [SigDef; 39] = [
     l(3, "farz", "negz ? tloz : thiz"),
     l(4, "tn_x", "selnear(tmin, nearx)"),
     l(4, "tn_xy", "selnear(tn_x, neary)"),
-    l(4, "t_near", "selnear(tn_xy, nearz)"),
+    l(4, "tn_xyz", "selnear(tn_xy, nearz)"),
     l(4, "tf_x", "selfar(tmax, farx)"),
     l(4, "tf_xy", "selfar(tf_x, fary)"),
-    l(4, "t_far", "selfar(tf_xy, farz)"),
-    l(5, "near_w", "t_near stepped down widen_ulps times (up if negative)"),
-    l(5, "far_w", "t_far stepped up widen_ulps times (down if negative)"),
-    l(6, "hit", "near_w <= far_w"),
+    l(4, "tf_xyz", "selfar(tf_xy, farz)"),
+    l(5, "t_near", "tn_xyz stepped widen_ulps times toward −∞ (IEEE nextDown; toward +∞, nextUp, if widen_ulps < 0)"),
+    l(5, "t_far", "tf_xyz stepped widen_ulps times toward +∞ (IEEE nextUp; toward −∞, nextDown, if widen_ulps < 0)"),
+    l(6, "hit", "t_near <= t_far"),
 ];
+
+/// The rules of the grid steps of stage 5 (and of the directed variant), in words: what
+/// nextUp / nextDown return at the special values.
+pub const STEP_RULES: &str = "nextUp(x) is the least format value greater than x and nextDown(x) the greatest value less than x (IEEE 754 nextUp/nextDown: toward +inf and toward -inf, whatever the sign of x); nextUp(+inf) = +inf, nextDown(-inf) = -inf, nextUp(-inf) = -max, nextDown(+inf) = +max; nextUp(+0) = nextUp(-0) = the least positive value (the smallest subnormal, or under FTZ the smallest normal) and nextDown(±0) its negative; a NaN stays the same NaN (bits unchanged); under FTZ the subnormals are skipped (nextDown of the smallest positive normal is +0, nextUp of its negative is -0); fixed point: plus or minus one step, the most positive and most negative values unchanged";
 
 const fn s(stage: u8, name: &'static str, op: Op, a: &'static str, b: &'static str) -> SigDef {
     SigDef { stage, name, op, a, b, note: "" }
@@ -125,12 +162,13 @@ pub const SLAB_VARIANTS: [&str; 5] = ["plain", "conservative", "directed", "take
 
 impl SlabConfig {
     /// Whether this variant promises zero false misses in format `f`: the directed variant in
-    /// every format that does not wrap; ulp widening by at least [`CONSERVATIVE_ULPS`] in float
-    /// formats with IEEE subnormals.
+    /// every format that does not wrap; the guarded ulp widening by at least
+    /// [`CONSERVATIVE_ULPS`] in float formats with IEEE subnormals.
     pub fn is_conservative<F: Format>(&self, f: &F) -> bool {
         let float = matches!(f.kind(), crate::format::FormatKind::Float(_));
         (self.directed && !f.wraps())
             || (!self.directed
+                && self.guard
                 && self.nan == SlabNan::Ignore
                 && self.prep == DirPrep::Plain
                 && self.widen_ulps >= CONSERVATIVE_ULPS
@@ -138,13 +176,50 @@ impl SlabConfig {
                 && !f.flushes())
     }
 
+    /// Whether this variant promises conservativeness at all (it is `directed` or guarded):
+    /// such a variant must keep its promise in every format it accepts.
+    pub fn promises_conservative(&self) -> bool {
+        self.directed || self.guard
+    }
+
+    /// The variant for format `f`, or a clear refusal when it promises conservativeness that
+    /// `f` cannot give (`conservative` in fixed point or under flush-to-zero, `directed` in a
+    /// wrapping fixed-point format).
+    pub fn for_format<F: Format>(self, name: &str, f: &F) -> Result<Self, String> {
+        if self.promises_conservative() && !self.is_conservative(f) {
+            let why = if self.directed {
+                "wrapping fixed point has no bound that survives a wrap-around (use :saturate)"
+            } else if f.flushes() {
+                "under flush-to-zero a subnormal difference becomes 0 and 4 grid steps no longer bound the error (use directed)"
+            } else {
+                "fixed point has no infinity for an overflow to reach (use directed)"
+            };
+            return Err(format!("the {name} slab variant is not conservative in {}: {why}", f.name()));
+        }
+        Ok(self)
+    }
+
+    /// The named variants that format `f` accepts (see [`SlabConfig::for_format`]).
+    pub fn variants_for<F: Format>(f: &F) -> Vec<&'static str> {
+        SLAB_VARIANTS
+            .iter()
+            .copied()
+            .filter(|v| SlabConfig::named(v).and_then(|c| c.for_format(v, f)).is_ok())
+            .collect()
+    }
+
+    /// A named variant for format `f` ([`SlabConfig::named`], then [`SlabConfig::for_format`]).
+    pub fn named_for<F: Format>(name: &str, f: &F) -> Result<Self, String> {
+        Self::named(name)?.for_format(name, f)
+    }
+
     /// A named variant (see [`SLAB_VARIANTS`]).
     pub fn named(name: &str) -> Result<Self, String> {
-        let c = |nan, prep, widen_ulps| Ok(SlabConfig { nan, prep, widen_ulps, directed: false });
+        let c = |nan, prep, widen_ulps| Ok(SlabConfig { nan, prep, widen_ulps, directed: false, guard: false });
         match name {
             "plain" => c(SlabNan::Ignore, DirPrep::Plain, 0),
             "directed" => Ok(SlabConfig { directed: true, ..SlabConfig::default() }),
-            "conservative" => c(SlabNan::Ignore, DirPrep::Plain, CONSERVATIVE_ULPS),
+            "conservative" => Ok(SlabConfig { guard: true, ..c(SlabNan::Ignore, DirPrep::Plain, CONSERVATIVE_ULPS)? }),
             "take-on-false" => c(SlabNan::TakeOnFalse, DirPrep::Plain, 0),
             "embree" => c(SlabNan::Ignore, DirPrep::Embree, 0),
             other => Err(format!("unknown slab variant '{other}'; variants: {}", SLAB_VARIANTS.join(", "))),
@@ -154,7 +229,7 @@ impl SlabConfig {
 
 impl Default for SlabConfig {
     fn default() -> Self {
-        Self { nan: SlabNan::Ignore, prep: DirPrep::Plain, widen_ulps: 0, directed: false }
+        Self { nan: SlabNan::Ignore, prep: DirPrep::Plain, widen_ulps: 0, directed: false, guard: false }
     }
 }
 
@@ -173,11 +248,8 @@ pub struct SlabRay<V> {
     pub inv_lo: [V; 3],
     /// Directed variant: an upper bound of 1/d per axis.
     pub inv_hi: [V; 3],
-    /// Directed variant: the axis is treated as parallel (d = 0; in fixed point also a saturated 1/d).
+    /// Directed variant: the axis is treated as parallel (d reads as ±0).
     pub parallel: [bool; 3],
-    /// Directed variant, fixed point: 1/d saturated, so its far end (`inv_hi` for d > 0,
-    /// `inv_lo` for d < 0) stands for ±∞.
-    pub inv_inf: [bool; 3],
 }
 
 /// An axis-aligned box.
@@ -268,9 +340,17 @@ impl<F: Format> Slab<F> {
             }
         };
         let (pdx, pdy, pdz) = (prep(dx), prep(dy), prep(dz));
-        let inv_dx = f.div(one, pdx);
-        let inv_dy = f.div(one, pdy);
-        let inv_dz = f.div(one, pdz);
+        let guard = self.guard_layout();
+        let recip = |d: F::V| {
+            let r = f.div(one, d);
+            match guard {
+                Some(l) if guarded_recip(l, f.to_bits(d), f.to_bits(r)) => f.from_bits(l.canonical_nan()),
+                _ => r,
+            }
+        };
+        let inv_dx = recip(pdx);
+        let inv_dy = recip(pdy);
+        let inv_dz = recip(pdz);
         record!(p; dx, dy, dz, pdx, pdy, pdz, inv_dx, inv_dy, inv_dz);
         let inv = [inv_dx, inv_dy, inv_dz];
         let mut ray = SlabRay {
@@ -281,20 +361,24 @@ impl<F: Format> Slab<F> {
             inv_lo: inv,
             inv_hi: inv,
             parallel: [false; 3],
-            inv_inf: [false; 3],
         };
         if self.cfg.directed {
-            let fixed = matches!(f.kind(), crate::format::FormatKind::Fixed { .. });
             let (top, bottom) = (f.from_f64(f64::INFINITY), f.from_f64(f64::NEG_INFINITY));
+            // a fixed format without 1 (q1.F) holds no reciprocal of any of its values but
+            // -1's: |1/d| >= 1 > max, so 1/d is bracketed by the saturation value
+            let no_one = f.to_f64(one) != 1.0;
             let d = [dx, dy, dz];
             for a in 0..3 {
-                let bits = f.to_bits(inv[a]);
-                let saturated = fixed && (bits == f.to_bits(top) || bits == f.to_bits(bottom));
-                ray.inv_inf[a] = saturated;
                 let zero = f.le(d[a], f.zero()) && f.le(f.zero(), d[a]);
                 ray.parallel[a] = zero;
-                ray.inv_lo[a] = f.next_down(inv[a]);
-                ray.inv_hi[a] = f.next_up(inv[a]);
+                if no_one {
+                    let end = if f.sign_bit(d[a]) { bottom } else { top };
+                    ray.inv_lo[a] = end;
+                    ray.inv_hi[a] = end;
+                } else {
+                    ray.inv_lo[a] = f.next_down(inv[a]);
+                    ray.inv_hi[a] = f.next_up(inv[a]);
+                }
             }
             let [inv_lox, inv_loy, inv_loz] = ray.inv_lo;
             let [inv_hix, inv_hiy, inv_hiz] = ray.inv_hi;
@@ -308,6 +392,26 @@ impl<F: Format> Slab<F> {
     /// Stage 0 without probing.
     pub fn prepare(&self, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64) -> SlabRay<F::V> {
         self.prepare_trace(o, d, tmin, tmax, &mut NoProbe)
+    }
+
+    /// The float layout the guard checks against, when the guard is on and the format is a float.
+    #[inline(always)]
+    fn guard_layout(&self) -> Option<crate::format::FloatLayout> {
+        match (self.cfg.guard, self.fmt.kind()) {
+            (true, crate::format::FormatKind::Float(l)) => Some(l),
+            _ => None,
+        }
+    }
+
+    /// A stage-1 subtract `a ⊖ b`, guarded: the canonical NaN if finite operands overflowed.
+    #[inline(always)]
+    fn sub_guarded(&self, g: Option<crate::format::FloatLayout>, a: F::V, b: F::V) -> F::V {
+        let f = &self.fmt;
+        let r = f.sub(a, b);
+        match g {
+            Some(l) if guarded_sub(l, f.to_bits(a), f.to_bits(b), f.to_bits(r)) => f.from_bits(l.canonical_nan()),
+            _ => r,
+        }
     }
 
     /// Embree's δ for this format: 2 ⊘ max-finite, rounded up (1/δ = max/2 stays finite).
@@ -369,13 +473,14 @@ impl<F: Format> Slab<F> {
         let f = &self.fmt;
         let [ox, oy, oz] = r.o;
         let [ix, iy, iz] = r.inv_d;
-        // stage 1: six subtracts
-        let lox = f.sub(b.min[0], ox);
-        let hix = f.sub(b.max[0], ox);
-        let loy = f.sub(b.min[1], oy);
-        let hiy = f.sub(b.max[1], oy);
-        let loz = f.sub(b.min[2], oz);
-        let hiz = f.sub(b.max[2], oz);
+        // stage 1: six subtracts (guarded in the conservative variant)
+        let g = self.guard_layout();
+        let lox = self.sub_guarded(g, b.min[0], ox);
+        let hix = self.sub_guarded(g, b.max[0], ox);
+        let loy = self.sub_guarded(g, b.min[1], oy);
+        let hiy = self.sub_guarded(g, b.max[1], oy);
+        let loz = self.sub_guarded(g, b.min[2], oz);
+        let hiz = self.sub_guarded(g, b.max[2], oz);
         record!(p; lox, hix, loy, hiy, loz, hiz);
         // stage 2: six multiplies
         let tlox = f.mul(lox, ix);
@@ -395,47 +500,66 @@ impl<F: Format> Slab<F> {
         // stage 4: the compare unit, accumulating from tmin / tmax in axis order x, y, z
         let tn_x = self.near_sel(r.tmin, nearx);
         let tn_xy = self.near_sel(tn_x, neary);
-        let t_near = self.near_sel(tn_xy, nearz);
+        let tn_xyz = self.near_sel(tn_xy, nearz);
         let tf_x = self.far_sel(r.tmax, farx);
         let tf_xy = self.far_sel(tf_x, fary);
-        let t_far = self.far_sel(tf_xy, farz);
-        record!(p; tn_x, tn_xy, t_near, tf_x, tf_xy, t_far);
-        // stage 5: widening (conservative variants)
-        let (mut near_w, mut far_w) = (t_near, t_far);
+        let tf_xyz = self.far_sel(tf_xy, farz);
+        record!(p; tn_x, tn_xy, tn_xyz, tf_x, tf_xy, tf_xyz);
+        // stage 5: widening (conservative variants): t_near toward −∞, t_far toward +∞
+        let (mut t_near, mut t_far) = (tn_xyz, tf_xyz);
         for _ in 0..self.cfg.widen_ulps.unsigned_abs() {
             if self.cfg.widen_ulps > 0 {
-                near_w = f.next_down(near_w);
-                far_w = f.next_up(far_w);
+                t_near = f.next_down(t_near);
+                t_far = f.next_up(t_far);
             } else {
-                near_w = f.next_up(near_w);
-                far_w = f.next_down(far_w);
+                t_near = f.next_up(t_near);
+                t_far = f.next_down(t_far);
             }
         }
-        record!(p; near_w, far_w);
+        record!(p; t_near, t_far);
         // stage 6: decision
-        let hit = f.le(near_w, far_w);
+        let hit = f.le(t_near, t_far);
         record_flags!(p; hit);
-        SlabOut { hit, t_near: near_w, t_far: far_w }
+        SlabOut { hit, t_near, t_far }
     }
 
     /// The directed variant: interval arithmetic in the format's own operations, conservative
-    /// in every format. Stage 0 adds `1/d` bounds `inv_lo = next_down(1 ⊘ d)`,
-    /// `inv_hi = next_up(1 ⊘ d)` and a parallel flag per axis (d = 0; in fixed point also a
-    /// saturated 1/d). Stage 1 brackets each plane distance: `lo = next_down(b ⊖ o)`,
-    /// `hi = next_up(b ⊖ o)` (one rounded subtract, then ±1 step: the exact difference lies
-    /// within one step of any rounding, flushes included). Stage 2 forms, with 6 multiplies,
-    /// a lower bound of the entry plane's t and an upper bound of the exit plane's t, picking
+    /// in every format that does not wrap. Stage 0 adds `1/d` bounds `inv_lo = nextDown(1 ⊘ d)`,
+    /// `inv_hi = nextUp(1 ⊘ d)` (in a fixed format without 1, q1.F, both are the saturation
+    /// value of d's sign: |1/d| ≥ 1 exceeds the range) and a parallel flag per axis (d reads
+    /// as ±0). Stage 1 brackets each plane distance: `lo = nextDown(b ⊖ o)`,
+    /// `hi = nextUp(b ⊖ o)` (one rounded subtract, then one step: the exact difference lies
+    /// within one step of any rounding, flushes included). Stage 2 forms, with 6 multiplies, a
+    /// lower bound of the entry plane's t and an upper bound of the exit plane's t, picking
     /// the bracket ends by sign (entry plane = min plane when d > 0, max plane when d < 0) and
-    /// stepping each product outward once more. Stage 4 accumulates with the `Ignore`
-    /// comparator (a NaN, possible only as 0 × ∞, drops that constraint: conservative); a
-    /// parallel axis adds no constraint when `min <= o <= max` and forces a miss otherwise.
-    /// Saturated fixed-point values stay bounds: a saturated lower bound is below the true
-    /// value, and an upper bound saturated at the format's maximum still reaches `tmax`.
+    /// stepping each product outward once more (nextDown / nextUp).
+    ///
+    /// **Unbounded ends.** A lower bracket end equal to the format's most negative value
+    /// (−∞ in floats, the most negative encoding in fixed point) stands for −∞, and an upper
+    /// end equal to the most positive value (+∞, or the most positive encoding) for +∞: a
+    /// saturated or overflowed result is only known to lie beyond. When a product's factor is
+    /// such an end, the product is not formed: the entry bound is the most negative value and
+    /// the exit bound the most positive (no constraint; `0 × ∞` is also covered). With the
+    /// signs fixed by d, these are the only values the product could bound.
+    ///
+    /// Why this never misses: the exact `t = (b − o)·(1/d)` with `b − o ∈ [lo, hi]` and
+    /// `1/d ∈ [inv_lo, inv_hi]` of d's sign; for d > 0 and `lo ≥ 0`, `t ≥ lo·(1/d) ≥ lo·inv_lo`,
+    /// for `lo < 0`, `t ≥ lo·inv_hi` (and mirrored for d < 0 and for the exit), and a rounded
+    /// product stepped outward once is on the far side of the exact product. A product that
+    /// saturates stays a bound where it matters: a saturated entry bound at the most positive
+    /// value is still below the exact t, and one at the most negative value is below `tmin`
+    /// (likewise for the exit and `tmax`). Stage 4 accumulates with the `Ignore` comparator
+    /// (a NaN, possible only from a NaN input, drops that constraint); a parallel axis adds
+    /// no constraint when `min <= o <= max` and forces a miss otherwise.
     pub fn trace_directed<P: Probe<F::V>>(&self, r: &SlabRay<F::V>, b: &Aabb<F::V>, p: &mut P) -> SlabOut<F::V> {
         let f = &self.fmt;
         let mut near = r.tmin;
         let mut far = r.tmax;
         let mut outside = false;
+        let (top, bottom) = (f.from_f64(f64::INFINITY), f.from_f64(f64::NEG_INFINITY));
+        // an upper end standing for +∞, a lower end standing for −∞
+        let up_inf = |v: F::V| f.to_bits(v) == f.to_bits(top);
+        let lo_inf = |v: F::V| f.to_bits(v) == f.to_bits(bottom);
         for a in 0..3 {
             let o = r.o[a];
             if r.parallel[a] {
@@ -453,32 +577,17 @@ impl<F: Format> Slab<F> {
             let dxp = f.sub(px, o);
             let (de_lo, de_hi) = (f.next_down(de), f.next_up(de));
             let (dx_lo, dx_hi) = (f.next_down(dxp), f.next_up(dxp));
-            // lower bound of de·inv: inv > 0 → smallest de, inv < 0 → largest de; then the inv
-            // end by that product's sign. `true` marks the end of 1/d that is far from zero.
-            let (x_e, (inv_e, far_e)) = if neg {
-                (de_hi, if f.sign_bit(de_hi) { (r.inv_hi[a], false) } else { (r.inv_lo[a], true) })
-            } else {
-                (de_lo, if f.sign_bit(de_lo) { (r.inv_hi[a], true) } else { (r.inv_lo[a], false) })
-            };
-            // upper bound of dx·inv: inv > 0 → largest dx, inv < 0 → smallest dx
-            let (x_x, (inv_x, far_x)) = if neg {
-                (dx_lo, if f.sign_bit(dx_lo) { (r.inv_lo[a], true) } else { (r.inv_hi[a], false) })
-            } else {
-                (dx_hi, if f.sign_bit(dx_hi) { (r.inv_lo[a], false) } else { (r.inv_hi[a], true) })
-            };
-            // a saturated 1/d: its far end is ±∞, so the product saturates by the signs
-            let (top, bottom) = (f.from_f64(f64::INFINITY), f.from_f64(f64::NEG_INFINITY));
-            let inf_prod = |x: F::V| {
-                if f.le(x, f.zero()) && f.le(f.zero(), x) {
-                    f.zero()
-                } else if f.sign_bit(x) != neg {
-                    bottom
-                } else {
-                    top
-                }
-            };
-            let t_entry = if r.inv_inf[a] && far_e { inf_prod(x_e) } else { f.next_down(f.mul(x_e, inv_e)) };
-            let t_exit = if r.inv_inf[a] && far_x { inf_prod(x_x) } else { f.next_up(f.mul(x_x, inv_x)) };
+            // lower bound of de·(1/d): d > 0 → the smallest de, d < 0 → the largest; then the
+            // 1/d end by that factor's sign. Each factor with "is it an unbounded end".
+            let (x_e, x_e_inf) = if neg { (de_hi, up_inf(de_hi)) } else { (de_lo, lo_inf(de_lo)) };
+            let (inv_e, inv_e_inf) =
+                if f.sign_bit(x_e) { (r.inv_hi[a], up_inf(r.inv_hi[a])) } else { (r.inv_lo[a], lo_inf(r.inv_lo[a])) };
+            // upper bound of dx·(1/d): d > 0 → the largest dx, d < 0 → the smallest
+            let (x_x, x_x_inf) = if neg { (dx_lo, lo_inf(dx_lo)) } else { (dx_hi, up_inf(dx_hi)) };
+            let (inv_x, inv_x_inf) =
+                if f.sign_bit(x_x) { (r.inv_lo[a], lo_inf(r.inv_lo[a])) } else { (r.inv_hi[a], up_inf(r.inv_hi[a])) };
+            let t_entry = if x_e_inf || inv_e_inf { bottom } else { f.next_down(f.mul(x_e, inv_e)) };
+            let t_exit = if x_x_inf || inv_x_inf { top } else { f.next_up(f.mul(x_x, inv_x)) };
             if P::ON {
                 p.value(["entry_x", "entry_y", "entry_z"][a], t_entry);
                 p.value(["exit_x", "exit_y", "exit_z"][a], t_exit);
@@ -605,8 +714,6 @@ pub struct SlabRaysSoa<V> {
     pub inv_hi: [Vec<V>; 3],
     /// Parallel-axis flag columns (directed variant).
     pub parallel: [Vec<bool>; 3],
-    /// Saturated-reciprocal flag columns (directed variant, fixed point).
-    pub inv_inf: [Vec<bool>; 3],
     /// tmin column.
     pub tmin: Vec<V>,
     /// tmax column.
@@ -622,7 +729,6 @@ impl<V: Copy> SlabRaysSoa<V> {
             self.inv_lo[a].push(r.inv_lo[a]);
             self.inv_hi[a].push(r.inv_hi[a]);
             self.parallel[a].push(r.parallel[a]);
-            self.inv_inf[a].push(r.inv_inf[a]);
         }
         self.tmin.push(r.tmin);
         self.tmax.push(r.tmax);
@@ -638,7 +744,6 @@ impl<V: Copy> SlabRaysSoa<V> {
             inv_lo: [self.inv_lo[0][i], self.inv_lo[1][i], self.inv_lo[2][i]],
             inv_hi: [self.inv_hi[0][i], self.inv_hi[1][i], self.inv_hi[2][i]],
             parallel: [self.parallel[0][i], self.parallel[1][i], self.parallel[2][i]],
-            inv_inf: [self.inv_inf[0][i], self.inv_inf[1][i], self.inv_inf[2][i]],
         }
     }
 }
@@ -693,4 +798,17 @@ impl<V: Copy + Default> SlabOutSoa<V> {
         self.t_near[i] = o.t_near;
         self.t_far[i] = o.t_far;
     }
+}
+
+/// The guard's reciprocal rule on encodings: `d` finite and nonzero, `1 ⊘ d` not a normal
+/// number (±∞, ±0 or subnormal).
+pub fn guarded_recip(l: crate::format::FloatLayout, d: u64, r: u64) -> bool {
+    let finite = |b: u64| !l.is_nan(b) && !l.is_inf(b);
+    finite(d) && !l.is_zero(d) && (l.is_inf(r) || l.is_zero(r) || l.is_subnormal(r))
+}
+
+/// The guard's subtract rule on encodings: both operands finite, the difference ±∞.
+pub fn guarded_sub(l: crate::format::FloatLayout, a: u64, b: u64, r: u64) -> bool {
+    let finite = |x: u64| !l.is_nan(x) && !l.is_inf(x);
+    finite(a) && finite(b) && l.is_inf(r)
 }

@@ -1,5 +1,7 @@
 //! Per-operation verification of every number format against independent oracles:
-//! Berkeley SoftFloat (binary16, binary32) and exact rationals (every float layout, fixed point).
+//! `rustc_apfloat` (the Rust port of LLVM's APFloat: binary16, binary32, bfloat16 and custom
+//! `eEmM` layouts through its `Semantics` trait), exact rationals (every float layout, fixed
+//! point) and, with `--features softfloat` (its build needs cmake), Berkeley SoftFloat.
 //! Cases are TestFloat-style: tables of special exponents and significand patterns, then seeded
 //! random operands (uniform bits, near exponents for cancellation and ties, sparse significands).
 
@@ -12,7 +14,8 @@ use datapath::format::{
 use datapath::rng::SplitMix64;
 use num_rational::BigRational;
 use oracle::{Fx, Op, OPS};
-use softfloat_wrapper::{Float as _, RoundingMode, F16 as Sf16, F32 as Sf32};
+use rustc_apfloat::ieee::{BFloat, Half, IeeeFloat, Semantics, Single};
+use rustc_apfloat::{Float as _, Round};
 
 const SEED: u64 = 0x5eed_0001;
 
@@ -123,54 +126,150 @@ fn fp16_and_f32_match_exact_rationals() {
     check_against_rationals(&Ieee::new(F32Native, divide()), 5000);
 }
 
-/// One SoftFloat operation, nearest-even.
-fn sf_apply<T: softfloat_wrapper::Float>(op: Op, x: T, y: T) -> T {
-    let rm = RoundingMode::TiesToEven;
-    match op {
-        Op::Add => x.add(y, rm),
-        Op::Sub => x.sub(y, rm),
-        Op::Mul => x.mul(y, rm),
-        Op::Div => x.div(y, rm),
-    }
+/// One APFloat operation, nearest-even, on encodings.
+fn ap_op<T: rustc_apfloat::Float>(op: Op, a: u64, b: u64) -> u64 {
+    let (x, y) = (T::from_bits(a as u128), T::from_bits(b as u128));
+    let r = Round::NearestTiesToEven;
+    let v = match op {
+        Op::Add => x.add_r(y, r),
+        Op::Sub => x.sub_r(y, r),
+        Op::Mul => x.mul_r(y, r),
+        Op::Div => x.div_r(y, r),
+    };
+    v.value.to_bits() as u64
 }
 
-fn sf_op16(op: Op, a: u64, b: u64) -> u64 {
-    sf_apply(op, Sf16::from_bits(a as u16), Sf16::from_bits(b as u16)).to_bits() as u64
+/// APFloat semantics for a custom `eEmM` layout (1 + E + M bits).
+macro_rules! ap_layout {
+    ($name:ident, $bits:literal, $exp:literal) => {
+        struct $name;
+        impl Semantics for $name {
+            const BITS: usize = $bits;
+            const EXP_BITS: usize = $exp;
+        }
+    };
 }
+ap_layout!(E8M16, 25, 8);
+ap_layout!(E5M2, 8, 5);
+ap_layout!(E6M9, 16, 6);
+ap_layout!(E4M3, 8, 4);
+ap_layout!(E3M20, 24, 3);
 
-fn sf_op32(op: Op, a: u64, b: u64) -> u64 {
-    sf_apply(op, Sf32::from_bits(a as u32), Sf32::from_bits(b as u32)).to_bits() as u64
-}
-
-/// SoftFloat returns its own default NaN and payloads; ours is the canonical NaN: compare NaN-ness
-/// and require the canonical encoding, otherwise compare bits.
-fn check_against_softfloat<B: IeeeBackend>(f: &Ieee<B>, sf: fn(Op, u64, u64) -> u64, n: usize) {
+/// An independent oracle returns its own NaNs and payloads; ours is the canonical NaN: compare
+/// NaN-ness and require the canonical encoding, otherwise compare bits.
+fn check_against_oracle<B: IeeeBackend>(f: &Ieee<B>, oracle: fn(Op, u64, u64) -> u64, name: &str, n: usize) {
     let l = f.backend.layout();
     let mut failures = Vec::new();
     let mut count = 0u64;
     for (a, b) in all_cases(l, n, SEED ^ 0x5f) {
         for op in OPS {
             let got = f.to_bits(apply(f, op, f.from_bits(a), f.from_bits(b)));
-            let want = sf(op, a, b);
+            let want = oracle(op, a, b);
             let ok = if l.is_nan(want) { got == l.canonical_nan() } else { got == want };
             count += 1;
             if !ok && failures.len() < 10 {
-                failures.push(format!("{} {op:?} {a:#x} {b:#x}: got {got:#x} softfloat {want:#x}", f.name()));
+                failures.push(format!("{} {op:?} {a:#x} {b:#x}: got {got:#x} {name} {want:#x}", f.name()));
             }
         }
     }
-    assert!(count > 100_000);
+    assert!(count > 10_000, "{count} cases");
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 #[test]
-fn fp16_matches_softfloat() {
-    check_against_softfloat(&Ieee::new(F16Half, divide()), sf_op16, 100_000);
+fn fp16_matches_apfloat() {
+    check_against_oracle(&Ieee::new(F16Half, divide()), ap_op::<Half>, "apfloat", 100_000);
 }
 
 #[test]
-fn f32_matches_softfloat() {
-    check_against_softfloat(&Ieee::new(F32Native, divide()), sf_op32, 100_000);
+fn f32_matches_apfloat() {
+    check_against_oracle(&Ieee::new(F32Native, divide()), ap_op::<Single>, "apfloat", 100_000);
+}
+
+#[test]
+fn bf16_matches_apfloat() {
+    check_against_oracle(&Ieee::new(Bf16, divide()), ap_op::<BFloat>, "apfloat", 50_000);
+}
+
+#[test]
+fn custom_layouts_match_apfloat() {
+    fn one<S: Semantics>(e: u32, m: u32) {
+        assert_eq!(S::BITS as u32, 1 + e + m);
+        check_against_oracle(
+            &Ieee::new(Soft(FloatLayout::new(e, m)), divide()),
+            ap_op::<IeeeFloat<S>>,
+            "apfloat",
+            10_000,
+        );
+    }
+    one::<E8M16>(8, 16);
+    one::<E5M2>(5, 2);
+    one::<E6M9>(6, 9);
+    one::<E4M3>(4, 3);
+    one::<E3M20>(3, 20);
+}
+
+/// A mutated engine (ties rounded away from zero instead of to even) must fail the oracle
+/// comparison: the check can fail.
+#[test]
+fn the_apfloat_check_catches_a_wrong_rounding() {
+    fn away(op: Op, a: u64, b: u64) -> u64 {
+        let (x, y) = (Half::from_bits(a as u128), Half::from_bits(b as u128));
+        let r = Round::NearestTiesToAway;
+        let v = match op {
+            Op::Add => x.add_r(y, r),
+            Op::Sub => x.sub_r(y, r),
+            Op::Mul => x.mul_r(y, r),
+            Op::Div => x.div_r(y, r),
+        };
+        v.value.to_bits() as u64
+    }
+    let f = Ieee::new(F16Half, divide());
+    let r = std::panic::catch_unwind(|| check_against_oracle(&f, away, "ties-away", 20_000));
+    assert!(r.is_err(), "ties-to-away was not told apart from ties-to-even");
+}
+
+#[cfg(feature = "softfloat")]
+mod softfloat {
+    use super::*;
+    use softfloat_wrapper::{Float as _, RoundingMode, F16 as Sf16, F32 as Sf32};
+
+    /// One SoftFloat operation, nearest-even.
+    fn sf_apply<T: softfloat_wrapper::Float>(op: Op, x: T, y: T) -> T {
+        let rm = RoundingMode::TiesToEven;
+        match op {
+            Op::Add => x.add(y, rm),
+            Op::Sub => x.sub(y, rm),
+            Op::Mul => x.mul(y, rm),
+            Op::Div => x.div(y, rm),
+        }
+    }
+
+    pub fn sf_op16(op: Op, a: u64, b: u64) -> u64 {
+        sf_apply(op, Sf16::from_bits(a as u16), Sf16::from_bits(b as u16)).to_bits() as u64
+    }
+
+    fn sf_op32(op: Op, a: u64, b: u64) -> u64 {
+        sf_apply(op, Sf32::from_bits(a as u32), Sf32::from_bits(b as u32)).to_bits() as u64
+    }
+
+    #[test]
+    fn fp16_matches_softfloat() {
+        check_against_oracle(&Ieee::new(F16Half, divide()), sf_op16, "softfloat", 100_000);
+    }
+
+    #[test]
+    fn f32_matches_softfloat() {
+        check_against_oracle(&Ieee::new(F32Native, divide()), sf_op32, "softfloat", 100_000);
+    }
+
+    /// All 2^32 binary16 operand pairs for + - × ÷ against SoftFloat. Run with
+    /// `cargo test --release -p datapath --features softfloat --test ops -- --ignored exhaustive_fp16`.
+    #[test]
+    #[ignore = "long: every binary16 operand pair (see README for the measured duration)"]
+    fn exhaustive_fp16_against_softfloat() {
+        super::exhaustive_fp16(sf_op16, "softfloat");
+    }
 }
 
 #[test]
@@ -376,11 +475,15 @@ fn fixed_recip_mul_is_reciprocal_then_multiply() {
     }
 }
 
-/// All 2^32 binary16 operand pairs for + - × ÷ against SoftFloat. Run with
+/// All 2^32 binary16 operand pairs for + - × ÷ against APFloat. Run with
 /// `cargo test --release -p datapath --test ops -- --ignored exhaustive_fp16`.
 #[test]
 #[ignore = "long: every binary16 operand pair (see README for the measured duration)"]
-fn exhaustive_fp16_against_softfloat() {
+fn exhaustive_fp16_against_apfloat() {
+    exhaustive_fp16(ap_op::<Half>, "apfloat");
+}
+
+fn exhaustive_fp16(oracle: fn(Op, u64, u64) -> u64, name: &str) {
     let f = Ieee::new(F16Half, divide());
     let l = FloatLayout::BINARY16;
     let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
@@ -394,11 +497,11 @@ fn exhaustive_fp16_against_softfloat() {
                         for b in 0..65536u64 {
                             for op in OPS {
                                 let got = f.to_bits(apply(&f, op, f.from_bits(a), f.from_bits(b)));
-                                let want = sf_op16(op, a, b);
+                                let want = oracle(op, a, b);
                                 let ok = if l.is_nan(want) { got == l.canonical_nan() } else { got == want };
                                 if !ok {
                                     if bad < 5 {
-                                        eprintln!("{op:?} {a:#06x} {b:#06x}: got {got:#06x} softfloat {want:#06x}");
+                                        eprintln!("{op:?} {a:#06x} {b:#06x}: got {got:#06x} {name} {want:#06x}");
                                     }
                                     bad += 1;
                                 }
@@ -412,7 +515,7 @@ fn exhaustive_fp16_against_softfloat() {
         hs.into_iter().map(|h| h.join().unwrap()).sum()
     });
     eprintln!(
-        "exhaustive fp16: 4 x 2^32 ops on {threads} threads in {:.1} s, {bad} mismatches",
+        "exhaustive fp16 against {name}: 4 x 2^32 ops on {threads} threads in {:.1} s, {bad} mismatches",
         start.elapsed().as_secs_f64()
     );
     assert_eq!(bad, 0);

@@ -303,6 +303,84 @@ mod slab {
         Ok(())
     }
 
+    /// Rays and boxes at the guard's edges (subnormal, tiny and huge direction components;
+    /// boxes and origins near ±max): the kernels equal the guarded model, and the guard changes
+    /// the model's answer on some of them (the edges are reached).
+    fn edge_batch<F: Format>(s: &Slab<F>, seed: u64, n: usize) -> (SlabRaysSoa<F::V>, BoxesSoa<F::V>) {
+        let f = &s.fmt;
+        let e = datapath::format::edges(f);
+        let mut r = SplitMix64::new(seed);
+        let (mut rays, mut boxes) = (SlabRaysSoa::default(), BoxesSoa::default());
+        let sgn = |r: &mut SplitMix64| if r.below(2) == 0 { 1.0 } else { -1.0 };
+        for _ in 0..n {
+            let mut o: [f64; 3] = std::array::from_fn(|_| r.range(-1.0, 1.0));
+            let mut d: [f64; 3] = std::array::from_fn(|_| r.range(-1.0, 1.0));
+            let mut lo: [f64; 3] = std::array::from_fn(|_| r.range(-1.0, 0.0));
+            let mut hi: [f64; 3] = std::array::from_fn(|_| r.range(0.0, 1.0));
+            let a = r.below(3) as usize;
+            match r.below(4) {
+                0 => {
+                    d[a] = sgn(&mut r) * e.least * (1 + r.below(8)) as f64;
+                    o[a] = 0.0;
+                    (lo[a], hi[a]) = if d[a] > 0.0 { (d[a], 4.0 * d[a]) } else { (4.0 * d[a], d[a]) };
+                }
+                1 => d[a] = sgn(&mut r) * e.max * (-r.range(0.0, 4.0)).exp2(),
+                2 => {
+                    o[a] = -e.max * r.range(0.3, 0.95);
+                    (lo[a], hi[a]) = (e.max * r.range(0.1, 0.5), e.max * r.range(0.5, 0.95));
+                    d[a] = e.max / 8.0;
+                }
+                _ => {
+                    (lo[a], hi[a]) = (-e.max * r.range(0.5, 0.95), e.max * r.range(0.5, 0.95));
+                    o[a] = lo[a];
+                    d[a] = e.max / 16.0;
+                }
+            }
+            rays.push(&s.prepare(o, d, 0.0, f64::INFINITY));
+            boxes.push(&s.store_box(lo, hi).unwrap());
+        }
+        (rays, boxes)
+    }
+
+    fn check_edges<F: Format + Copy>(
+        widest: Kernel,
+        f: F,
+        pairs: PairsFn<F>,
+        one: RayFn<F>,
+    ) -> Result<(), TestCaseError>
+    where
+        F::V: Default,
+    {
+        let s = Slab::new(f, SlabConfig::named("conservative").unwrap());
+        let unguarded = Slab::new(f, SlabConfig { guard: false, ..s.cfg });
+        let n = 4000;
+        let (rays, boxes) = edge_batch(&s, 0xed9e, n);
+        let mut a = SlabOutSoa::with_len(n);
+        s.batch(&rays, &boxes, &mut a);
+        let fresh = || SlabOutSoa::with_len(n);
+        on_every_kernel(widest, &a, |b| pairs(&s, &rays, &boxes, b), fresh, |a, b| same(&f, a, b))?;
+        // the unguarded unit on the unguarded rays answers otherwise somewhere: the guard acts
+        let (urays, _) = edge_batch(&unguarded, 0xed9e, n);
+        let mut u = SlabOutSoa::with_len(n);
+        unguarded.batch(&urays, &boxes, &mut u);
+        prop_assert!(a.hit.iter().zip(&u.hit).filter(|(g, u)| g != u).count() > 10);
+        for k in [0, 1, 2, 3, 17, n - 1] {
+            let ray = rays.get(k);
+            s.batch_ray(&ray, &boxes, &mut a);
+            on_every_kernel(widest, &a, |b| one(&s, &ray, &boxes, b), fresh, |a, b| same(&f, a, b))?;
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn slab_kernels_match_the_guard_at_the_edges() {
+        check_edges(WIDEST_F32, Ieee::new(F32Native, FpOpts::default()), slab_batch_f32, slab_ray_f32).unwrap();
+        check_edges(WIDEST_F16, Ieee::new(F16Half, FpOpts::default()), slab_batch_f16, slab_ray_f16).unwrap();
+        let div = FpOpts { div: DivMode::Divide, ..FpOpts::default() };
+        check_edges(WIDEST_F32, Ieee::new(F32Native, div), slab_batch_f32, slab_ray_f32).unwrap();
+        check_edges(WIDEST_F16, Ieee::new(F16Half, div), slab_batch_f16, slab_ray_f16).unwrap();
+    }
+
     const VARIANTS: [&str; 4] = ["plain", "conservative", "take-on-false", "embree"];
 
     proptest! {

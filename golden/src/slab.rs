@@ -46,9 +46,22 @@ fn q(x: f64) -> BigRational {
     BigRational::from_float(x).expect("finite")
 }
 
-/// The exact decision (rational arithmetic) for finite inputs; ±∞ is allowed for tmax and for
-/// box planes (an infinite plane bounds nothing on its side).
-pub fn slab_exact(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], max: [f64; 3]) -> bool {
+/// The exact decision (rational arithmetic): `None` (no decision) when an origin or direction
+/// component is not finite or any input is NaN; ±∞ is allowed for tmin, tmax and for box
+/// planes (an infinite plane bounds nothing on its side, and a box whose min is +∞ or max is
+/// −∞ is empty).
+pub fn slab_exact(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], max: [f64; 3]) -> Option<bool> {
+    if o.iter().chain(&d).any(|x| !x.is_finite())
+        || tmin.is_nan()
+        || tmax.is_nan()
+        || min.iter().chain(&max).any(|x| x.is_nan())
+    {
+        return None;
+    }
+    Some(slab_exact_finite(o, d, tmin, tmax, min, max))
+}
+
+fn slab_exact_finite(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], max: [f64; 3]) -> bool {
     // interval [near, far] of t; None = unbounded on that side
     let mut near: Option<BigRational> = if tmin.is_finite() { Some(q(tmin)) } else { None };
     let mut far: Option<BigRational> = if tmax.is_finite() { Some(q(tmax)) } else { None };
@@ -56,7 +69,7 @@ pub fn slab_exact(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3],
         return false;
     }
     for a in 0..3 {
-        if min[a] > max[a] {
+        if min[a] > max[a] || min[a] == f64::INFINITY || max[a] == f64::NEG_INFINITY {
             return false;
         }
         if d[a] == 0.0 {
@@ -100,29 +113,42 @@ mod tests {
     fn through_the_middle_and_beside() {
         let r = slab_f64([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI);
         assert_eq!((r.hit, r.t_near, r.t_far), (true, 2.0, 4.0));
-        assert!(slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI));
+        assert!(slab_exact_finite([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI));
         assert!(!slab_f64([-3.0, 2.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI).hit);
-        assert!(!slab_exact([-3.0, 2.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI));
+        assert!(!slab_exact_finite([-3.0, 2.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI));
     }
 
     #[test]
     fn grazing_a_face_in_its_plane_hits_the_closed_box() {
         for d in [[1.0, 0.0, 0.0], [1.0, -0.0, 0.0]] {
             assert!(slab_f64([-3.0, 1.0, 0.0], d, 0.0, f64::INFINITY, LO, HI).hit);
-            assert!(slab_exact([-3.0, 1.0, 0.0], d, 0.0, f64::INFINITY, LO, HI));
+            assert!(slab_exact_finite([-3.0, 1.0, 0.0], d, 0.0, f64::INFINITY, LO, HI));
         }
         // touching an edge exactly
-        assert!(slab_exact([-3.0, 1.0, 1.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI));
+        assert!(slab_exact_finite([-3.0, 1.0, 1.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI));
         // the line x + y = 2 touches the corner (1, 1); x + y = 2.001 passes beside it
-        assert!(slab_exact([3.0, -1.0, 0.0], [-1.0, 1.0, 0.0], 0.0, f64::INFINITY, LO, HI));
-        assert!(!slab_exact([3.0, -0.999, 0.0], [-1.0, 1.0, 0.0], 0.0, f64::INFINITY, LO, HI));
+        assert!(slab_exact_finite([3.0, -1.0, 0.0], [-1.0, 1.0, 0.0], 0.0, f64::INFINITY, LO, HI));
+        assert!(!slab_exact_finite([3.0, -0.999, 0.0], [-1.0, 1.0, 0.0], 0.0, f64::INFINITY, LO, HI));
+    }
+
+    #[test]
+    fn non_finite_rays_have_no_decision() {
+        for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+            assert_eq!(slab_exact([bad, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI), None);
+            assert_eq!(slab_exact([-3.0, 0.0, 0.0], [1.0, bad, 0.0], 0.0, f64::INFINITY, LO, HI), None);
+        }
+        assert_eq!(slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::NAN, LO, HI), None);
+        assert_eq!(slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, LO, HI), Some(true));
+        // an empty box (min +inf, max -inf) is missed
+        let (e0, e1) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        assert_eq!(slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, f64::INFINITY, e0, e1), Some(false));
     }
 
     #[test]
     fn interval_limits_are_closed() {
-        assert!(slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, 2.0, LO, HI));
-        assert!(!slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, 1.999, LO, HI));
-        assert!(slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 4.0, 9.0, LO, HI));
-        assert!(!slab_exact([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 4.001, 9.0, LO, HI));
+        assert!(slab_exact_finite([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, 2.0, LO, HI));
+        assert!(!slab_exact_finite([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, 1.999, LO, HI));
+        assert!(slab_exact_finite([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 4.0, 9.0, LO, HI));
+        assert!(!slab_exact_finite([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 4.001, 9.0, LO, HI));
     }
 }

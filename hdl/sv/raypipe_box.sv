@@ -20,9 +20,35 @@ package raypipe_box;
     return sign_of(F, d) ? fsub(F, zero_of(F, 1'b0), SLAB_DELTA) : SLAB_DELTA;
   endfunction
 
-  // 1 / d in the datapath's division
+  // the guard's enable; RAYPIPE_NO_GUARD leaves it out (a negative check of hdl/selftest: a
+  // conservative unit without the guard must fail the set)
+`ifdef RAYPIPE_NO_GUARD
+  localparam logic GUARD = 1'b0;
+`else
+  localparam logic GUARD = SLAB_GUARD[0];
+`endif
+
+  // a number that is neither NaN nor infinite
+  function automatic logic finite(word_t a);
+    return !is_nan(F, a) && !is_inf(F, a);
+  endfunction
+
+  // 1 / d in the datapath's division; the conservative variant's guard (SLAB_GUARD): a finite
+  // nonzero d whose reciprocal is not a normal number (+-inf, +-0 or subnormal) gives the
+  // canonical NaN
   function automatic word_t recip(word_t d);
-    return fdivide(F, RECIP_MUL[0], one_of(F), d);
+    word_t r = fdivide(F, RECIP_MUL[0], one_of(F), d);
+    if (GUARD && finite(d) && !is_zero(F, d) && (is_inf(F, r) || is_zero(F, r) || is_sub(F, r)))
+      return canonical_nan(F);
+    return r;
+  endfunction
+
+  // a stage-1 subtract; the guard: finite operands whose difference overflowed to +-inf give
+  // the canonical NaN
+  function automatic word_t gsub(word_t a, word_t b);
+    word_t r = fsub(F, a, b);
+    if (GUARD && finite(a) && finite(b) && is_inf(F, r)) return canonical_nan(F);
+    return r;
   endfunction
 
   // near chain: acc replaced by x when x is farther in (NaN: plain keeps acc, take-on-false takes x)
@@ -36,7 +62,7 @@ package raypipe_box;
     return flt(F, x, acc) ? x : acc;
   endfunction
 
-  // t_near stepped down (t_far up) SLAB_WIDEN_ULPS grid steps
+  // t_near stepped SLAB_WIDEN_ULPS grid steps toward -inf (IEEE nextDown), t_far toward +inf (nextUp)
   function automatic word_t widen(word_t t, logic up);
     for (int j = 0; j < int'(SLAB_WIDEN_ULPS); j++) t = up ? next_up(F, t) : next_down(F, t);
     return t;
@@ -64,12 +90,12 @@ package raypipe_box;
   // One whole box test (stages 1 to 6): {hit, widened t_near}.
   function automatic logic [64:0] test(ray_t r, word_t minx, word_t miny, word_t minz, word_t maxx, word_t maxy,
                                        word_t maxz);
-    word_t tlx = fmul(F, fsub(F, minx, r.ox), r.ix);
-    word_t thx = fmul(F, fsub(F, maxx, r.ox), r.ix);
-    word_t tly = fmul(F, fsub(F, miny, r.oy), r.iy);
-    word_t thy = fmul(F, fsub(F, maxy, r.oy), r.iy);
-    word_t tlz = fmul(F, fsub(F, minz, r.oz), r.iz);
-    word_t thz = fmul(F, fsub(F, maxz, r.oz), r.iz);
+    word_t tlx = fmul(F, gsub(minx, r.ox), r.ix);
+    word_t thx = fmul(F, gsub(maxx, r.ox), r.ix);
+    word_t tly = fmul(F, gsub(miny, r.oy), r.iy);
+    word_t thy = fmul(F, gsub(maxy, r.oy), r.iy);
+    word_t tlz = fmul(F, gsub(minz, r.oz), r.iz);
+    word_t thz = fmul(F, gsub(maxz, r.oz), r.iz);
     logic nx = sign_of(F, r.ix);
     logic ny = sign_of(F, r.iy);
     logic nz = sign_of(F, r.iz);

@@ -26,6 +26,9 @@ package raypipe_fp is
   function make_fmt(e, m, ftz, prop : std_logic_vector(63 downto 0)) return fmt_t;
   function w64(x : std_logic_vector) return word_t;
   function is_nan(f : fmt_t; a : word_t) return boolean;
+  function is_inf(f : fmt_t; a : word_t) return boolean;
+  function is_zero(f : fmt_t; a : word_t) return boolean;
+  function is_sub(f : fmt_t; a : word_t) return boolean;
   function sign_of(f : fmt_t; a : word_t) return boolean;
   function canonical_nan(f : fmt_t) return word_t;
   function zero_of(f : fmt_t; s : boolean) return word_t;

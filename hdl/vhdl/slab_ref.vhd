@@ -87,9 +87,21 @@ architecture behavioural of raypipe_slab_ref is
     return acc;
   end function;
 
-  function sub(a, b : std_logic_vector) return std_logic_vector is
+  -- a number that is neither NaN nor infinite
+  function finite(a : word_t) return boolean is
   begin
-    return nw(fsub(F, w64(a), w64(b)));
+    return not is_nan(F, a) and not is_inf(F, a);
+  end function;
+
+  -- a stage-1 subtract; the conservative variant's guard (P_SLAB_GUARD): finite operands
+  -- whose difference overflowed to +-inf give the canonical NaN
+  function sub(a, b : std_logic_vector) return std_logic_vector is
+    variable r : word_t := fsub(F, w64(a), w64(b));
+  begin
+    if P_SLAB_GUARD(0) = '1' and finite(w64(a)) and finite(w64(b)) and is_inf(F, r) then
+      return nw(canonical_nan(F));
+    end if;
+    return nw(r);
   end function;
 
   function mul(a, b : std_logic_vector) return std_logic_vector is
@@ -97,9 +109,16 @@ architecture behavioural of raypipe_slab_ref is
     return nw(fmul(F, w64(a), w64(b)));
   end function;
 
+  -- 1 / d; the guard: a finite nonzero d whose reciprocal is not a normal number (+-inf,
+  -- +-0 or subnormal) gives the canonical NaN
   function recip(d : std_logic_vector) return std_logic_vector is
+    variable r : word_t := fdivide(F, RECIP_MUL, one_of(F), w64(d));
   begin
-    return nw(fdivide(F, RECIP_MUL, one_of(F), w64(d)));
+    if P_SLAB_GUARD(0) = '1' and finite(w64(d)) and not is_zero(F, w64(d))
+       and (is_inf(F, r) or is_zero(F, r) or is_sub(F, r)) then
+      return nw(canonical_nan(F));
+    end if;
+    return nw(r);
   end function;
 
   function sel(c : std_logic_vector; a, b : std_logic_vector) return std_logic_vector is
@@ -138,21 +157,21 @@ architecture behavioural of raypipe_slab_ref is
       when 4 =>
         y.s.tn_x := near_sel(x.i.tmin, x.s.nearx);
         y.s.tn_xy := near_sel(y.s.tn_x, x.s.neary);
-        y.s.t_near := near_sel(y.s.tn_xy, x.s.nearz);
+        y.s.tn_xyz := near_sel(y.s.tn_xy, x.s.nearz);
         y.s.tf_x := far_sel(x.i.tmax, x.s.farx);
         y.s.tf_xy := far_sel(y.s.tf_x, x.s.fary);
-        y.s.t_far := far_sel(y.s.tf_xy, x.s.farz);
+        y.s.tf_xyz := far_sel(y.s.tf_xy, x.s.farz);
       when 5 =>
-        n := w64(x.s.t_near);
-        f_w := w64(x.s.t_far);
+        n := w64(x.s.tn_xyz);
+        f_w := w64(x.s.tf_xyz);
         for j in 1 to to_integer(unsigned(P_SLAB_WIDEN_ULPS(15 downto 0))) loop
           n := next_down(F, n);
           f_w := next_up(F, f_w);
         end loop;
-        y.s.near_w := nw(n);
-        y.s.far_w := nw(f_w);
+        y.s.t_near := nw(n);
+        y.s.t_far := nw(f_w);
       when others =>
-        y.s.hit := flag(fle(F, w64(x.s.near_w), w64(x.s.far_w)));
+        y.s.hit := flag(fle(F, w64(x.s.t_near), w64(x.s.t_far)));
     end case;
     return y;
   end function;
@@ -175,6 +194,6 @@ begin
   end process;
 
   out_valid <= v(L);
-  out_row <= st(L).s.hit & st(L).s.near_w & st(L).s.far_w;
+  out_row <= st(L).s.hit & st(L).s.t_near & st(L).s.t_far;
   stg_row <= from_slab_stages_t(st(L).s);
 end architecture;

@@ -254,11 +254,13 @@ fn rti_crosses(level: u32) -> Vec<RtiCross> {
 }
 
 /// Slab ray placements (level 1 ids 0-3).
-const SLAB_RAYS: [(&str, &str); 4] = [
+const SLAB_RAYS: [(&str, &str); 6] = [
     ("random", "random ray and box in [-1, 1]^3"),
     ("face_signed_zero", "origin on a face plane, one direction component +0 or -0"),
     ("grazing", "aimed at a face, edge or corner point of the box"),
     ("inside", "origin inside the box"),
+    ("edge_d", "a direction component of 1 to 8 least steps (subnormal: 1/d overflows), 1 to 64 least normals, or within 2^4 of the maximum (1/d subnormal), the box's slab on that axis where the ray meets it at t in [0.5, 4]"),
+    ("near_max", "box planes near +-max on one axis, the origin near the other end or on the near plane: plane minus origin overflows (floats) or saturates (fixed point)"),
 ];
 const SLAB_ZERO: (&str, &str) = ("zero_extent", "box of zero extent on one or more axes");
 const SLAB_SPECIAL: (&str, &str) = ("inf_nan", "ray inputs +inf, -inf or NaN (floats only)");
@@ -290,13 +292,15 @@ impl SlabCross {
     }
 }
 
-/// The slab classes of a level: level 1 the six named classes (ids 0-5), level 2 adds each
+/// The slab classes of a level: level 1 the eight named classes (ids 0-7), level 2 adds each
 /// special placement with a zero-extent box and with special inputs, and the two together.
 fn slab_crosses(level: u32) -> Vec<SlabCross> {
     let c = |ray, zero_box, special| SlabCross { ray, zero_box, special };
     let mut v = vec![c(0, false, false), c(1, false, false), c(2, false, false), c(3, false, false)];
     v.push(c(0, true, false));
     v.push(c(0, false, true));
+    v.push(c(4, false, false));
+    v.push(c(5, false, false));
     if level >= 2 {
         for ray in 1..4 {
             v.push(c(ray, true, false));
@@ -582,13 +586,14 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             counts = push_rows(&mut files, per_class);
         }
         Unit::Slab => {
-            let sc = SlabConfig::named(&req.slab_variant)?;
+            let sc = SlabConfig::named_for(&req.slab_variant, &f)?;
             if sc.directed {
                 return Err("the directed slab variant has a data-dependent signal set; vectors support plain, conservative, take-on-false and embree".into());
             }
             let slab = Slab::new(f, sc);
             options.insert("variant".into(), req.slab_variant.clone());
-            options.insert("config".into(), format!("{sc:?}"));
+            crate::gen::slab_options(&mut options, &sc);
+            params.insert("slab_guard".into(), sc.guard as u64);
             params.insert("slab_take_on_false".into(), (sc.nan == datapath::slab::SlabNan::TakeOnFalse) as u64);
             params.insert("slab_embree".into(), (sc.prep == datapath::slab::DirPrep::Embree) as u64);
             params.insert("slab_delta".into(), f.to_bits(slab.delta()));
@@ -648,7 +653,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                     if cross.special && !float {
                         return Ok(None);
                     }
-                    let x = slab_case(cross, r);
+                    let x = slab_case(cross, r, datapath::format::edges(&f));
                     let b = slab.store_box([x[8], x[9], x[10]], [x[11], x[12], x[13]]).map_err(|e| e.to_string())?;
                     let mut bits: Vec<u64> = x[..8].iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
                     bits.extend(b.min.iter().chain(b.max.iter()).map(|&v| f.to_bits(v)));
@@ -840,7 +845,7 @@ fn signals<F: Format>(f: &F, rec: &Recorder<F::V>) -> Vec<u64> {
         .collect()
 }
 
-fn slab_case(cross: SlabCross, r: &mut SplitMix64) -> [f64; 14] {
+fn slab_case(cross: SlabCross, r: &mut SplitMix64, e: datapath::format::Edges) -> [f64; 14] {
     let mut lo = [0.0; 3];
     let mut hi = [0.0; 3];
     for a in 0..3 {
@@ -871,6 +876,51 @@ fn slab_case(cross: SlabCross, r: &mut SplitMix64) -> [f64; 14] {
             d = std::array::from_fn(|a| p[a] - o[a]);
         }
         3 => o = std::array::from_fn(|a| r.range(lo[a], hi[a])),
+        4 => {
+            // the ray crosses the other axes' slabs around t = tm; axis a's slab where the ray
+            // meets it at t in [t1, t2] (q1.F holds t < 1)
+            let cap = (e.max / 2.0).min(4.0);
+            let (t1, t2) = (r.range(0.125, 0.5) * cap, r.range(0.5, 1.0) * cap);
+            let tm = (t1 + t2) / 2.0;
+            let a = r.below(3) as usize;
+            for b in (0..3).filter(|&b| b != a) {
+                let p = r.range(lo[b], hi[b]);
+                d[b] = r.range(-0.05, 0.05);
+                o[b] = p - d[b] * tm;
+            }
+            let s = if r.below(2) == 0 { 1.0 } else { -1.0 };
+            d[a] = s * match r.below(3) {
+                0 => e.least * (1 + r.below(8)) as f64,
+                1 => e.min_normal * r.range(1.0, 64.0),
+                _ => e.max * (-r.range(0.0, 4.0)).exp2(),
+            };
+            o[a] = 0.0;
+            let (x, y) = (d[a] * t1, d[a] * t2);
+            // a huge d puts the slab beyond the range: then near one unit instead (t ~ 1/|d|)
+            let (x, y) =
+                if y.abs() > e.max / 2.0 { (s * 0.5f64.min(e.max / 4.0), s * 1f64.min(e.max / 2.0)) } else { (x, y) };
+            (lo[a], hi[a]) = (x.min(y), x.max(y));
+        }
+        5 => {
+            let a = r.below(3) as usize;
+            let s = if r.below(2) == 0 { 1.0 } else { -1.0 };
+            let tm = (e.max / 4.0).min(2.0) * r.range(0.25, 1.0);
+            if r.below(2) == 0 {
+                let (x, y) = (r.range(0.3, 0.9) * e.max, r.range(0.3, 0.9) * e.max);
+                (lo[a], hi[a]) = if s > 0.0 { (x.min(y), x.max(y)) } else { (-x.max(y), -x.min(y)) };
+                o[a] = -s * r.range(0.3, 0.95) * e.max;
+                d[a] = (((lo[a] + hi[a]) / 2.0 - o[a]) / tm).clamp(-e.max, e.max);
+            } else {
+                (lo[a], hi[a]) = (-r.range(0.55, 0.95) * e.max, r.range(0.55, 0.95) * e.max);
+                o[a] = if s > 0.0 { lo[a] } else { hi[a] };
+                let far = if s > 0.0 { hi[a] } else { lo[a] };
+                d[a] = ((far - o[a]) / (1.1 * tm)).clamp(-e.max, e.max);
+            }
+            for b in (0..3).filter(|&b| b != a) {
+                d[b] = r.range(-1.0, 1.0) * (hi[b] - lo[b]) / tm;
+                o[b] = (lo[b] + hi[b]) / 2.0 - d[b] * tm;
+            }
+        }
         _ => {}
     }
     if cross.special {
@@ -1076,4 +1126,45 @@ fn rti_config_from(m: &Manifest) -> Result<RtiConfig, String> {
         .and_then(|s| s.parse().ok())
         .ok_or("manifest has no det_threshold")?;
     Ok(RtiConfig { cull, det_threshold, tie })
+}
+
+/// The slab unit's configuration as manifest options, one key per rule, in words.
+pub(crate) fn slab_options(options: &mut BTreeMap<String, String>, sc: &SlabConfig) {
+    use datapath::slab::{DirPrep, SlabNan, STEP_RULES};
+    options.insert(
+        "slab_comparator".into(),
+        match sc.nan {
+            SlabNan::Ignore => {
+                "ignore: near t = (x > t) ? x : t, far t = (x < t) ? x : t (a NaN x loses every compare and is ignored)"
+            }
+            SlabNan::TakeOnFalse => {
+                "take-on-false: near t = (x <= t) ? t : x, far t = (t <= x) ? t : x (a NaN on either side takes x)"
+            }
+        }
+        .into(),
+    );
+    options.insert(
+        "slab_direction_prep".into(),
+        match sc.prep {
+            DirPrep::Plain => "plain: inv_d = 1 / d (a ±0 component gives ±inf)",
+            DirPrep::Embree => "embree: |d| < delta (params.slab_delta) becomes +delta or -delta by the sign bit of d, then inv_d = 1 / d",
+        }
+        .into(),
+    );
+    options.insert(
+        "slab_widening".into(),
+        format!(
+            "t_near = tn_xyz stepped {0} times toward -inf (nextDown) and t_far = tf_xyz stepped {0} times toward +inf (nextUp); {STEP_RULES}",
+            sc.widen_ulps
+        ),
+    );
+    options.insert(
+        "slab_guard".into(),
+        if sc.guard {
+            "on: inv_d of a finite nonzero pd whose quotient is not a normal number (+-inf, +-0 or subnormal) is the canonical NaN; a stage-1 difference of finite operands that is +-inf (overflow) is the canonical NaN; the products they feed are NaN and the comparator ignores them"
+        } else {
+            "off"
+        }
+        .into(),
+    );
 }

@@ -256,7 +256,7 @@ pub(crate) fn generate<F: Format>(
     if n == 0 || n > 255 {
         return Err(format!("--leaves must be 1..=255, got {n}"));
     }
-    let sc = SlabConfig::named(variant)?;
+    let sc = SlabConfig::named_for(variant, &f)?;
     if sc.directed {
         return Err("the traverse unit's box tester supports plain, conservative, take-on-false and embree".into());
     }
@@ -339,6 +339,7 @@ pub(crate) fn generate<F: Format>(
     params.insert("leaves".into(), n as u64);
     params.insert("levels".into(), depth as u64);
     params.insert("max_levels".into(), max_levels as u64);
+    params.insert("slab_guard".into(), sc.guard as u64);
     params.insert("slab_take_on_false".into(), (sc.nan == datapath::slab::SlabNan::TakeOnFalse) as u64);
     params.insert("slab_embree".into(), (sc.prep == datapath::slab::DirPrep::Embree) as u64);
     params.insert("slab_delta".into(), f.to_bits(s.delta()));
@@ -346,6 +347,7 @@ pub(crate) fn generate<F: Format>(
     let mut options = BTreeMap::new();
     options.insert("scene".into(), tree.name.clone());
     options.insert("variant".into(), variant.to_string());
+    crate::gen::slab_options(&mut options, &sc);
     options.insert(
         "traversal".into(),
         "2-bit ray history, restart from the root (raypipe README, 'Traversal'); the right child is nearer only when its entry t_near is less than the left's (format compare), ties and NaN go left".into(),

@@ -203,6 +203,33 @@ pub trait Format: Copy + Debug + Send + Sync + 'static {
     }
 }
 
+/// A format's edge magnitudes, where stress and vector classes probe it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Edges {
+    /// The least positive value (the smallest subnormal; under FTZ the smallest normal; fixed
+    /// point: one step).
+    pub least: f64,
+    /// The least positive normal value (fixed point: one step).
+    pub min_normal: f64,
+    /// The largest finite value.
+    pub max: f64,
+}
+
+/// The edge magnitudes of format `f`.
+pub fn edges<F: Format>(f: &F) -> Edges {
+    match f.kind() {
+        FormatKind::Float(l) => {
+            let n = l.min_normal();
+            let least = if f.flushes() { n } else { layout::pow2(l.emin() - l.man_bits as i32) };
+            Edges { least, min_normal: n, max: l.max_finite() }
+        }
+        FormatKind::Fixed { frac_bits, .. } => {
+            let step = layout::pow2(-(frac_bits as i32));
+            Edges { least: step, min_normal: step, max: f.error_model().max }
+        }
+    }
+}
+
 /// An IEEE-like float format: a bit-exact backend plus the datapath's [`FpOpts`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Ieee<B: IeeeBackend> {

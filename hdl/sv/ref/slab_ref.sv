@@ -2,7 +2,7 @@
 // per stage of raypipe's slab stage table (stage 0: direction conversion, preparation and
 // the three reciprocals; 1: six subtracts; 2: six multiplies; 3: near/far by the sign of
 // 1/d; 4: the compare-select chains from tmin/tmax in axis order x, y, z; 5: widening by
-// SLAB_WIDEN_ULPS grid steps; 6: hit = near_w <= far_w). Latency 7.
+// SLAB_WIDEN_ULPS grid steps; 6: hit = t_near <= t_far). Latency 7.
 // The conversion, preparation and compare-select rules come from raypipe_box.sv.
 // Every stage signal is carried to the end of the pipeline and presented on stg_row.
 // Define RAYPIPE_INJECT_FAULT to make the tlox multiplier truncate instead of rounding to
@@ -58,12 +58,12 @@ module raypipe_slab_ref
         y.s.inv_dz = recip(y.s.pdz);
       end
       1: begin
-        y.s.lox = fsub(F, x.i.minx, x.i.ox);
-        y.s.hix = fsub(F, x.i.maxx, x.i.ox);
-        y.s.loy = fsub(F, x.i.miny, x.i.oy);
-        y.s.hiy = fsub(F, x.i.maxy, x.i.oy);
-        y.s.loz = fsub(F, x.i.minz, x.i.oz);
-        y.s.hiz = fsub(F, x.i.maxz, x.i.oz);
+        y.s.lox = gsub(x.i.minx, x.i.ox);
+        y.s.hix = gsub(x.i.maxx, x.i.ox);
+        y.s.loy = gsub(x.i.miny, x.i.oy);
+        y.s.hiy = gsub(x.i.maxy, x.i.oy);
+        y.s.loz = gsub(x.i.minz, x.i.oz);
+        y.s.hiz = gsub(x.i.maxz, x.i.oz);
       end
       2: begin
         y.s.tlox = mul_tlox(x.s.lox, x.s.inv_dx);
@@ -87,16 +87,16 @@ module raypipe_slab_ref
       4: begin
         y.s.tn_x = near_sel(x.i.tmin, x.s.nearx);
         y.s.tn_xy = near_sel(y.s.tn_x, x.s.neary);
-        y.s.t_near = near_sel(y.s.tn_xy, x.s.nearz);
+        y.s.tn_xyz = near_sel(y.s.tn_xy, x.s.nearz);
         y.s.tf_x = far_sel(x.i.tmax, x.s.farx);
         y.s.tf_xy = far_sel(y.s.tf_x, x.s.fary);
-        y.s.t_far = far_sel(y.s.tf_xy, x.s.farz);
+        y.s.tf_xyz = far_sel(y.s.tf_xy, x.s.farz);
       end
       5: begin
-        y.s.near_w = widen(x.s.t_near, 1'b0);
-        y.s.far_w = widen(x.s.t_far, 1'b1);
+        y.s.t_near = widen(x.s.tn_xyz, 1'b0);
+        y.s.t_far = widen(x.s.tf_xyz, 1'b1);
       end
-      default: y.s.hit = fle(F, x.s.near_w, x.s.far_w);
+      default: y.s.hit = fle(F, x.s.t_near, x.s.t_far);
     endcase
     return y;
   endfunction
@@ -125,8 +125,8 @@ module raypipe_slab_ref
 
   slab_expected_t o;
   assign o.hit = last.s.hit;
-  assign o.t_near = last.s.near_w;
-  assign o.t_far = last.s.far_w;
+  assign o.t_near = last.s.t_near;
+  assign o.t_far = last.s.t_far;
   assign out_row = o;
   assign stg_row = last.s;
 endmodule
