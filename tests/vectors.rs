@@ -320,3 +320,73 @@ fn level_2_crosses_the_classes() {
         assert!(check_set(&dir).is_ok());
     }
 }
+
+/// `--check` checks the whole set: a changed manifest parameter, a stale HDL package, a cut
+/// files list or another unit is named, never a panic and never a pass.
+#[test]
+fn check_names_the_first_difference_in_any_file() {
+    use serde_json::Value;
+    type Edit = fn(&mut Value);
+    let json_cases: [(&str, Unit, Edit, &str); 9] = [
+        ("latency", Unit::Slab, |m| m["latency"] = 3.into(), "field latency"),
+        ("width", Unit::Rti, |m| m["files"][1]["fields"][2]["width"] = 17.into(), "files[1].fields[2]"),
+        ("exp", Unit::Op, |m| m["params"]["exp"] = 6.into(), "params.exp"),
+        ("max_levels", Unit::Traverse, |m| m["params"]["max_levels"] = 99.into(), "MAX_LEVELS"),
+        ("empty files", Unit::Rti, |m| m["files"] = Value::Array(vec![]), "field files lists"),
+        (
+            "cut files",
+            Unit::Slab,
+            |m| {
+                m["files"].as_array_mut().unwrap().truncate(1);
+            },
+            "field files lists",
+        ),
+        ("unit", Unit::Slab, |m| m["unit"] = "rti".into(), "field unit"),
+        ("contract", Unit::Rti, |m| m["contract"]["rounding"] = "toward zero".into(), "contract.rounding"),
+        ("class", Unit::Slab, |m| m["classes"][2]["count"] = 5.into(), "class 2"),
+    ];
+    for (what, unit, edit, want) in json_cases {
+        let set = generate(&req(unit, "fp16", 4)).unwrap();
+        let dir = tmp(&format!("check-{}", what.replace(' ', "_")));
+        write_set(&set, &dir).unwrap();
+        assert!(check_set(&dir).is_ok(), "{what}: the unchanged set must pass");
+        let p = dir.join("manifest.json");
+        let mut m: Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+        edit(&mut m);
+        std::fs::write(&p, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+        let e = check_set(&dir).expect_err(what);
+        assert!(e.contains(want), "{what}: {e}");
+    }
+    // the generated packages are compared too
+    for (file, from, to, want) in [
+        ("raypipe_pkg.sv", "localparam int LATENCY = 7;", "localparam int LATENCY = 3;", "raypipe_pkg.sv line"),
+        (
+            "raypipe_pkg.vhd",
+            "constant LATENCY : natural := 7;",
+            "constant LATENCY : natural := 3;",
+            "raypipe_pkg.vhd line",
+        ),
+    ] {
+        let set = generate(&req(Unit::Slab, "f32", 3)).unwrap();
+        let dir = tmp(&format!("check-{file}"));
+        write_set(&set, &dir).unwrap();
+        let p = dir.join(file);
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(text.contains(from), "{file}");
+        std::fs::write(&p, text.replacen(from, to, 1)).unwrap();
+        let e = check_set(&dir).unwrap_err();
+        assert!(e.contains(want), "{file}: {e}");
+    }
+    // an input row changed by hand (a valid row, hash updated) is not what the seed draws
+    let set = generate(&req(Unit::Op, "fp16", 3)).unwrap();
+    let dir = tmp("check-input");
+    write_set(&set, &dir).unwrap();
+    let p = dir.join("manifest.json");
+    let mut m: Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+    m["seed"] = 12345.into();
+    std::fs::write(&p, serde_json::to_string_pretty(&m).unwrap()).unwrap();
+    assert!(check_set(&dir).unwrap_err().contains("seed 12345"));
+    // not JSON, or a manifest without a field
+    std::fs::write(&p, "{\"schema\": 2}").unwrap();
+    assert!(check_set(&dir).unwrap_err().contains("manifest.json"));
+}

@@ -755,6 +755,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
         git: git_hash(),
         command: req.command.clone(),
         seed: req.seed,
+        count: req.count,
         unit: unit.into(),
         level: req.level,
         format: f.name(),
@@ -1001,16 +1002,10 @@ pub fn write_set(set: &VectorSet, dir: &Path) -> Result<PathBuf, String> {
     Ok(dir.to_path_buf())
 }
 
-/// Reads a set back, checks every file's hash, re-runs the model on every input row and
-/// compares every expected and stage row bit for bit. Returns the number of vectors checked.
-pub fn check_set(dir: &Path) -> Result<usize, String> {
-    let text = std::fs::read_to_string(dir.join("manifest.json"))
-        .map_err(|e| format!("{}: {e}", dir.join("manifest.json").display()))?;
-    let m: Manifest = serde_json::from_str(&text).map_err(|e| format!("manifest.json: {e}"))?;
-    if m.schema != manifest::SCHEMA {
-        return Err(format!("manifest schema {} is not {}", m.schema, manifest::SCHEMA));
-    }
-    let any: AnyFormat = m.format.parse()?;
+pub use crate::check::check_set;
+
+/// Reads every data file the manifest lists, checking its hash, digit count and row count.
+pub(crate) fn read_files(dir: &Path, m: &Manifest) -> Result<Vec<Vec<Vec<u64>>>, String> {
     let mut contents = Vec::new();
     for fm in &m.files {
         let c = std::fs::read_to_string(dir.join(&fm.name)).map_err(|e| format!("{}: {e}", fm.name))?;
@@ -1021,6 +1016,15 @@ pub fn check_set(dir: &Path) -> Result<usize, String> {
             .lines()
             .enumerate()
             .map(|(i, l)| {
+                if l.len() != fm.digits as usize {
+                    return Err(format!(
+                        "{} line {}: {} hex digits, the manifest says {}",
+                        fm.name,
+                        i + 1,
+                        l.len(),
+                        fm.digits
+                    ));
+                }
                 unpack(l, &fm.fields.iter().map(|x| x.width).collect::<Vec<_>>())
                     .map_err(|e| format!("{} line {}: {e}", fm.name, i + 1))
             })
@@ -1030,9 +1034,41 @@ pub fn check_set(dir: &Path) -> Result<usize, String> {
         }
         contents.push(rows);
     }
-    let unit: Unit = m.unit.parse()?;
+    Ok(contents)
+}
+
+/// Re-runs the model on every input row and compares every expected and stage row bit for
+/// bit (the manifest already checked against this raypipe's). Returns the vectors checked.
+pub(crate) fn check_rows(
+    m: &Manifest,
+    unit: Unit,
+    any: AnyFormat,
+    contents: &[Vec<Vec<u64>>],
+) -> Result<usize, String> {
+    // the inputs' class ids and the counts the manifest gives them
+    if let Some(inputs) = contents.first() {
+        for c in &m.classes {
+            let n = inputs.iter().filter(|r| r.first() == Some(&(c.id as u64))).count();
+            if n != c.count {
+                return Err(format!(
+                    "manifest.json: class {} ({}) has count {}, the inputs hold {n}",
+                    c.id, c.name, c.count
+                ));
+            }
+        }
+        if let Some((i, r)) =
+            inputs.iter().enumerate().find(|(_, r)| !m.classes.iter().any(|c| r.first() == Some(&(c.id as u64))))
+        {
+            return Err(format!(
+                "{} line {}: class {} is not in the manifest",
+                m.files[0].name,
+                i + 1,
+                r.first().copied().unwrap_or(0)
+            ));
+        }
+    }
     if unit == Unit::Traverse {
-        return with_format!(any, |f| check_traverse(f, &m, &contents));
+        return with_format!(any, |f| check_traverse(f, m, contents));
     }
     with_format!(any, |f| {
         let n = contents[0].len();

@@ -103,6 +103,9 @@ pub struct Manifest {
     pub command: String,
     /// Seed of every random stream.
     pub seed: u64,
+    /// Vectors requested per coverage class (`--count`; a class can hold fewer, see `classes`).
+    #[serde(default)]
+    pub count: usize,
     /// Unit: rti, slab or op.
     pub unit: String,
     /// Coverage level.
