@@ -1076,7 +1076,7 @@ pub(crate) fn check_rows(
             let (class, bits) = (input[0], &input[1..]);
             let want: Vec<Vec<u64>> = match unit {
                 Unit::Rti => {
-                    let rti = Rti::new(f, rti_config_from(&m)?);
+                    let rti = Rti::new(f, rti_config_from(m)?);
                     rti_rows(&rti, class, bits)[1..].to_vec()
                 }
                 Unit::Slab => {
