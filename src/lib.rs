@@ -16,3 +16,26 @@ pub mod stats;
 pub mod stress;
 pub mod traverse;
 pub mod verify;
+
+/// How a run ended, as its exit code: 0 every property held, 1 one failed, 3 the run proved
+/// nothing (no test could decide the property). Bad input is 2 (a clear error, no result).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Outcome {
+    /// Every property held on a run that decided something.
+    Pass = 0,
+    /// A property failed.
+    Fail = 1,
+    /// Nothing failed, but no test decided the property: the run proved nothing.
+    Inconclusive = 3,
+}
+
+impl From<bool> for Outcome {
+    fn from(passed: bool) -> Self {
+        if passed {
+            Outcome::Pass
+        } else {
+            Outcome::Fail
+        }
+    }
+}

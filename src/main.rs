@@ -8,8 +8,10 @@ use datapath::{with_format, AnyFormat};
 use golden::{Ray64, Tri64};
 use raypipe::scene::Scene;
 use raypipe::verify::{render, verify, VerifyConfig};
+use raypipe::Outcome;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use vectors::outdir::OutDir;
 
 /// Large blocks (the batch columns) at staggered page offsets, so that a kernel's columns do
 /// not share cache sets (see [`datapath::alloc`]).
@@ -114,14 +116,14 @@ enum Cmd {
         /// Box (unit slab): minx,miny,minz,maxx,maxy,maxz.
         #[arg(long = "box", allow_hyphen_values = true)]
         aabb: Option<String>,
-        /// Slab variant: plain, conservative, take-on-false, embree.
+        /// Slab variant: plain, conservative, directed, take-on-false, embree.
         #[arg(long, default_value = "plain")]
         variant: String,
         /// Smallest accepted t.
         #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
         tmin: f64,
         /// Largest accepted t.
-        #[arg(long, default_value_t = f64::INFINITY)]
+        #[arg(long, default_value_t = f64::INFINITY, allow_hyphen_values = true)]
         tmax: f64,
         #[command(flatten)]
         rti: RtiArgs,
@@ -206,7 +208,7 @@ enum Cmd {
     },
     /// Write a self-describing vector set for RTL testbenches (or check one with --check).
     Vectors {
-        /// Unit: rti, slab or op.
+        /// Unit: rti, slab, op or traverse.
         #[arg(long, default_value = "rti")]
         unit: String,
         /// Number format (default f32, or the plan's narrowest format within its budget).
@@ -230,7 +232,7 @@ enum Cmd {
         /// Worker threads (default: every core); the files do not depend on it.
         #[arg(long)]
         threads: Option<usize>,
-        /// Slab variant (unit slab).
+        /// Slab variant (units slab and traverse): plain, conservative, take-on-false, embree.
         #[arg(long, default_value = "plain")]
         variant: String,
         /// Re-check an existing set against the models instead of writing one.
@@ -242,12 +244,13 @@ enum Cmd {
         /// First N leaves per ray (unit traverse, 1..=255).
         #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u64).range(1..=255))]
         leaves: u64,
-        /// Triangles per leaf at most (unit traverse, 1..=255).
-        #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=255))]
-        leaf_size: u32,
-        /// Level pipelines the hardware has (unit traverse; the history holds 2 bits per level).
-        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
-        levels: u64,
+        /// Triangles per leaf at most (unit traverse, 1..=255; default 4, or the plan's).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=255))]
+        leaf_size: Option<u32>,
+        /// Level pipelines the hardware has (unit traverse; the history holds 2 bits per level;
+        /// default 64, or the plan's).
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+        levels: Option<u64>,
         #[command(flatten)]
         rti: RtiArgs,
     },
@@ -364,6 +367,22 @@ fn parse_list(what: &str, s: &str, n: usize) -> Result<Vec<f64>, String> {
     Ok(v)
 }
 
+/// The t interval of `explain`: both ends numbers (±inf allowed), tmin <= tmax, tmin not +inf
+/// and tmax not -inf.
+fn check_interval(tmin: f64, tmax: f64) -> Result<(), String> {
+    for (name, v) in [("--tmin", tmin), ("--tmax", tmax)] {
+        if v.is_nan() {
+            return Err(format!("{name} must be a number, got NaN"));
+        }
+    }
+    if tmin == f64::INFINITY || tmax == f64::NEG_INFINITY || tmin > tmax {
+        return Err(format!(
+            "the t interval [--tmin {tmin}, --tmax {tmax}] is empty: need tmin <= tmax, tmin < inf, tmax > -inf"
+        ));
+    }
+    Ok(())
+}
+
 /// Prints `value` as JSON, or the text `render` gives.
 fn emit<T: serde::Serialize>(json: bool, value: &T, render: impl FnOnce(&T) -> String) -> Result<(), String> {
     if json {
@@ -374,6 +393,37 @@ fn emit<T: serde::Serialize>(json: bool, value: &T, render: impl FnOnce(&T) -> S
     Ok(())
 }
 
+/// Verify, plan and report hold every test of a run in memory (~160 bytes each; the
+/// streaming engine will lift this): a run of more tests is refused up front.
+const MAX_TESTS: u64 = 40_000_000;
+/// Rays `traverse` holds (~75 bytes each) and `stats` holds (~200 bytes each) at most.
+const MAX_TRAVERSE_RAYS: u64 = 50_000_000;
+const MAX_STATS_RAYS: u64 = 20_000_000;
+/// Pairs per `speed` call at most (15 columns of 4 bytes: 1 GiB).
+const MAX_SPEED_PAIRS: u64 = 1 << 24;
+/// Vectors per class at most (the set is built in memory before it is written).
+const MAX_VECTOR_COUNT: u64 = 100_000;
+
+/// Refuses a size this build cannot serve, before any work.
+fn limit(what: &str, n: u64, max: u64, why: &str) -> Result<(), String> {
+    if n > max {
+        return Err(format!("{what} = {n} is more than this command can hold: at most {max} ({why})"));
+    }
+    Ok(())
+}
+
+/// The tests a verify-like run of `rays` rays makes per format on `scene`.
+fn check_tests(rays: u64, scene: &Scene, sample: u64) -> Result<(), String> {
+    let per_ray = (scene.tris.len() as u64).min(sample).max(1);
+    let tests = rays.saturating_mul(per_ray);
+    limit(
+        &format!("tests per format (--rays {rays} x {per_ray} triangles per ray)"),
+        tests,
+        MAX_TESTS,
+        "every test is held in memory, ~160 bytes each; use fewer --rays or a smaller --sample",
+    )
+}
+
 /// The OBJ scene at `path`, or the built-in scene.
 fn load_scene(path: Option<&std::path::Path>) -> Result<Scene, String> {
     match path {
@@ -382,7 +432,7 @@ fn load_scene(path: Option<&std::path::Path>) -> Result<Scene, String> {
     }
 }
 
-fn run_verify(a: VerifyArgs) -> Result<bool, String> {
+fn run_verify(a: VerifyArgs) -> Result<Outcome, String> {
     let rti = a.rti.config()?;
     let scene = load_scene(a.scene.as_deref())?;
     let plan = a.plan.as_deref().map(raypipe::plan::load).transpose()?;
@@ -394,10 +444,11 @@ fn run_verify(a: VerifyArgs) -> Result<bool, String> {
         (true, Some(p)) => p.within_budget()?,
         (true, None) => DEFAULT_FORMATS.iter().map(|f| f.parse().expect("built-in format name")).collect(),
     };
+    check_tests(a.rays, &scene, a.sample)?;
     let cfg = VerifyConfig { formats, rays: a.rays as usize, seed: a.seed, rti, sample: a.sample as usize };
     let rep = verify(&cfg, &scene);
     emit(a.json, &rep, render)?;
-    Ok(rep.passed)
+    Ok(rep.outcome())
 }
 
 fn stages_markdown(table: &[datapath::rti::SigDef]) -> String {
@@ -415,7 +466,13 @@ fn stages_markdown(table: &[datapath::rti::SigDef]) -> String {
     s
 }
 
-fn run() -> Result<bool, String> {
+fn run() -> Result<Outcome, String> {
+    // the manifest records the exact command line: it must be text
+    if let Some(a) = std::env::args_os().find(|a| a.to_str().is_none()) {
+        return Err(format!(
+            "argument {a:?} is not valid UTF-8; raypipe records its command line and needs text arguments"
+        ));
+    }
     let cli = Cli::parse();
     match cli.cmd {
         None => run_verify(VerifyArgs {
@@ -432,9 +489,7 @@ fn run() -> Result<bool, String> {
         Some(Cmd::Explain { unit, format, ray, tri, aabb, variant, tmin, tmax, rti }) => {
             let cfg = rti.config()?;
             let r = parse_list("--ray", &ray, 6)?;
-            if tmin.is_nan() || tmax.is_nan() {
-                return Err("--tmin/--tmax must not be NaN".into());
-            }
+            check_interval(tmin, tmax)?;
             let ray = Ray64 { o: [r[0], r[1], r[2]], d: [r[3], r[4], r[5]], tmin, tmax };
             match unit.as_str() {
                 "rti" => {
@@ -453,9 +508,10 @@ fn run() -> Result<bool, String> {
                 }
                 other => return Err(format!("unknown unit '{other}'; units: rti, slab")),
             }
-            Ok(true)
+            Ok(Outcome::Pass)
         }
         Some(Cmd::Traverse { scene, format, variant, rays, seed, n, leaf_size, levels, json }) => {
+            limit("--rays", rays, MAX_TRAVERSE_RAYS, "every ray is held in memory")?;
             let scene = load_scene(scene.as_deref())?;
             let cfg = raypipe::traverse::TraverseConfig {
                 formats: format,
@@ -468,30 +524,35 @@ fn run() -> Result<bool, String> {
             };
             let rep = raypipe::traverse::traverse(&cfg, &scene)?;
             emit(json, &rep, raypipe::traverse::render)?;
-            Ok(rep.passed)
+            Ok(Outcome::from(rep.passed))
         }
         Some(Cmd::Stats { scene, rays, seed, leaf_sizes, svg, json }) => {
+            limit("--rays", rays, MAX_STATS_RAYS, "every ray is held in memory")?;
+            let out = svg.as_deref().map(|d| OutDir::check(d, &raypipe::stats::SVG_FILES)).transpose()?;
             let scene = load_scene(scene.as_deref())?;
             let rep = raypipe::stats::stats(&scene, &leaf_sizes, rays as usize, seed)?;
             emit(json, &rep, raypipe::stats::render)?;
-            if let Some(dir) = svg {
-                for p in raypipe::stats::write_svgs(&rep, &dir)? {
+            if let Some(out) = out {
+                for p in raypipe::stats::write_svgs(&rep, &out)? {
                     eprintln!("wrote {}", p.display());
                 }
             }
-            Ok(true)
+            Ok(Outcome::Pass)
         }
         Some(Cmd::Render { scene, format, variant, width, height, leaf_size, out, json }) => {
+            let dir = OutDir::check(&out, &raypipe::render::FILES)?;
+            with_format!(format, |f| SlabConfig::named_for(&variant, &f).map(|_| ()))?;
             let scene = load_scene(scene.as_deref())?;
             let rep =
-                with_format!(format, |f| raypipe::render::render(f, &variant, &scene, width, height, leaf_size, &out))?;
+                with_format!(format, |f| raypipe::render::render(f, &variant, &scene, width, height, leaf_size, &dir))?;
             emit(json, &rep, |rep| {
                 format!(
                     "raypipe render: scene {}, format {}, slab variant {}: {} pixels, golden hits {}, holes (golden hit, pipeline miss) {}, false hits {}, other triangle {}; wrote {}/render.png and {}/diff.png (red: hole, blue: false hit, yellow: other triangle)",
                     scene.name, rep.format, rep.variant, rep.pixels, rep.golden_hits, rep.holes, rep.false_hits, rep.other_triangle, out.display(), out.display()
-                ) + "\n"
+                ) + &format!("\nboxes the slab unit culled on the way to the golden closest hit: {}{}\n", rep.culled,
+                    if rep.conservative { if rep.culled > 0 { " (VIOLATION: the variant is conservative in this format)" } else { " (the variant is conservative in this format: must be 0)" } } else { "" })
             })?;
-            Ok(true)
+            Ok(Outcome::from(!(rep.conservative && rep.culled > 0)))
         }
         Some(Cmd::Vectors {
             unit,
@@ -512,10 +573,15 @@ fn run() -> Result<bool, String> {
         }) => {
             if let Some(dir) = check {
                 let n = vectors::gen::check_set(&dir)?;
-                println!("{}: {n} vectors, every expected and stage row equals the model's bits", dir.display());
-                return Ok(true);
+                println!(
+                    "{}: {n} vectors; the manifest, the HDL packages and every input, expected and stage row are what this raypipe writes",
+                    dir.display()
+                );
+                return Ok(Outcome::Pass);
             }
             let out = out.ok_or("--out is required")?;
+            limit("--count", count, MAX_VECTOR_COUNT, "a set is built in memory before it is written")?;
+            vectors::gen::check_out(&out)?;
             let unit: vectors::gen::Unit = unit.parse()?;
             // a plan fixes what the scene does not need: the format, the leaf size, the levels
             let plan = plan.as_deref().map(raypipe::plan::load).transpose()?;
@@ -524,8 +590,21 @@ fn run() -> Result<bool, String> {
                 (None, Some(p)) => p.narrowest()?,
                 (None, None) => "f32".parse().expect("built-in format name"),
             };
-            let (leaf_size, levels) =
-                plan.as_ref().map_or((leaf_size, levels), |p| (p.leaf_size, p.level_pipelines as u64));
+            // the plan's leaf size and level pipelines, unless given (a conflict is refused)
+            let (leaf_size, levels) = match &plan {
+                Some(p) => {
+                    for (flag, given, planned) in [
+                        ("--leaf-size", leaf_size.map(u64::from), p.leaf_size as u64),
+                        ("--levels", levels, p.level_pipelines as u64),
+                    ] {
+                        if let Some(g) = given.filter(|&g| g != planned) {
+                            return Err(format!("{flag} {g} conflicts with the plan's {planned}; drop one of them"));
+                        }
+                    }
+                    (p.leaf_size, p.level_pipelines as u64)
+                }
+                None => (leaf_size.unwrap_or(4), levels.unwrap_or(64)),
+            };
             let tree = if unit == vectors::gen::Unit::Traverse {
                 let scene = load_scene(scene.as_deref())?;
                 if let Some(p) = &plan {
@@ -564,10 +643,11 @@ fn run() -> Result<bool, String> {
                 m.classes.iter().map(|c| format!("{} {}", c.name, c.count)).collect::<Vec<_>>().join(", "),
                 m.seed
             );
-            Ok(true)
+            Ok(Outcome::Pass)
         }
         Some(Cmd::Plan { scene, format, pipelines, budget, rays, seed, levels, json }) => {
             let scene = load_scene(scene.as_deref())?;
+            check_tests(rays, &scene, 512)?;
             let cfg = raypipe::plan::PlanConfig {
                 formats: format,
                 pipelines,
@@ -578,12 +658,16 @@ fn run() -> Result<bool, String> {
             };
             let p = raypipe::plan::plan(&cfg, &scene)?;
             emit(json, &p, raypipe::plan::render)?;
-            Ok(true)
+            Ok(Outcome::Pass)
         }
         Some(Cmd::Report { scene, format, variant, rays, stress_count, seed, out, json }) => {
+            let dir = OutDir::check(&out, &raypipe::report::FILES)?;
             let mut scenes = vec![Scene::builtin()];
             for p in &scene {
                 scenes.push(load_scene(Some(p))?);
+            }
+            for s in &scenes {
+                check_tests(rays, s, 512)?;
             }
             let cfg = raypipe::report::ReportConfig {
                 formats: format,
@@ -593,23 +677,24 @@ fn run() -> Result<bool, String> {
                 seed,
             };
             let rep = raypipe::report::report(&cfg, &scenes)?;
-            let files = raypipe::report::write(&rep, &out)?;
+            let files = raypipe::report::write(&rep, &dir)?;
             emit(json, &rep, raypipe::report::markdown)?;
             for f in files {
                 eprintln!("wrote {}", f.display());
             }
-            Ok(true)
+            Ok(Outcome::Pass)
         }
         Some(Cmd::Speed { pairs, seed, json }) => {
+            limit("--pairs", pairs, MAX_SPEED_PAIRS, "the columns are held in memory")?;
             let rep = raypipe::speed::speed(pairs as usize, seed);
             emit(json, &rep, raypipe::speed::render)?;
-            Ok(true)
+            Ok(Outcome::Pass)
         }
         Some(Cmd::Stress { format, variant, count, seed, json }) => {
             let cfg = raypipe::stress::StressConfig { formats: format, variants: variant, count: count as usize, seed };
             let rep = raypipe::stress::stress(&cfg)?;
             emit(json, &rep, raypipe::stress::render)?;
-            Ok(rep.passed)
+            Ok(Outcome::from(rep.passed))
         }
         Some(Cmd::Stages { unit, div }) => {
             let d = match div.as_str() {
@@ -622,7 +707,7 @@ fn run() -> Result<bool, String> {
                 "slab" => print!("{}", stages_markdown(&datapath::slab::SLAB_TABLE)),
                 other => return Err(format!("unknown unit '{other}'; units: rti, slab")),
             }
-            Ok(true)
+            Ok(Outcome::Pass)
         }
     }
 }
@@ -643,9 +728,14 @@ fn command_without_threads() -> String {
 }
 
 fn main() -> ExitCode {
+    // an interrupted run removes its temporary files and directories (exit 130, as a shell does)
+    let _ = ctrlc::set_handler(|| {
+        vectors::outdir::remove_partials();
+        eprintln!("interrupted: removed the partial output");
+        std::process::exit(130);
+    });
     match run() {
-        Ok(true) => ExitCode::SUCCESS,
-        Ok(false) => ExitCode::from(1),
+        Ok(o) => ExitCode::from(o as u8),
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::from(2)

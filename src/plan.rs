@@ -43,8 +43,10 @@ pub struct FormatFit {
     pub false_hits: u64,
     /// (false misses + false hits) / tests.
     pub disagreement_rate: f64,
-    /// Within the budget.
+    /// Within the budget (and usable: see `unusable`).
     pub meets_budget: bool,
+    /// Why the format cannot be chosen whatever its disagreement rate, if it cannot.
+    pub unusable: Option<String>,
 }
 
 /// The plan.
@@ -182,15 +184,26 @@ pub fn plan(cfg: &PlanConfig, scene: &Scene) -> Result<Plan, String> {
         .zip(&rep.formats)
         .map(|(f, r)| {
             let rate = (r.false_misses + r.false_hits) as f64 / (r.tests.max(1)) as f64;
+            let collapsed_triangles = with_format!(*f, |f| collapsed(f, scene));
+            // a format that holds none of the scene (every triangle collapses), or in which no
+            // test is decisive, agrees with the golden by missing everything: never within budget
+            let unusable = if collapsed_triangles == scene.tris.len() {
+                Some("every triangle collapses when stored".to_string())
+            } else if r.decisive == 0 {
+                Some("no test is decisive (the run proves nothing in this format)".to_string())
+            } else {
+                None
+            };
             FormatFit {
                 format: r.format.clone(),
                 width: r.width,
-                collapsed_triangles: with_format!(*f, |f| collapsed(f, scene)),
+                collapsed_triangles,
                 tests: r.tests,
                 false_misses: r.false_misses,
                 false_hits: r.false_hits,
                 disagreement_rate: rate,
-                meets_budget: rate <= cfg.budget,
+                meets_budget: rate <= cfg.budget && unusable.is_none(),
+                unusable,
             }
         })
         .collect();
@@ -252,8 +265,17 @@ pub fn render(p: &Plan) -> String {
             f.false_misses,
             f.false_hits,
             f.disagreement_rate,
-            if f.meets_budget { "ok" } else { "over" }
+            if f.meets_budget {
+                "ok"
+            } else if f.unusable.is_some() {
+                "unusable"
+            } else {
+                "over"
+            }
         );
+    }
+    for f in p.formats.iter().filter(|f| f.unusable.is_some()) {
+        s += &format!("{} unusable: {}\n", f.format, f.unusable.as_deref().unwrap_or(""));
     }
     s += &format!(
         "\nnarrowest format within {:e} disagreements per test: {} ({} rays, seed {})\n",

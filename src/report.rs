@@ -96,6 +96,8 @@ pub struct Report {
     pub seed: u64,
     /// Points, RTI first.
     pub points: Vec<Point>,
+    /// Format–variant pairs not run: the variant promises conservativeness the format cannot give.
+    pub refused: Vec<String>,
 }
 
 /// Scene rays against their target and 31 sampled triangles: (tests, false misses, false hits)
@@ -189,7 +191,11 @@ pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
     for f in &cfg.formats {
         let name = f.name();
         for v in &cfg.variants {
-            datapath::slab::SlabConfig::named(v)?;
+            let named = datapath::slab::SlabConfig::named(v)?;
+            // a variant that cannot keep its promise in this format is not run (stress names it)
+            if with_format!(*f, |f| named.for_format(v, &f)).is_err() {
+                continue;
+            }
             let mut p = Point::new("slab", format!("{name} {v}"), *f);
             let (mut time, mut timed) = (0.0, 0u64);
             for s in scenes {
@@ -219,6 +225,7 @@ pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
         stress_count: cfg.stress_count,
         seed: cfg.seed,
         points,
+        refused: st.refused.clone(),
     })
 }
 
@@ -255,31 +262,31 @@ pub fn markdown(r: &Report) -> String {
             if p.pareto { "★" } else { "" }
         );
     }
+    for why in &r.refused {
+        s += &format!("\nnot run: {why}\n");
+    }
     s
 }
 
 /// Writes `report.md`, `report.json`, `report_rti.svg` and `report_slab.svg` into `dir`.
-pub fn write(r: &Report, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let mut out = Vec::new();
-    let md = dir.join("report.md");
-    std::fs::write(&md, markdown(r)).map_err(|e| format!("{}: {e}", md.display()))?;
-    out.push(md);
-    let js = dir.join("report.json");
-    std::fs::write(&js, serde_json::to_string_pretty(r).map_err(|e| e.to_string())? + "\n")
-        .map_err(|e| format!("{}: {e}", js.display()))?;
-    out.push(js);
+pub fn write(r: &Report, out: &vectors::outdir::OutDir) -> Result<Vec<std::path::PathBuf>, String> {
+    let mut written = vec![out.write("report.md", markdown(r).as_bytes())?];
+    let json = serde_json::to_string_pretty(r).map_err(|e| e.to_string())? + "\n";
+    written.push(out.write("report.json", json.as_bytes())?);
     for unit in ["rti", "slab"] {
         let pts: Vec<&Point> = r.points.iter().filter(|p| p.unit == unit).collect();
         if pts.is_empty() {
             continue;
         }
-        let path = dir.join(format!("report_{unit}.svg"));
-        plot(&path, unit, &pts).map_err(|e| format!("{}: {e}", path.display()))?;
-        out.push(path);
+        let name = format!("report_{unit}.svg");
+        let svg = plot(unit, &pts).map_err(|e| format!("{name}: {e}"))?;
+        written.push(out.write(&name, svg.as_bytes())?);
     }
-    Ok(out)
+    Ok(written)
 }
+
+/// The files [`write`] may write (checked before the work starts).
+pub const FILES: [&str; 4] = ["report.md", "report.json", "report_rti.svg", "report_slab.svg"];
 
 /// Error rates below this (none seen) are drawn at it.
 const ERR_FLOOR: f64 = 1e-7;
@@ -287,7 +294,14 @@ const ERR_FLOOR: f64 = 1e-7;
 /// One unit's plot: time per test against error rate, both on log scales, the Pareto front in
 /// red, every point labelled beside its dot where that overlaps no other dot or label, and
 /// named under the plot otherwise.
-fn plot(path: &std::path::Path, unit: &str, pts: &[&Point]) -> Result<(), String> {
+fn plot(unit: &str, pts: &[&Point]) -> Result<String, String> {
+    let mut svg = String::new();
+    draw(unit, pts, &mut svg)?;
+    Ok(svg)
+}
+
+/// [`plot`]'s drawing, into `svg`.
+fn draw(unit: &str, pts: &[&Point], svg: &mut String) -> Result<(), String> {
     use plotters::prelude::*;
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let (w, h) = (900u32, 560u32);
@@ -301,7 +315,7 @@ fn plot(path: &std::path::Path, unit: &str, pts: &[&Point]) -> Result<(), String
     let ys = span(pts.iter().map(|p| y(p)).collect(), 0.3);
     // one significant digit where the axis spans decades, two where it spans less
     let digits = if ys.end - ys.start < 2.0 { 1 } else { 0 };
-    let root = SVGBackend::new(path, (w, h)).into_drawing_area();
+    let root = SVGBackend::with_string(svg, (w, h)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(format!("{unit}: time per test vs error (Pareto front in red)"), ("sans-serif", 18))

@@ -201,10 +201,18 @@ pub fn render(r: &StatsReport) -> String {
 /// One line figure: file name, y label, the value per leaf size.
 type Figure = (&'static str, &'static str, fn(&LeafSizeStats) -> f64);
 
-/// Writes the figures as SVG files into `dir` (plotters, SVG backend only).
-pub fn write_svgs(r: &StatsReport, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, String> {
+/// The files [`write_svgs`] writes (checked before the work starts).
+pub const SVG_FILES: [&str; 5] = [
+    "fig3-1_rays_per_leaf.svg",
+    "fig3-2_wasted_rti.svg",
+    "fig3-4_no_back_traversal.svg",
+    "restart_overhead.svg",
+    "fig3-5_back_distance.svg",
+];
+
+/// Writes the figures as SVG files into `out` (plotters, SVG backend only).
+pub fn write_svgs(r: &StatsReport, out: &vectors::outdir::OutDir) -> Result<Vec<std::path::PathBuf>, String> {
     use plotters::prelude::*;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let mut written = Vec::new();
     let series: [Figure; 4] = [
@@ -214,12 +222,12 @@ pub fn write_svgs(r: &StatsReport, dir: &std::path::Path) -> Result<Vec<std::pat
         ("restart_overhead.svg", "history / stack box tests", |w| w.restart_overhead),
     ];
     for (file, label, f) in series {
-        let path = dir.join(file);
+        let mut svg = String::new();
         let pts: Vec<(f64, f64)> = r.rows.iter().map(|w| ((w.leaf_size as f64).log2(), f(w))).collect();
         let ymax = pts.iter().map(|p| p.1).fold(0.0, f64::max) * 1.1 + 1e-9;
         let xmax = pts.iter().map(|p| p.0).fold(0.0, f64::max) + 0.5;
         {
-            let root = SVGBackend::new(&path, (640, 400)).into_drawing_area();
+            let root = SVGBackend::with_string(&mut svg, (640, 400)).into_drawing_area();
             root.fill(&WHITE).map_err(|e| err(&e))?;
             let mut chart = ChartBuilder::on(&root)
                 .caption(format!("{} — {}", r.scene, label), ("sans-serif", 18))
@@ -233,12 +241,12 @@ pub fn write_svgs(r: &StatsReport, dir: &std::path::Path) -> Result<Vec<std::pat
             chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, BLUE.filled()))).map_err(|e| err(&e))?;
             root.present().map_err(|e| err(&e))?;
         }
-        written.push(path);
+        written.push(out.write(file, svg.as_bytes())?);
     }
     // fig. 3-5: back-traversal distance distribution, one line per leaf size
-    let path = dir.join("fig3-5_back_distance.svg");
+    let mut svg = String::new();
     {
-        let root = SVGBackend::new(&path, (640, 400)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (640, 400)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(&e))?;
         let maxd = r.rows.iter().map(|w| w.back_distance.len()).max().unwrap_or(1) as f64;
         let mut chart = ChartBuilder::on(&root)
@@ -263,6 +271,6 @@ pub fn write_svgs(r: &StatsReport, dir: &std::path::Path) -> Result<Vec<std::pat
         chart.configure_series_labels().background_style(WHITE).border_style(BLACK).draw().map_err(|e| err(&e))?;
         root.present().map_err(|e| err(&e))?;
     }
-    written.push(path);
+    written.push(out.write(SVG_FILES[4], svg.as_bytes())?);
     Ok(written)
 }

@@ -90,6 +90,19 @@ pub struct VerifyReport {
     pub slab: Vec<SlabReport>,
     /// No property failed.
     pub passed: bool,
+    /// Formats in which no test was decisive: the property was not tested there.
+    pub inconclusive: Vec<String>,
+}
+
+impl VerifyReport {
+    /// The exit outcome: a failure, else inconclusive when a format had no decisive test.
+    pub fn outcome(&self) -> crate::Outcome {
+        match (self.passed, self.inconclusive.is_empty()) {
+            (false, _) => crate::Outcome::Fail,
+            (true, false) => crate::Outcome::Inconclusive,
+            (true, true) => crate::Outcome::Pass,
+        }
+    }
 }
 
 /// The (ray, triangle) test list: per ray, the triangles it is tested against.
@@ -294,6 +307,7 @@ pub fn verify(cfg: &VerifyConfig, scene: &Scene) -> VerifyReport {
         seed: cfg.seed,
         tests_per_ray: lists.first().map_or(0, Vec::len),
         passed: formats.iter().all(|f| f.violations == 0) && slab_ok,
+        inconclusive: formats.iter().filter(|f| f.decisive == 0).map(|f| f.format.clone()).collect(),
         formats,
         slab,
     }
@@ -351,7 +365,12 @@ pub fn render(r: &VerifyReport) -> String {
         .join(", ");
     s += "\n";
     s += &render_slab(&r.slab);
-    if r.passed {
+    if r.passed && !r.inconclusive.is_empty() {
+        s += &format!(
+            "property: INCONCLUSIVE: no decisive test in {} (every test's error bound straddles a threshold: degenerate triangles, or coordinates too large for the format): the run proved nothing there\n",
+            r.inconclusive.join(", ")
+        );
+    } else if r.passed {
         s += "property: PASS (no violations)\n";
     } else {
         s += "property: FAIL\n";

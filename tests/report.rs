@@ -33,7 +33,8 @@ fn points_pareto_front_and_files() {
     // the directed slab never misses, so all its error is false hits
     assert!(r.points.iter().filter(|p| p.variant.ends_with("directed")).all(|p| p.false_misses == 0));
     let dir = std::env::temp_dir().join(format!("raypipe-report-{}", std::process::id()));
-    let files = write(&r, &dir).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let files = write(&r, &vectors::outdir::OutDir::check(&dir, &raypipe::report::FILES).unwrap()).unwrap();
     assert_eq!(files.len(), 4);
     assert!(std::fs::read_to_string(dir.join("report.md")).unwrap().contains("| rti | f32 | 32 |"));
     // every point drawn, and named: beside its dot, or in the line under the plot

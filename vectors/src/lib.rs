@@ -7,6 +7,7 @@ pub mod check;
 pub mod gen;
 pub mod hdl;
 pub mod manifest;
+pub mod outdir;
 pub mod pack;
 pub mod traverse;
 

@@ -53,6 +53,30 @@ impl fmt::Display for AnyFormat {
     }
 }
 
+/// Each option group of a format name may be given once: `fp16:ftz+ieee` is refused, not
+/// settled by the last one.
+struct OptionGroups<'a> {
+    name: &'a str,
+    seen: Vec<(&'static str, String)>,
+}
+
+impl<'a> OptionGroups<'a> {
+    fn new(name: &'a str) -> Self {
+        Self { name, seen: Vec::new() }
+    }
+
+    fn once(&mut self, group: &'static str, opt: &str) -> Result<(), String> {
+        if let Some((_, first)) = self.seen.iter().find(|(g, _)| *g == group) {
+            return Err(format!(
+                "format '{}': options '{first}' and '{opt}' both set the {group} rule; give one; {FORMAT_HELP}",
+                self.name
+            ));
+        }
+        self.seen.push((group, opt.to_string()));
+        Ok(())
+    }
+}
+
 fn parse_custom(s: &str) -> Option<(u32, u32)> {
     let rest = s.strip_prefix('e')?;
     let (e, m) = rest.split_once('m')?;
@@ -79,7 +103,14 @@ impl FromStr for AnyFormat {
             let mut round = FxRound::Floor;
             let mut overflow = FxOverflow::Saturate;
             let mut div = DivMode::RecipMul;
+            let mut seen = OptionGroups::new(s);
             for o in opts {
+                match o {
+                    "floor" | "ceil" | "trunc" | "nearest" => seen.once("rounding", o)?,
+                    "saturate" | "wrap" => seen.once("overflow", o)?,
+                    "recip" | "divide" => seen.once("division", o)?,
+                    _ => {}
+                }
                 match o {
                     "floor" => round = FxRound::Floor,
                     "ceil" => round = FxRound::Ceil,
@@ -97,7 +128,14 @@ impl FromStr for AnyFormat {
                 .map_err(|e| format!("{e}; {FORMAT_HELP}"));
         }
         let mut o = FpOpts::default();
+        let mut seen = OptionGroups::new(s);
         for t in opts {
+            match t {
+                "ftz" | "ieee" => seen.once("subnormals", t)?,
+                "canonical" | "propagate" => seen.once("NaN", t)?,
+                "recip" | "divide" => seen.once("division", t)?,
+                _ => {}
+            }
             match t {
                 "ftz" => o.subnormals = Subnormals::Ftz,
                 "ieee" => o.subnormals = Subnormals::Ieee,
@@ -147,7 +185,24 @@ mod tests {
 
     #[test]
     fn bad_names_are_clear_errors() {
-        for n in ["f31", "e12m3", "e8m0", "q0.8", "q40.40", "fp16:fast", "q8.8:ftz", "", "e8", "q8"] {
+        for n in [
+            "f31",
+            "e12m3",
+            "e8m0",
+            "q0.8",
+            "q40.40",
+            "fp16:fast",
+            "q8.8:ftz",
+            "",
+            "e8",
+            "q8",
+            "fp16:ftz+ieee",
+            "f32:divide+recip",
+            "q8.24:saturate+wrap",
+            "q8.24:floor+nearest",
+            "bf16:canonical+propagate",
+            "fp16:ftz+ftz",
+        ] {
             let e = n.parse::<AnyFormat>().unwrap_err();
             assert!(e.contains("format"), "{n}: {e}");
         }
