@@ -1,17 +1,120 @@
 //! `raypipe explain`: every stage signal of one RTI test (value and hex bits) beside the same
-//! datapath evaluated in binary64 and the golden f64 result — how one failing RTL case is debugged.
+//! datapath evaluated in binary64 and the golden f64 result, or every signal of one slab test
+//! beside the f64 reference and the exact decision — how one failing RTL case is debugged.
+//! The trace is data ([`RtiTrace`], [`SlabTrace`]); the text and `--json` are two views of it.
 
 use crate::judge::{faces, quantise};
 use datapath::bound::RtiBound;
 use datapath::format::{FloatLayout, FpOpts, Ieee, Soft};
 use datapath::probe::{Recorder, Signal};
 use datapath::rti::{stage_table, Op, Rti, RtiConfig};
+use datapath::slab::Slab;
 use datapath::Format;
 use golden::{Ray64, Tri64};
+use serde::Serialize;
 use std::fmt::Write;
 
-/// Renders the stage-by-stage trace of one test.
-pub fn explain<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> String {
+/// One value as the testbench sees it: the number (`%e`, or `true`/`false` for a flag) and the
+/// hex bits it drives or probes.
+#[derive(Clone, Debug, Serialize)]
+pub struct Value {
+    /// Signal or input name.
+    pub name: String,
+    /// The value in decimal (`inf`, `NaN`, or a flag's `true`/`false`).
+    pub value: String,
+    /// The encoding in hex (a flag: 0 or 1).
+    pub bits: String,
+}
+
+/// One stage signal of the RTI trace.
+#[derive(Clone, Debug, Serialize)]
+pub struct RtiSignal {
+    /// Stage.
+    pub stage: u8,
+    /// Signal name and the model's value.
+    #[serde(flatten)]
+    pub model: Value,
+    /// The operation, as in the stage table.
+    pub op: String,
+    /// The same datapath in binary64 on the same quantised inputs.
+    pub binary64: String,
+    /// (model − binary64) in ulps of the format, when both are finite.
+    pub diff_ulps: Option<f64>,
+}
+
+/// Every signal of one ray–triangle test.
+#[derive(Clone, Debug, Serialize)]
+pub struct RtiTrace {
+    /// Format.
+    pub format: String,
+    /// Bits per value.
+    pub width: u32,
+    /// The quantised inputs.
+    pub inputs: Vec<Value>,
+    /// Every stage signal in stage-table order.
+    pub signals: Vec<RtiSignal>,
+    /// The model's outputs: valid, hit, t, u, v.
+    pub model: Vec<Value>,
+    /// The golden f64 Möller–Trumbore on the quantised inputs.
+    pub golden: GoldenRti,
+    /// The error bound's verdict.
+    pub bound: BoundRti,
+}
+
+/// The golden RTI result.
+#[derive(Clone, Debug, Serialize)]
+pub struct GoldenRti {
+    /// Hit.
+    pub hit: bool,
+    /// t, u, v, det, |det|/(|d||e1||e2|), barycentric margin, edge distance (decimal strings).
+    pub t: String,
+    /// u.
+    pub u: String,
+    /// v.
+    pub v: String,
+    /// det.
+    pub det: String,
+    /// |det| / (|d| |e1| |e2|).
+    pub det_rel: String,
+    /// min(u, v, 1 − u − v).
+    pub bary_margin: String,
+    /// Distance of the hit point from the nearest edge.
+    pub edge_dist: String,
+}
+
+/// The RTI error bound at this test.
+#[derive(Clone, Debug, Serialize)]
+pub struct BoundRti {
+    /// Every compared quantity is farther from its threshold than its bound: the model must agree.
+    pub decisive: bool,
+    /// The exact hit decision (f64-evaluated within the bound).
+    pub exact_hit: bool,
+    /// Bounds on |error| of det, up, vp, tp and t.
+    pub det_err: f64,
+    /// up.
+    pub up_err: f64,
+    /// vp.
+    pub vp_err: f64,
+    /// tp.
+    pub tp_err: f64,
+    /// t.
+    pub t_err: f64,
+}
+
+fn num(x: f64) -> String {
+    format!("{x:e}")
+}
+
+fn value<F: Format>(f: &F, name: &str, v: F::V) -> Value {
+    Value { name: name.into(), value: num(f.to_f64(v)), bits: f.hex(v) }
+}
+
+fn flag(name: &str, b: bool) -> Value {
+    Value { name: name.into(), value: b.to_string(), bits: (b as u8).to_string() }
+}
+
+/// The stage-by-stage trace of one ray–triangle test.
+pub fn trace_rti<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> RtiTrace {
     let f = &rti.fmt;
     let (rq, tq) = quantise(rti, ray, tri);
     let mut rec = Recorder::new();
@@ -21,62 +124,46 @@ pub fn explain<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> String {
     let twin = Rti::new(twin_fmt, RtiConfig { cull: rti.cull, det_threshold: f.to_f64(rti.det_thr), tie: rti.tie });
     let mut trec = Recorder::new();
     twin.trace(&twin.ray(rq.o, rq.d, rq.tmin, rq.tmax), &twin.tri(tq.v), &mut trec);
-
-    let mut s = String::new();
-    let _ = writeln!(s, "format {}  ({} bits per value)", f.name(), f.width());
-    let _ = writeln!(s, "inputs (quantised; hex = the bits an RTL testbench drives):");
-    let names = ["ox", "oy", "oz", "dx", "dy", "dz"];
-    let vals: Vec<f64> = rq.o.iter().chain(rq.d.iter()).copied().collect();
-    for (n, v) in names.iter().zip(vals) {
-        let _ = writeln!(s, "  {n:<5} {:>24} {}", format!("{v:e}"), f.hex(f.from_f64(v)));
+    let mut inputs = Vec::new();
+    for (n, v) in ["ox", "oy", "oz", "dx", "dy", "dz"].iter().zip(rq.o.iter().chain(rq.d.iter())) {
+        inputs.push(value(f, n, f.from_f64(*v)));
     }
     for (k, p) in tq.v.iter().enumerate() {
         for (a, v) in p.iter().enumerate() {
-            let _ = writeln!(s, "  v{k}{}   {:>24} {}", ["x", "y", "z"][a], format!("{v:e}"), f.hex(f.from_f64(*v)));
+            inputs.push(value(f, &format!("v{k}{}", ["x", "y", "z"][a]), f.from_f64(*v)));
         }
     }
-    let _ = writeln!(
-        s,
-        "\n{:>2}  {:<8} {:<18} {:>24} {:>17} {:>24} {:>10}",
-        "st", "signal", "op", "model", "bits", "binary64 twin", "diff ulp"
-    );
+    inputs.push(value(f, "tmin", f.from_f64(rq.tmin)));
+    inputs.push(value(f, "tmax", f.from_f64(rq.tmax)));
+    let mut signals = Vec::new();
     for d in stage_table(f.div_mode()) {
-        let opstr = match d.op {
+        let op = match d.op {
             Op::Sub => format!("{} - {}", d.a, d.b),
             Op::Add => format!("{} + {}", d.a, d.b),
             Op::Mul => format!("{} * {}", d.a, d.b),
             Op::Div => format!("{} / {}", d.a, d.b),
-            Op::Logic => "logic".to_string(),
+            Op::Logic => d.note.to_string(),
         };
         match (rec.get(d.name), trec.get(d.name)) {
             (Some(Signal::Value(v)), Some(Signal::Value(w))) => {
                 let (x, y) = (f.to_f64(v), f64::from_bits(w));
-                let diff =
-                    if x.is_finite() && y.is_finite() { format!("{:.2}", (x - y) / f.ulp(y)) } else { "-".into() };
-                let _ = writeln!(
-                    s,
-                    "{:>2}  {:<8} {:<18} {:>24} {:>17} {:>24} {:>10}",
-                    d.stage,
-                    d.name,
-                    opstr,
-                    format!("{x:e}"),
-                    f.hex(v),
-                    format!("{y:e}"),
-                    diff
-                );
+                let diff = (x.is_finite() && y.is_finite()).then(|| (x - y) / f.ulp(y));
+                signals.push(RtiSignal {
+                    stage: d.stage,
+                    model: value(f, d.name, v),
+                    op,
+                    binary64: num(y),
+                    diff_ulps: diff,
+                });
             }
             (Some(Signal::Flag(b)), Some(Signal::Flag(c))) => {
-                let _ = writeln!(
-                    s,
-                    "{:>2}  {:<8} {:<18} {:>24} {:>17} {:>24} {:>10}",
-                    d.stage,
-                    d.name,
-                    opstr,
-                    b,
-                    b as u8,
-                    c,
-                    if b == c { "" } else { "DIFFERS" }
-                );
+                signals.push(RtiSignal {
+                    stage: d.stage,
+                    model: flag(d.name, b),
+                    op,
+                    binary64: c.to_string(),
+                    diff_ulps: None,
+                });
             }
             _ => {}
         }
@@ -84,84 +171,169 @@ pub fn explain<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> String {
     let g = golden::intersect(&rq, &tq, faces(rti));
     let b = RtiBound::new(f.error_model(), f.div_mode(), rq.o, rq.d, tq.v);
     let v = b.verdict(rti.cull, f.to_f64(rti.det_thr), rq.tmin, rq.tmax);
+    RtiTrace {
+        format: f.name(),
+        width: f.width(),
+        inputs,
+        signals,
+        model: vec![
+            flag("valid", out.valid),
+            flag("hit", out.hit),
+            value(f, "t", out.t),
+            value(f, "u", out.u),
+            value(f, "v", out.v),
+        ],
+        golden: GoldenRti {
+            hit: g.hit,
+            t: num(g.t),
+            u: num(g.u),
+            v: num(g.v),
+            det: num(g.det),
+            det_rel: num(g.det_rel),
+            bary_margin: num(g.bary_margin),
+            edge_dist: num(g.edge_dist),
+        },
+        bound: BoundRti {
+            decisive: v.decisive,
+            exact_hit: v.hit,
+            det_err: b.det.err(),
+            up_err: b.up.err(),
+            vp_err: b.vp.err(),
+            tp_err: b.tp.err(),
+            t_err: b.t_err,
+        },
+    }
+}
+
+/// The RTI trace as text.
+pub fn render_rti(t: &RtiTrace) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "format {}  ({} bits per value)", t.format, t.width);
+    let _ = writeln!(s, "inputs (quantised; hex = the bits an RTL testbench drives):");
+    for v in &t.inputs {
+        let _ = writeln!(s, "  {:<5} {:>24} {}", v.name, v.value, v.bits);
+    }
     let _ = writeln!(
         s,
-        "\nmodel : hit {} valid {} t {:e} u {:e} v {:e}",
-        out.hit,
-        out.valid,
-        f.to_f64(out.t),
-        f.to_f64(out.u),
-        f.to_f64(out.v)
+        "\n{:>2}  {:<8} {:<18} {:>24} {:>17} {:>24} {:>10}",
+        "st", "signal", "op", "model", "bits", "binary64 twin", "diff ulp"
     );
-    let _ = writeln!(s, "golden: hit {} t {:e} u {:e} v {:e} det {:e} |det|/(|d||e1||e2|) {:.3e} barycentric margin {:.3e} edge distance {:.3e}", g.hit, g.t, g.u, g.v, g.det, g.det_rel, g.bary_margin, g.edge_dist);
+    for g in &t.signals {
+        let op = if g.op.len() > 18 { "logic" } else { g.op.as_str() };
+        let diff = match (g.diff_ulps, g.model.value == "true" || g.model.value == "false") {
+            (Some(d), _) => format!("{d:.2}"),
+            (None, true) if g.model.value != g.binary64 => "DIFFERS".into(),
+            (None, true) => String::new(),
+            (None, false) => "-".into(),
+        };
+        let _ = writeln!(
+            s,
+            "{:>2}  {:<8} {:<18} {:>24} {:>17} {:>24} {:>10}",
+            g.stage, g.model.name, op, g.model.value, g.model.bits, g.binary64, diff
+        );
+    }
+    let m = |n: &str| t.model.iter().find(|v| v.name == n).map_or("", |v| v.value.as_str()).to_string();
+    let _ = writeln!(s, "\nmodel : hit {} valid {} t {} u {} v {}", m("hit"), m("valid"), m("t"), m("u"), m("v"));
+    let g = &t.golden;
     let _ = writeln!(
         s,
-        "bound : decisive {} (exact hit {}); |err| det <= {:.3e}, u' <= {:.3e}, v' <= {:.3e}, t' <= {:.3e}, t <= {:.3e}",
-        v.decisive,
-        v.hit,
-        b.det.err(),
-        b.up.err(),
-        b.vp.err(),
-        b.tp.err(),
-        b.t_err
+        "golden: hit {} t {} u {} v {} det {} |det|/(|d||e1||e2|) {} barycentric margin {} edge distance {}",
+        g.hit, g.t, g.u, g.v, g.det, g.det_rel, g.bary_margin, g.edge_dist
+    );
+    let b = &t.bound;
+    let _ = writeln!(
+        s,
+        "bound : decisive {} (exact hit {}); |err| det <= {:.3e}, up <= {:.3e}, vp <= {:.3e}, tp <= {:.3e}, t <= {:.3e}",
+        b.decisive, b.exact_hit, b.det_err, b.up_err, b.vp_err, b.tp_err, b.t_err
     );
     s
 }
 
-/// Renders every slab signal of one ray–box test (value and hex bits), the f64 reference and
-/// the exact decision.
-pub fn explain_slab<F: Format>(
-    s: &datapath::slab::Slab<F>,
+/// Every signal of one ray–box test.
+#[derive(Clone, Debug, Serialize)]
+pub struct SlabTrace {
+    /// Format.
+    pub format: String,
+    /// Variant name.
+    pub variant: String,
+    /// The stored (outward-rounded) box: min x y z, max x y z.
+    pub stored_box: Vec<Value>,
+    /// Every signal in the order the model reports it (the stage table's order).
+    pub signals: Vec<Value>,
+    /// The model's outputs: hit, t_near, t_far.
+    pub model: Vec<Value>,
+    /// The f64 reference on the quantised ray and the original box: hit, t_near, t_far.
+    pub golden_hit: bool,
+    /// Its entry distance.
+    pub golden_t_near: String,
+    /// Its exit distance.
+    pub golden_t_far: String,
+    /// The exact decision (rational arithmetic); `None` when a quantised origin or direction
+    /// component is not finite.
+    pub exact_hit: Option<bool>,
+}
+
+/// The trace of one ray–box test.
+pub fn trace_slab<F: Format>(
+    s: &Slab<F>,
+    variant: &str,
     ray: &Ray64,
     lo: [f64; 3],
     hi: [f64; 3],
-) -> Result<String, String> {
+) -> Result<SlabTrace, String> {
     let f = &s.fmt;
     let b = s.store_box(lo, hi).map_err(|e| e.to_string())?;
     let mut rec = Recorder::new();
     let r = s.prepare_trace(ray.o, ray.d, ray.tmin, ray.tmax, &mut rec);
     let out = s.trace(&r, &b, &mut rec);
-    let mut t = String::new();
-    let _ = writeln!(t, "format {}  variant {:?}", f.name(), s.cfg);
-    let _ = writeln!(
-        t,
-        "stored box (outward-rounded): min {:?} max {:?}",
-        b.min.map(|v| f.to_f64(v)),
-        b.max.map(|v| f.to_f64(v))
-    );
-    let _ = writeln!(
-        t,
-        "  bits min {} {} {}  max {} {} {}",
-        f.hex(b.min[0]),
-        f.hex(b.min[1]),
-        f.hex(b.min[2]),
-        f.hex(b.max[0]),
-        f.hex(b.max[1]),
-        f.hex(b.max[2])
-    );
-    let _ = writeln!(t, "\n{:<8} {:>24} {:>17}", "signal", "value", "bits");
-    for (name, sig) in &rec.signals {
-        match sig {
-            Signal::Value(v) => {
-                let _ = writeln!(t, "{:<8} {:>24} {:>17}", name, format!("{:e}", f.to_f64(*v)), f.hex(*v));
-            }
-            Signal::Flag(x) => {
-                let _ = writeln!(t, "{:<8} {:>24} {:>17}", name, x, *x as u8);
-            }
-        }
-    }
+    let names = ["minx", "miny", "minz", "maxx", "maxy", "maxz"];
+    let stored_box = names.iter().zip(b.min.iter().chain(b.max.iter())).map(|(n, v)| value(f, n, *v)).collect();
+    let signals = rec
+        .signals
+        .iter()
+        .map(|(name, sig)| match sig {
+            Signal::Value(v) => value(f, name, *v),
+            Signal::Flag(x) => flag(name, *x),
+        })
+        .collect();
     let q = |x: f64| f.to_f64(f.from_f64(x));
     let (oq, dq) = (ray.o.map(q), ray.d.map(q));
     let g = golden::slab_f64(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi);
-    let exact = match golden::slab_exact(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi) {
+    Ok(SlabTrace {
+        format: f.name(),
+        variant: variant.into(),
+        stored_box,
+        signals,
+        model: vec![flag("hit", out.hit), value(f, "t_near", out.t_near), value(f, "t_far", out.t_far)],
+        golden_hit: g.hit,
+        golden_t_near: num(g.t_near),
+        golden_t_far: num(g.t_far),
+        exact_hit: golden::slab_exact(oq, dq, q(ray.tmin), q(ray.tmax), lo, hi),
+    })
+}
+
+/// The slab trace as text.
+pub fn render_slab(t: &SlabTrace) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "format {}  variant {}", t.format, t.variant);
+    let _ = writeln!(s, "stored box (outward-rounded):");
+    for v in &t.stored_box {
+        let _ = writeln!(s, "  {:<8} {:>24} {:>17}", v.name, v.value, v.bits);
+    }
+    let _ = writeln!(s, "\n{:<8} {:>24} {:>17}", "signal", "value", "bits");
+    for v in &t.signals {
+        let _ = writeln!(s, "{:<8} {:>24} {:>17}", v.name, v.value, v.bits);
+    }
+    let m = |n: &str| t.model.iter().find(|v| v.name == n).map_or("", |v| v.value.as_str()).to_string();
+    let _ = writeln!(s, "\nmodel : hit {} t_near {} t_far {}", m("hit"), m("t_near"), m("t_far"));
+    let exact = match t.exact_hit {
         Some(e) => e.to_string(),
         None => "none (a quantised origin or direction component is not finite)".into(),
     };
-    let _ = writeln!(t, "\nmodel : hit {} t_near {:e} t_far {:e}", out.hit, f.to_f64(out.t_near), f.to_f64(out.t_far));
     let _ = writeln!(
-        t,
-        "golden: hit {} t_near {:e} t_far {:e} (f64, quantised ray, original box); exact decision: hit {}",
-        g.hit, g.t_near, g.t_far, exact
+        s,
+        "golden: hit {} t_near {} t_far {} (f64, quantised ray, original box); exact decision: hit {exact}",
+        t.golden_hit, t.golden_t_near, t.golden_t_far
     );
-    Ok(t)
+    s
 }

@@ -127,6 +127,9 @@ enum Cmd {
         tmax: f64,
         #[command(flatten)]
         rti: RtiArgs,
+        /// Print the trace as JSON (every signal's value and bits, the references, the verdict).
+        #[arg(long)]
+        json: bool,
     },
     /// The 2-bit ray history and 1-bit trail traversals against the stack traversal on a scene's BVH.
     Traverse {
@@ -486,7 +489,7 @@ fn run() -> Result<Outcome, String> {
             rti: RtiArgs { cull: false, det_threshold: 0.0, tie: Tie::First },
         }),
         Some(Cmd::Verify(a)) => run_verify(a),
-        Some(Cmd::Explain { unit, format, ray, tri, aabb, variant, tmin, tmax, rti }) => {
+        Some(Cmd::Explain { unit, format, ray, tri, aabb, variant, tmin, tmax, rti, json }) => {
             let cfg = rti.config()?;
             let r = parse_list("--ray", &ray, 6)?;
             check_interval(tmin, tmax)?;
@@ -495,16 +498,17 @@ fn run() -> Result<Outcome, String> {
                 "rti" => {
                     let t = parse_list("--tri", tri.as_deref().ok_or("--unit rti needs --tri")?, 9)?;
                     let tri = Tri64 { v: [[t[0], t[1], t[2]], [t[3], t[4], t[5]], [t[6], t[7], t[8]]] };
-                    with_format!(format, |f| print!("{}", raypipe::explain::explain(&Rti::new(f, cfg), &ray, &tri)));
+                    let t = with_format!(format, |f| raypipe::explain::trace_rti(&Rti::new(f, cfg), &ray, &tri));
+                    emit(json, &t, raypipe::explain::render_rti)?;
                 }
                 "slab" => {
                     let b = parse_list("--box", aabb.as_deref().ok_or("--unit slab needs --box")?, 6)?;
                     let (lo, hi) = ([b[0], b[1], b[2]], [b[3], b[4], b[5]]);
-                    let text = with_format!(format, |f| {
+                    let t = with_format!(format, |f| {
                         let sc = SlabConfig::named_for(&variant, &f)?;
-                        raypipe::explain::explain_slab(&Slab::new(f, sc), &ray, lo, hi)
+                        raypipe::explain::trace_slab(&Slab::new(f, sc), &variant, &ray, lo, hi)
                     })?;
-                    print!("{text}");
+                    emit(json, &t, raypipe::explain::render_slab)?;
                 }
                 other => return Err(format!("unknown unit '{other}'; units: rti, slab")),
             }

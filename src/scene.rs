@@ -159,15 +159,49 @@ impl Scene {
         Self::normalised("builtin (cornell box + icosphere + needles)".into(), tris)
     }
 
-    /// Loads a Wavefront OBJ (polygons triangulated as fans).
+    /// Loads a Wavefront OBJ file (polygons triangulated as fans; materials ignored).
     pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
         if !path.is_file() {
             return Err(SceneError::Io(format!("{}: no such file", path.display())));
         }
+        let file = std::fs::File::open(path).map_err(|e| SceneError::Io(format!("{}: {e}", path.display())))?;
+        let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+        Self::parse_obj(&name, &mut std::io::BufReader::new(file))
+    }
+
+    /// Reads a Wavefront OBJ from `reader` (what [`Scene::load_obj`] does with a file; the
+    /// fuzz target `obj` feeds it arbitrary bytes). `name` names the scene and the errors.
+    pub fn parse_obj(name: &str, reader: &mut impl std::io::BufRead) -> Result<Scene, SceneError> {
         let opts =
             tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
-        let (models, _) =
-            tobj::load_obj(path, &opts).map_err(|e| SceneError::Malformed(format!("{}: {e}", path.display())))?;
+        // only positions and faces matter: the rest (texture coordinates, normals, materials,
+        // groups) is dropped before tobj sees it, and with it the index paths tobj does not
+        // check (a hostile texture index made it panic under fuzzing)
+        let mut bytes = Vec::new();
+        reader.read_to_end(&mut bytes).map_err(|e| SceneError::Io(format!("{name}: {e}")))?;
+        let text = String::from_utf8_lossy(&bytes);
+        let mut kept = String::with_capacity(text.len());
+        for line in text.lines() {
+            let mut words = line.split_whitespace();
+            match words.next() {
+                Some("v") => {
+                    kept.push_str(line.trim());
+                    kept.push('\n');
+                }
+                Some("f") => {
+                    kept.push('f');
+                    for w in words {
+                        kept.push(' ');
+                        kept.push_str(w.split('/').next().unwrap_or(""));
+                    }
+                    kept.push('\n');
+                }
+                _ => {}
+            }
+        }
+        let (models, _) = tobj::load_obj_buf(&mut kept.as_bytes(), &opts, |_| Err(tobj::LoadError::OpenFileFailed))
+            .map_err(|e| SceneError::Malformed(format!("{name}: {e}")))?;
+        let path = std::path::Path::new(name);
         let mut tris = Vec::new();
         for m in &models {
             let p = &m.mesh.positions;
@@ -197,8 +231,7 @@ impl Scene {
         if tris.is_empty() {
             return Err(SceneError::NoTriangles(path.display().to_string()));
         }
-        let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
-        Ok(Self::normalised(name, tris))
+        Ok(Self::normalised(name.to_string(), tris))
     }
 
     /// Scales by the power of two that brings the largest |coordinate| into (1/2, 1].

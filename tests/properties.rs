@@ -59,7 +59,7 @@ fn check(any: &AnyFormat, cull: Cull, ray: &Ray64, tri: &Tri64) -> Result<(), Te
             return Err(TestCaseError::fail(format!(
                 "{}: {why}\n{}",
                 rti.fmt.name(),
-                raypipe::explain::explain(&rti, ray, tri)
+                raypipe::explain::render_rti(&raypipe::explain::trace_rti(&rti, ray, tri))
             )));
         }
         Ok(())

@@ -159,7 +159,7 @@ const STAGES_1_TO_7: [SigDef; 53] = [
     s(3, "qx", Op::Sub, "qxa", "qxb"),
     s(3, "qy", Op::Sub, "qya", "qyb"),
     s(3, "qz", Op::Sub, "qza", "qzb"),
-    // stage 4: the twelve dot-product multiplies: det = e1·p, u' = s·p, v' = d·q, t' = e2·q
+    // stage 4: the twelve dot-product multiplies: det = e1·p, up = s·p, vp = d·q, tp = e2·q
     s(4, "detx", Op::Mul, "e1x", "px"),
     s(4, "dety", Op::Mul, "e1y", "py"),
     s(4, "detz", Op::Mul, "e1z", "pz"),
@@ -182,13 +182,13 @@ const STAGES_1_TO_7: [SigDef; 53] = [
     s(6, "up", Op::Add, "up_xy", "upz"),
     s(6, "vp", Op::Add, "vp_xy", "vpz"),
     s(6, "tp", Op::Add, "tp_xy", "tpz"),
-    // stage 7: u' + v' and the division-free validity test; the valid bit may be cleared here
+    // stage 7: uv = up + vp and the division-free validity test; the valid bit may be cleared here
     s(7, "uv", Op::Add, "up", "vp"),
     l(7, "det_ok", "two-sided: threshold < |det|; backface culling: threshold < det"),
-    l(7, "u_ok", "det > 0 ? 0 <= u' : u' <= 0"),
-    l(7, "v_ok", "det > 0 ? 0 <= v' : v' <= 0"),
-    l(7, "uv_ok", "det > 0 ? u'+v' <= det : det <= u'+v'"),
-    l(7, "t_ok", "det > 0 ? 0 <= t' : t' <= 0"),
+    l(7, "u_ok", "det > 0 ? 0 <= up : up <= 0"),
+    l(7, "v_ok", "det > 0 ? 0 <= vp : vp <= 0"),
+    l(7, "uv_ok", "det > 0 ? uv <= det : det <= uv"),
+    l(7, "t_ok", "det > 0 ? 0 <= tp : tp <= 0"),
 ];
 
 const VALID: SigDef = l(7, "valid", "det_ok & u_ok & v_ok & uv_ok & t_ok");

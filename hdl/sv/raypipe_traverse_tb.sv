@@ -38,6 +38,7 @@ module raypipe_traverse_tb;
 
   string dir;
   int max_errors = 10;
+  bit strict = 0;
   int timeout = 100000;
   int sent = 0;
   int got = 0;
@@ -59,6 +60,8 @@ module raypipe_traverse_tb;
     if (!$value$plusargs("set=%s", dir)) dir = "set";
     if ($value$plusargs("maxerrors=%d", max_errors)) ;
     if ($value$plusargs("timeout=%d", timeout)) ;
+    // +strict also compares passes and box_tests (implementation-defined)
+    if ($test$plusargs("strict")) strict = 1;
     $readmemh($sformatf("%0s/%0s", dir, IN_FILE), ins);
     $readmemh($sformatf("%0s/%0s", dir, OUT_FILE), outs);
     $display("raypipe_traverse_tb: %0d rays from %0s, %0d levels, first %0d leaves", N, dir, LEVELS, LEAVES);
@@ -101,11 +104,11 @@ module raypipe_traverse_tb;
         $display("FAIL: a result with no ray outstanding");
         failed++;
       end else begin
-        if (diff_out(res_row, outs[got]) != "none") begin
+        if (diff_out(res_row, outs[got], strict) != "none") begin
           failed++;
           if (failed <= max_errors)
             $display("FAIL ray %0d (line %0d, class %0d): first field to differ: %0s", got, got + 1,
-                     ins[got][IN_W-1 -: 8], diff_out(res_row, outs[got]));
+                     ins[got][IN_W-1 -: 8], diff_out(res_row, outs[got], strict));
         end else passed++;
         got++;
       end

@@ -117,6 +117,8 @@ impl Layout {
                     width: *width,
                     lsb: top,
                     stage: *stage,
+                    care_when: None,
+                    implementation_defined: false,
                 }
             })
             .collect()
@@ -764,18 +766,60 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
         params,
         latency,
         stages,
-        acceptable_values: "exact: every operation is correctly rounded per the contract, so each output has exactly one acceptable value".into(),
+        acceptable_values: ACCEPTABLE.into(),
         files: files
             .iter()
             .map(|fr| {
-                let fields = fr.layout.fields();
+                let mut fields = fr.layout.fields();
+                acceptance(req.unit, &fr.role, &mut fields);
                 let width: u32 = fields.iter().map(|x| x.width).sum();
-                manifest::File { name: fr.name.clone(), role: fr.role.clone(), rows: fr.lines.len(), width, digits: width.div_ceil(4), fields, sha256: String::new() }
+                manifest::File {
+                    name: fr.name.clone(),
+                    role: fr.role.clone(),
+                    rows: fr.lines.len(),
+                    width,
+                    digits: width.div_ceil(4),
+                    fields,
+                    sha256: String::new(),
+                }
             })
             .collect(),
-        classes: classes.iter().enumerate().map(|(i, (n, c))| Class { id: i as u32, name: n.clone(), covers: c.clone(), count: counts[i] }).collect(),
+        classes: classes
+            .iter()
+            .enumerate()
+            .map(|(i, (n, c))| Class { id: i as u32, name: n.clone(), covers: c.clone(), count: counts[i] })
+            .collect(),
     };
     Ok(VectorSet { manifest, files: files.into_iter().map(|fr| (fr.name, fr.lines.join("\n") + "\n")).collect() })
+}
+
+/// What the manifest says of acceptable values.
+pub const ACCEPTABLE: &str = "exact: every operation is correctly rounded per the contract, so each output field has exactly one acceptable value; a field with care_when F is compared only when the 1-bit field F of the expected output row is 1 (any value is acceptable otherwise); a field marked implementation_defined depends on how the DUT is built and is compared only on request (+strict in the kit's testbenches)";
+
+/// The per-field acceptance rules: rti `t`, `u`, `v` and every stage signal after the valid
+/// bit's stage (the divide and what depends on it, `hit` excepted) are don't-care when
+/// `valid = 0` (a DUT may skip the divide); traverse `passes` and `box_tests` count work the way
+/// the model's traversal does it (one pass per walk from the root, the root box once and two
+/// boxes per level visited) and are implementation-defined.
+fn acceptance(unit: Unit, role: &str, fields: &mut [Field]) {
+    let output = role == "expected outputs" || role.starts_with("expected results");
+    match unit {
+        Unit::Rti => {
+            for f in fields.iter_mut().filter(|f| f.dir == "out") {
+                let after_valid = f.stage.is_some_and(|s| s > 7) && f.name != "hit";
+                let outputs_tuv = output && ["t", "u", "v"].contains(&f.name.as_str());
+                if outputs_tuv || (role == crate::hdl::STAGE_ROLE && after_valid) {
+                    f.care_when = Some("valid".into());
+                }
+            }
+        }
+        Unit::Traverse => {
+            for f in fields.iter_mut().filter(|f| f.name == "passes" || f.name == "box_tests") {
+                f.implementation_defined = true;
+            }
+        }
+        _ => {}
+    }
 }
 
 /// The format's contract as integers.

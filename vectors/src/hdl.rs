@@ -108,10 +108,19 @@ fn sv_set_package(m: &crate::manifest::Manifest) -> String {
     for (k, v) in &m.params {
         s += &format!("  localparam logic [63:0] {} = 64'h{v:x};\n", k.to_uppercase());
     }
+    // the acceptance rules: a care_when field is compared only when its flag in the expected
+    // output row is 1, an implementation-defined field only with strict
+    let out_file = get(1);
+    let flag_bit = |name: &str| -> Option<u32> {
+        out_file.and_then(|f| f.fields.iter().find(|x| x.name == name && x.width == 1)).map(|x| x.lsb)
+    };
+    let out_w = out_file.map_or(1, |f| f.width);
     for (i, fname) in [(1, "diff_out"), (2, "diff_stg")] {
         let w = get(i).map_or(1, |f| f.width);
+        let extra = if i == 2 { format!(", logic [{}:0] want_out", out_w - 1) } else { String::new() };
+        let row = if i == 2 { "want_out" } else { "want" };
         s += &format!(
-            "  // The first field (in file order: earliest stage first) where got and want differ, or \"none\".\n  function automatic string {fname}(logic [{}:0] got, logic [{}:0] want);\n",
+            "  // The first field (in file order: earliest stage first) where got and want differ, or \"none\";\n  // fields the manifest marks care_when F are skipped when F is 0 in the expected output row,\n  // implementation-defined fields unless strict.\n  function automatic string {fname}(logic [{}:0] got, logic [{}:0] want{extra}, bit strict);\n",
             w - 1,
             w - 1
         );
@@ -119,7 +128,14 @@ fn sv_set_package(m: &crate::manifest::Manifest) -> String {
             for fld in &f.fields {
                 let (hi, lo) = (fld.lsb + fld.width - 1, fld.lsb);
                 let at = fld.stage.map_or(String::new(), |k| format!(" (stage {k})"));
-                s += &format!("    if (got[{hi}:{lo}] !== want[{hi}:{lo}]) return \"{}{at}\";\n", fld.name);
+                let mut cond = format!("got[{hi}:{lo}] !== want[{hi}:{lo}]");
+                if let Some(b) = fld.care_when.as_deref().and_then(flag_bit) {
+                    cond = format!("{row}[{b}] && {cond}");
+                }
+                if fld.implementation_defined {
+                    cond = format!("strict && {cond}");
+                }
+                s += &format!("    if ({cond}) return \"{}{at}\";\n", fld.name);
             }
         }
         s += "    return \"none\";\n  endfunction\n";

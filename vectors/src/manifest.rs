@@ -45,6 +45,14 @@ pub struct Field {
     /// Pipeline stage that produces it (outputs and stage signals).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub stage: Option<u8>,
+    /// The field is compared only when this 1-bit field of the expected output row is 1 (rti
+    /// `t`, `u`, `v` and the signals after the divide: `valid`); absent: always compared.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub care_when: Option<String>,
+    /// The value depends on how a DUT is built (traverse `passes`, `box_tests`): the kit's
+    /// testbenches compare it only with `+strict`.
+    #[serde(skip_serializing_if = "std::ops::Not::not", default)]
+    pub implementation_defined: bool,
 }
 
 /// One data file.

@@ -5,7 +5,8 @@
 // division-free validity test; then the division: recip-mul formats 8: 1/det, 9: t, u, v
 // products, 10: the t-interval test; divide formats 8: three divides, 9: the t-interval test).
 // Every stage signal is carried to the end of the pipeline and presented on stg_row.
-// Define RAYPIPE_INJECT_FAULT to make the detx multiplier truncate instead of rounding to
+// Define RAYPIPE_SKIP_DIVIDE to zero the divide's signals when valid = 0 (a DUT that skips the
+// divide; the testbench must still pass). Define RAYPIPE_INJECT_FAULT to make the detx multiplier truncate instead of rounding to
 // nearest (the kit's negative check: the testbench must fail, naming stage signal detx).
 module raypipe_rti_ref
   import raypipe_fp::*;
@@ -140,6 +141,20 @@ module raypipe_rti_ref
         y.s.hit = x.s.valid & y.s.tmin_ok & y.s.tmax_ok;
       end
     endcase
+`ifdef RAYPIPE_SKIP_DIVIDE
+    // a thesis-style DUT: once the valid bit clears, the divide stage is skipped and everything
+    // after it reads 0 (the manifest marks those fields care_when valid: the set must pass)
+    if (k > 7 && !y.s.valid) begin
+`ifdef RAYPIPE_RECIP_MUL
+      y.s.inv_det = '0;
+`endif
+      y.s.t = '0;
+      y.s.u = '0;
+      y.s.v = '0;
+      y.s.tmin_ok = 1'b0;
+      y.s.tmax_ok = 1'b0;
+    end
+`endif
     return y;
   endfunction
 

@@ -12,7 +12,8 @@
 // 11 the farther taken): new & both hit -> nearer, 10; one hit -> it, 01; 10 & the deepest 10
 // at pass start -> farther, 11, deeper levels 00; 10 otherwise -> nearer; 11 -> farther; no
 // hit -> the pass ends. The right child is nearer only when its t_near < the left's.
-// Define RAYPIPE_INJECT_FAULT to send ties to the right child (the negative check).
+// Define RAYPIPE_INJECT_FAULT to send ties to the right child (the negative check), and
+// RAYPIPE_COUNT_PAIRS_TWICE to count box tests otherwise (passes; fails with +strict).
 module raypipe_traverse_ref
   import raypipe_fp::*;
   import raypipe_box::*;
@@ -132,7 +133,12 @@ module raypipe_traverse_ref
           end
         end
         LEVEL: begin
+`ifdef RAYPIPE_COUNT_PAIRS_TWICE
+          // counts its box tests otherwise (implementation-defined: passes unless +strict)
+          box_tests = box_tests + 4;
+`else
           box_tests = box_tests + 2;
+`endif
           el = box(ray, lmem[level_base(level) + idx]);
           er = box(ray, rmem[level_base(level) + idx]);
           side = -1;
