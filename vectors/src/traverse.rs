@@ -350,7 +350,7 @@ pub(crate) fn generate<F: Format>(
     crate::gen::slab_options(&mut options, &sc);
     options.insert(
         "traversal".into(),
-        "2-bit ray history, restart from the root (raypipe README, 'Traversal'); the right child is nearer only when its entry t_near is less than the left's (format compare), ties and NaN go left".into(),
+        "2-bit ray history, restart from the root (raypipe README, section 'BVH traversal: the 2-bit ray history'); the right child is nearer only when its entry t_near is less than the left's (format compare), ties and NaN go left".into(),
     );
     options.insert(
         "address_word".into(),
