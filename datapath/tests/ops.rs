@@ -15,7 +15,7 @@ use datapath::rng::SplitMix64;
 use num_rational::BigRational;
 use oracle::{Fx, Op, OPS};
 use rustc_apfloat::ieee::{BFloat, Half, IeeeFloat, Semantics, Single};
-use rustc_apfloat::{Float as _, Round};
+use rustc_apfloat::Round;
 
 const SEED: u64 = 0x5eed_0001;
 
@@ -128,8 +128,12 @@ fn fp16_and_f32_match_exact_rationals() {
 
 /// One APFloat operation, nearest-even, on encodings.
 fn ap_op<T: rustc_apfloat::Float>(op: Op, a: u64, b: u64) -> u64 {
+    ap_op_in::<T>(Round::NearestTiesToEven, op, a, b)
+}
+
+/// One APFloat operation in rounding mode `r`, on encodings.
+fn ap_op_in<T: rustc_apfloat::Float>(r: Round, op: Op, a: u64, b: u64) -> u64 {
     let (x, y) = (T::from_bits(a as u128), T::from_bits(b as u128));
-    let r = Round::NearestTiesToEven;
     let v = match op {
         Op::Add => x.add_r(y, r),
         Op::Sub => x.sub_r(y, r),
@@ -214,15 +218,7 @@ fn custom_layouts_match_apfloat() {
 #[test]
 fn the_apfloat_check_catches_a_wrong_rounding() {
     fn away(op: Op, a: u64, b: u64) -> u64 {
-        let (x, y) = (Half::from_bits(a as u128), Half::from_bits(b as u128));
-        let r = Round::NearestTiesToAway;
-        let v = match op {
-            Op::Add => x.add_r(y, r),
-            Op::Sub => x.sub_r(y, r),
-            Op::Mul => x.mul_r(y, r),
-            Op::Div => x.div_r(y, r),
-        };
-        v.value.to_bits() as u64
+        ap_op_in::<Half>(Round::NearestTiesToAway, op, a, b)
     }
     let f = Ieee::new(F16Half, divide());
     let r = std::panic::catch_unwind(|| check_against_oracle(&f, away, "ties-away", 20_000));
