@@ -88,6 +88,8 @@ fn a_promise_the_format_cannot_keep_is_refused() {
         ("fp16:ftz", "conservative", "flush-to-zero"),
         ("f32:ftz+divide", "conservative", "flush-to-zero"),
         ("q16.16:wrap", "directed", "wrap"),
+        ("e5m2", "conservative", "fewer than 4 fraction bits"),
+        ("e4m3", "conservative", "fewer than 4 fraction bits"),
     ] {
         let any: AnyFormat = name.parse().unwrap();
         let e = with_format!(any, |f| SlabConfig::named_for(variant, &f)).unwrap_err();
@@ -95,7 +97,7 @@ fn a_promise_the_format_cannot_keep_is_refused() {
         let listed = with_format!(any, |f| SlabConfig::variants_for(&f));
         assert!(!listed.contains(&variant), "{name}: {listed:?}");
     }
-    for name in ["f32", "fp16", "bf16", "e8m16", "f32:propagate+divide"] {
+    for name in ["f32", "fp16", "bf16", "e8m16", "e5m4", "f32:propagate+divide"] {
         let any: AnyFormat = name.parse().unwrap();
         assert_eq!(with_format!(any, |f| SlabConfig::variants_for(&f)).len(), 5, "{name}");
     }

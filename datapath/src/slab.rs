@@ -27,11 +27,13 @@
 //! subtract of finite operands that overflowed to ±∞. Either becomes the canonical NaN, the
 //! products it feeds are NaN, and the `Ignore` comparator drops them: that axis (reciprocal) or
 //! that plane (subtract) imposes no constraint, which only widens the interval. Every other
-//! finite product obeys `|t_c − t| ≤ γ₃|t| + s/2` with `γ₃ = 3u/(1 − 3u)`. Then
-//! `γ₃|t| + s/2 < 4 ulp(t_c)` for every computed `t_c`: for a normal `t_c`,
-//! `ulp(t_c) ≥ u|t_c|` and `|t| ≤ |t_c|/(1 − γ₃)`, so the error is below `3.01 u|t_c|`, and
-//! four steps toward −∞ from a power of two `2^e` still cover `4 · 2^(e−M−1) ≥ 3.01u·2^e`;
-//! for a subnormal `t_c`, steps are `s` and the error is below `1.5 s + s/2 = 2s`. A product
+//! finite product obeys `|t_c − t| ≤ γ₃|t| + s/2` with `γ₃ = 3u/(1 − 3u)`, hence
+//! `|t_c − t| ≤ 3u/(1 − 6u)·|t_c| + s/2`. For a normal `t_c` the smallest of the 4 steps
+//! toward −∞ is at least `u·|t_c|` (the steps below a power of two `2^e` are `2^(e−M−1) = u·2^e`,
+//! half those above it), so 4 steps cover `4u|t_c| ≥ 3u/(1 − 6u)·|t_c|` whenever `u ≤ 1/24`:
+//! the variant needs at least [`MIN_MAN_BITS`] = 4 fraction bits (`u ≤ 1/32`) and refuses
+//! narrower formats (e5m2, e4m3, …). For a subnormal `t_c` the steps are `s`, `|t|` is below
+//! about the least normal `2^M·s`, and the error is below `3u/(1 − 6u)·2^M·s + s/2 < 2.4 s`. A product
 //! that overflowed to ±∞ from finite factors has `|t|` above the largest finite value, so one
 //! step toward zero (±∞ → ±max) is already on the right side. Widening the accumulated
 //! `t_near` by 4 steps toward −∞ (IEEE nextDown) and `t_far` by 4 toward +∞ (nextUp) widens
@@ -97,6 +99,9 @@ pub struct SlabConfig {
 /// Widening that, with the guard, makes the float slab test conservative (the proof is in the
 /// module docs): every guarded computed distance is within 4 grid steps of the exact one.
 pub const CONSERVATIVE_ULPS: i32 = 4;
+
+/// The fewest fraction bits the 4-step proof holds for (`u = 2^-(M+1) <= 1/32`).
+pub const MIN_MAN_BITS: u32 = 4;
 
 /// The stage table of the round-to-nearest slab datapath (variants plain, conservative,
 /// take-on-false, embree), in the order the probe reports the signals. Stage 0 runs once per
@@ -165,7 +170,8 @@ impl SlabConfig {
     /// every format that does not wrap; the guarded ulp widening by at least
     /// [`CONSERVATIVE_ULPS`] in float formats with IEEE subnormals.
     pub fn is_conservative<F: Format>(&self, f: &F) -> bool {
-        let float = matches!(f.kind(), crate::format::FormatKind::Float(_));
+        // the widening proof needs u <= 1/32: at least 4 fraction bits
+        let float = matches!(f.kind(), crate::format::FormatKind::Float(l) if l.man_bits >= MIN_MAN_BITS);
         (self.directed && !f.wraps())
             || (!self.directed
                 && self.guard
@@ -189,6 +195,8 @@ impl SlabConfig {
         if self.promises_conservative() && !self.is_conservative(f) {
             let why = if self.directed {
                 "wrapping fixed point has no bound that survives a wrap-around (use :saturate)"
+            } else if matches!(f.kind(), crate::format::FormatKind::Float(l) if l.man_bits < MIN_MAN_BITS) {
+                "with fewer than 4 fraction bits, 4 grid steps do not bound three roundings (use directed)"
             } else if f.flushes() {
                 "under flush-to-zero a subnormal difference becomes 0 and 4 grid steps no longer bound the error (use directed)"
             } else {
