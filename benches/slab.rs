@@ -4,7 +4,7 @@
 //! Run: `cargo bench --bench slab` (`RAYPIPE_PLAN=plan.json` benches only a plan's formats).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa, SLAB_VARIANTS};
+use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa};
 use datapath::{with_format, AnyFormat, Format};
 use std::hint::black_box;
 
@@ -26,7 +26,8 @@ fn bench_slab(c: &mut Criterion) {
     };
     for any in formats {
         with_format!(any, |f| {
-            for v in SLAB_VARIANTS {
+            // the variants this format accepts (a conservative promise it cannot keep is refused)
+            for v in SlabConfig::variants_for(&f) {
                 let s = Slab::new(f, SlabConfig::named(v).unwrap());
                 let (mut rs, mut bs) = (SlabRaysSoa::default(), BoxesSoa::default());
                 for (ray, t) in &rays {

@@ -34,8 +34,10 @@ pub struct RtiSignal {
     /// Signal name and the model's value.
     #[serde(flatten)]
     pub model: Value,
-    /// The operation, as in the stage table.
+    /// The operation, as in the stage table (for a compare/logic row, its rule).
     pub op: String,
+    /// A compare/logic row (a 1-bit signal).
+    pub logic: bool,
     /// The same datapath in binary64 on the same quantised inputs.
     pub binary64: String,
     /// (model − binary64) in ulps of the format, when both are finite.
@@ -144,6 +146,7 @@ pub fn trace_rti<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> RtiTrace 
             Op::Div => format!("{} / {}", d.a, d.b),
             Op::Logic => d.note.to_string(),
         };
+        let logic = d.op == Op::Logic;
         match (rec.get(d.name), trec.get(d.name)) {
             (Some(Signal::Value(v)), Some(Signal::Value(w))) => {
                 let (x, y) = (f.to_f64(v), f64::from_bits(w));
@@ -152,6 +155,7 @@ pub fn trace_rti<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> RtiTrace 
                     stage: d.stage,
                     model: value(f, d.name, v),
                     op,
+                    logic,
                     binary64: num(y),
                     diff_ulps: diff,
                 });
@@ -161,6 +165,7 @@ pub fn trace_rti<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> RtiTrace 
                     stage: d.stage,
                     model: flag(d.name, b),
                     op,
+                    logic,
                     binary64: c.to_string(),
                     diff_ulps: None,
                 });
@@ -219,8 +224,8 @@ pub fn render_rti(t: &RtiTrace) -> String {
         "st", "signal", "op", "model", "bits", "binary64 twin", "diff ulp"
     );
     for g in &t.signals {
-        let op = if g.op.len() > 18 { "logic" } else { g.op.as_str() };
-        let diff = match (g.diff_ulps, g.model.value == "true" || g.model.value == "false") {
+        let op = if g.logic { "logic" } else { g.op.as_str() };
+        let diff = match (g.diff_ulps, g.logic) {
             (Some(d), _) => format!("{d:.2}"),
             (None, true) if g.model.value != g.binary64 => "DIFFERS".into(),
             (None, true) => String::new(),

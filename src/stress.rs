@@ -7,6 +7,7 @@
 //! hits none of the candidate triangles.
 
 use crate::scene::icosphere;
+use datapath::format::Edges;
 use datapath::rng::SplitMix64;
 use datapath::rti::{Rti, RtiConfig};
 use datapath::slab::{Slab, SlabConfig};
@@ -64,20 +65,6 @@ pub const SLAB_STRESS: [(&str, &str); 15] = [
     ("max_planes", "box planes at exactly +-max on an axis, origin inside or outside"),
     ("mixed_edges", "two of the above edges at once on different axes"),
 ];
-
-/// The format's scales the edge classes draw from: the least positive value `s`, the least
-/// normal `n` (fixed point: both the step) and the largest finite `m`.
-#[derive(Clone, Copy)]
-struct Scales {
-    s: f64,
-    n: f64,
-    m: f64,
-}
-
-fn scales<F: Format>(f: &F) -> Scales {
-    let e = datapath::format::edges(f);
-    Scales { s: e.least, n: e.min_normal, m: e.max }
-}
 
 /// Failures of one RTI class in one format.
 #[derive(Clone, Debug, Serialize)]
@@ -332,9 +319,9 @@ fn rti_rows<F: Format>(f: F, cfg: &StressConfig) -> Vec<RtiStressRow> {
         .collect()
 }
 
-fn slab_case(class: usize, r: &mut SplitMix64, sc: Scales) -> ([f64; 8], [f64; 3], [f64; 3]) {
+fn slab_case(class: usize, r: &mut SplitMix64, e: Edges) -> ([f64; 8], [f64; 3], [f64; 3]) {
     if class >= 8 {
-        return slab_edge_case(class, r, sc);
+        return slab_edge_case(class, r, e);
     }
     let (scale, center) = match class {
         4 => ((-6f64).exp2(), unit(r).map(|x| 512.0 * x)),
@@ -401,16 +388,16 @@ fn sign(r: &mut SplitMix64) -> f64 {
 
 /// The edge classes (8 and up): a ray that hits a box on the ordinary axes at t* and whose
 /// special axis (or two) is built from the format's scales.
-fn slab_edge_case(class: usize, r: &mut SplitMix64, sc: Scales) -> ([f64; 8], [f64; 3], [f64; 3]) {
+fn slab_edge_case(class: usize, r: &mut SplitMix64, e: Edges) -> ([f64; 8], [f64; 3], [f64; 3]) {
     // t stays well inside every format's range (q1.F holds t < 1)
-    let tcap = (sc.m / 2.0).min(8.0);
+    let tcap = (e.max / 2.0).min(8.0);
     let (t1, t2) = {
         let a = r.range(0.0625, 0.5) * tcap;
         (a, a * r.range(1.0, 2.0))
     };
     let tmid = (t1 + t2) / 2.0;
     // ordinary axes: a box of half-width w around the point the ray reaches at tmid
-    let w = (sc.m / 8.0).min(1.0) * r.range(0.05, 0.5);
+    let w = (e.max / 8.0).min(1.0) * r.range(0.05, 0.5);
     let mut lo = [0.0; 3];
     let mut hi = [0.0; 3];
     let mut o = [0.0; 3];
@@ -435,7 +422,7 @@ fn slab_edge_case(class: usize, r: &mut SplitMix64, sc: Scales) -> ([f64; 8], [f
         match kind {
             // tiny components: the slab at t in [t1, t2] scaled by d
             8 | 9 => {
-                let k = if kind == 8 { sc.s * (1.0 + r.below(8) as f64) } else { sc.n * r.range(1.0, 64.0) };
+                let k = if kind == 8 { e.least * (1.0 + r.below(8) as f64) } else { e.min_normal * r.range(1.0, 64.0) };
                 let da = sign(r) * k;
                 d[a] = da;
                 o[a] = 0.0;
@@ -444,10 +431,10 @@ fn slab_edge_case(class: usize, r: &mut SplitMix64, sc: Scales) -> ([f64; 8], [f
             }
             // huge components: the box at t ~ 1/|d|, i.e. one unit or so from the origin
             10 => {
-                let da = sign(r) * sc.m * (-(r.range(0.0, 4.0))).exp2();
+                let da = sign(r) * e.max * (-(r.range(0.0, 4.0))).exp2();
                 d[a] = da;
                 o[a] = 0.0;
-                let u = (sc.m / 4.0).min(2.0);
+                let u = (e.max / 4.0).min(2.0);
                 let (x, y) = (da.signum() * u * r.range(0.1, 0.5), da.signum() * u * r.range(0.5, 1.0));
                 (lo[a], hi[a]) = (x.min(y), x.max(y));
             }
@@ -471,20 +458,20 @@ fn slab_edge_case(class: usize, r: &mut SplitMix64, sc: Scales) -> ([f64; 8], [f
                 let s = sign(r);
                 if r.below(2) == 0 {
                     // a box beyond the middle, the origin near the opposite end
-                    let (x, y) = (r.range(0.3, 0.9) * sc.m, r.range(0.3, 0.9) * sc.m);
+                    let (x, y) = (r.range(0.3, 0.9) * e.max, r.range(0.3, 0.9) * e.max);
                     (lo[a], hi[a]) = if s > 0.0 { (x.min(y), x.max(y)) } else { (-x.max(y), -x.min(y)) };
-                    o[a] = -s * r.range(0.3, 0.95) * sc.m;
+                    o[a] = -s * r.range(0.3, 0.95) * e.max;
                 } else {
                     // a box across the middle, the origin on (or just before) its near plane:
                     // the far plane's difference exceeds the range
-                    let (x, y) = (r.range(0.55, 0.95) * sc.m, r.range(0.55, 0.95) * sc.m);
+                    let (x, y) = (r.range(0.55, 0.95) * e.max, r.range(0.55, 0.95) * e.max);
                     (lo[a], hi[a]) = (-x, y);
-                    let before = if r.below(2) == 0 { 0.0 } else { r.range(0.0, 0.04) * sc.m };
+                    let before = if r.below(2) == 0 { 0.0 } else { r.range(0.0, 0.04) * e.max };
                     o[a] = if s > 0.0 { lo[a] - before } else { hi[a] + before };
                     // leave the slab just after tmid, and cross the other axes' slabs in a
                     // narrow window around tmid: a shrunken exit misses them
                     let far = if s > 0.0 { hi[a] } else { lo[a] };
-                    d[a] = ((far - o[a]) / (1.1 * tmid)).clamp(-sc.m, sc.m);
+                    d[a] = ((far - o[a]) / (1.1 * tmid)).clamp(-e.max, e.max);
                     if kinds.len() == 1 {
                         for b in (0..3).filter(|&b| b != a) {
                             d[b] = sign(r) * w * r.range(2.0, 4.0) / tmid;
@@ -495,17 +482,18 @@ fn slab_edge_case(class: usize, r: &mut SplitMix64, sc: Scales) -> ([f64; 8], [f
                 }
                 // reach the middle of the slab at tmid
                 d[a] = ((lo[a] + hi[a]) / 2.0 - o[a]) / tmid;
-                d[a] = d[a].clamp(-sc.m, sc.m);
+                d[a] = d[a].clamp(-e.max, e.max);
             }
             // planes at exactly +-max
             _ => {
                 (lo[a], hi[a]) = match r.below(3) {
-                    0 => (-sc.m, sc.m),
-                    1 => (r.range(0.0, 0.5) * sc.m, sc.m),
-                    _ => (-sc.m, -r.range(0.0, 0.5) * sc.m),
+                    0 => (-e.max, e.max),
+                    1 => (r.range(0.0, 0.5) * e.max, e.max),
+                    _ => (-e.max, -r.range(0.0, 0.5) * e.max),
                 };
-                o[a] = if r.below(2) == 0 { r.range(lo[a], hi[a]) } else { -hi[a].signum() * r.range(0.5, 1.0) * sc.m };
-                d[a] = (((lo[a] + hi[a]) / 2.0 - o[a]) / tmid).clamp(-sc.m, sc.m);
+                o[a] =
+                    if r.below(2) == 0 { r.range(lo[a], hi[a]) } else { -hi[a].signum() * r.range(0.5, 1.0) * e.max };
+                d[a] = (((lo[a] + hi[a]) / 2.0 - o[a]) / tmid).clamp(-e.max, e.max);
             }
         }
     }
@@ -515,7 +503,7 @@ fn slab_edge_case(class: usize, r: &mut SplitMix64, sc: Scales) -> ([f64; 8], [f
 fn slab_rows<F: Format>(f: F, sc: SlabConfig, variant: &str, cfg: &StressConfig) -> Vec<SlabStressRow> {
     use rayon::prelude::*;
     let s = Slab::new(f, sc);
-    let scl = scales(&f);
+    let edges = datapath::format::edges(&f);
     let q = |x: f64| f.to_f64(f.from_f64(x));
     (0..SLAB_STRESS.len())
         .into_par_iter()
@@ -535,7 +523,7 @@ fn slab_rows<F: Format>(f: F, sc: SlabConfig, variant: &str, cfg: &StressConfig)
                 undecided_hits: 0,
             };
             for _ in 0..cfg.count {
-                let (x, lo, hi) = slab_case(class, &mut r, scl);
+                let (x, lo, hi) = slab_case(class, &mut r, edges);
                 // the box corners as the format holds them, so that a point on a face (origin
                 // or aim) stays on it after quantisation; store_box keeps them exactly
                 let (lo, hi) = (lo.map(q), hi.map(q));

@@ -209,11 +209,7 @@ impl SlabConfig {
 
     /// The named variants that format `f` accepts (see [`SlabConfig::for_format`]).
     pub fn variants_for<F: Format>(f: &F) -> Vec<&'static str> {
-        SLAB_VARIANTS
-            .iter()
-            .copied()
-            .filter(|v| SlabConfig::named(v).and_then(|c| c.for_format(v, f)).is_ok())
-            .collect()
+        SLAB_VARIANTS.iter().copied().filter(|v| SlabConfig::named_for(v, f).is_ok()).collect()
     }
 
     /// A named variant for format `f` ([`SlabConfig::named`], then [`SlabConfig::for_format`]).

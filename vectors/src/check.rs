@@ -101,16 +101,8 @@ fn request_from(m: &Manifest, unit: Unit, format: AnyFormat, contents: &[Vec<Vec
 /// The traverse set's tree from its root row and level banks, in the breadth-first order the
 /// layout assigns pair indices in (so laying it out again gives the same banks).
 fn tree_from_banks<F: Format>(f: &F, m: &Manifest, contents: &[Vec<Vec<u64>>]) -> Result<TreeInput, String> {
-    let idx = |name: &str| m.files.iter().position(|x| x.name == name);
-    let levels = m.params.get("levels").copied().ok_or("manifest.json: params has no levels")? as usize;
-    let root = idx("tree_root.hex").and_then(|i| contents[i].first()).ok_or("the set has no tree_root.hex row")?;
-    let mut banks = Vec::new();
-    for l in 0..levels {
-        let (Some(a), Some(b)) = (idx(&format!("tree_l{l}_left.hex")), idx(&format!("tree_l{l}_right.hex"))) else {
-            return Err(format!("the set lacks the level {l} bank images"));
-        };
-        banks.push((&contents[a], &contents[b]));
-    }
+    let (root, banks) = crate::gen::tree_images(m, contents)?;
+    let levels = banks.len();
     let node = |row: &[u64]| -> Result<(NodeDesc, u32), String> {
         if row.len() < 7 {
             return Err("a tree row has fewer than 7 fields".into());

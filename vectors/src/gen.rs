@@ -1220,18 +1220,32 @@ pub(crate) fn check_rows(
     })
 }
 
-/// The traverse unit's check: the tree comes from the set's own BRAM images.
-fn check_traverse<F: Format>(f: F, m: &Manifest, contents: &[Vec<Vec<u64>>]) -> Result<usize, String> {
+/// One level's left and right bank rows.
+pub(crate) type BankImages<'a> = (&'a Vec<Vec<u64>>, &'a Vec<Vec<u64>>);
+
+/// A traverse set's BRAM images: the root entry row and each level's two banks, by file name.
+pub(crate) fn tree_images<'a>(
+    m: &Manifest,
+    contents: &'a [Vec<Vec<u64>>],
+) -> Result<(&'a [u64], Vec<BankImages<'a>>), String> {
     let idx = |name: &str| m.files.iter().position(|x| x.name == name);
-    let levels = m.params.get("levels").copied().ok_or("manifest has no levels parameter")? as usize;
-    let n = m.params.get("leaves").copied().ok_or("manifest has no leaves parameter")? as usize;
-    let root = idx("tree_root.hex").and_then(|i| contents[i].first()).ok_or("set has no tree_root.hex row")?;
+    let levels = m.params.get("levels").copied().ok_or("manifest.json: params has no levels")? as usize;
+    let root = idx("tree_root.hex").and_then(|i| contents.get(i)?.first()).ok_or("the set has no tree_root.hex row")?;
     let mut banks = Vec::new();
     for l in 0..levels {
-        let (a, b) = (idx(&format!("tree_l{l}_left.hex")), idx(&format!("tree_l{l}_right.hex")));
-        let (Some(a), Some(b)) = (a, b) else { return Err(format!("set lacks the level {l} bank images")) };
-        banks.push((contents[a].clone(), contents[b].clone()));
+        let (Some(a), Some(b)) = (idx(&format!("tree_l{l}_left.hex")), idx(&format!("tree_l{l}_right.hex"))) else {
+            return Err(format!("the set lacks the level {l} bank images"));
+        };
+        banks.push((&contents[a], &contents[b]));
     }
+    Ok((root, banks))
+}
+
+/// The traverse unit's check: the tree comes from the set's own BRAM images.
+fn check_traverse<F: Format>(f: F, m: &Manifest, contents: &[Vec<Vec<u64>>]) -> Result<usize, String> {
+    let n = m.params.get("leaves").copied().ok_or("manifest has no leaves parameter")? as usize;
+    let (root, images) = tree_images(m, contents)?;
+    let banks: Vec<_> = images.into_iter().map(|(a, b)| (a.clone(), b.clone())).collect();
     let variant = m.options.get("variant").map_or("plain", |s| s.as_str());
     let want = crate::traverse::recheck(f, variant, n, root, &banks, &contents[0])?;
     for (i, w) in want.iter().enumerate() {
