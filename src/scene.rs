@@ -266,30 +266,50 @@ impl Scene {
     /// are exercised) and incoherent (random origin, uniformly random direction). Each ray
     /// carries the index of the triangle it was aimed at (or a random one).
     pub fn rays(&self, n: usize, seed: u64) -> Vec<(Ray64, usize)> {
-        let mut r = SplitMix64::new(seed);
-        let (lo, hi) = self.bounds();
-        let mut out = Vec::with_capacity(n);
-        for i in 0..n {
-            let o = [0, 1, 2].map(|a| r.range(lo[a], hi[a]));
-            let target = r.below(self.tris.len() as u64) as usize;
-            let d = if i % 2 == 0 {
-                let t = &self.tris[target];
-                let (b1, b2) = (r.range(-0.1, 1.1), r.range(-0.1, 1.1));
-                let (b1, b2) = if b1 + b2 > 1.2 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
-                let b0 = 1.0 - b1 - b2;
-                let p = [0, 1, 2].map(|a| b0 * t.v[0][a] + b1 * t.v[1][a] + b2 * t.v[2][a]);
-                [p[0] - o[0], p[1] - o[1], p[2] - o[2]]
-            } else {
-                let z = r.range(-1.0, 1.0);
-                let phi = r.range(0.0, 2.0 * std::f64::consts::PI);
-                let s = (1.0 - z * z).sqrt();
-                [s * phi.cos(), s * phi.sin(), z]
-            };
-            out.push((Ray64 { o, d, tmin: 0.0, tmax: f64::INFINITY }, target));
-        }
-        out
+        let g = self.ray_gen(seed);
+        (0..n as u64).map(|i| g.ray(self, i)).collect()
+    }
+
+    /// The generator of [`Scene::rays`] for `seed`, to make any ray by its index.
+    pub fn ray_gen(&self, seed: u64) -> RayGen {
+        RayGen { seed, bounds: self.bounds() }
     }
 }
+
+/// Makes ray `i` of a scene's seeded ray set without the rays before it.
+#[derive(Clone, Copy, Debug)]
+pub struct RayGen {
+    seed: u64,
+    bounds: ([f64; 3], [f64; 3]),
+}
+
+impl RayGen {
+    /// Ray `i` of the seeded ray set (see [`Scene::rays`]) and its target triangle: drawn from
+    /// `SplitMix64::for_item(seed, RAY_STREAM, i)` alone.
+    pub fn ray(&self, scene: &Scene, i: u64) -> (Ray64, usize) {
+        let mut r = SplitMix64::for_item(self.seed, RAY_STREAM, i);
+        let (lo, hi) = self.bounds;
+        let o = [0, 1, 2].map(|a| r.range(lo[a], hi[a]));
+        let target = r.below(scene.tris.len() as u64) as usize;
+        let d = if i % 2 == 0 {
+            let t = &scene.tris[target];
+            let (b1, b2) = (r.range(-0.1, 1.1), r.range(-0.1, 1.1));
+            let (b1, b2) = if b1 + b2 > 1.2 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
+            let b0 = 1.0 - b1 - b2;
+            let p = [0, 1, 2].map(|a| b0 * t.v[0][a] + b1 * t.v[1][a] + b2 * t.v[2][a]);
+            [p[0] - o[0], p[1] - o[1], p[2] - o[2]]
+        } else {
+            let z = r.range(-1.0, 1.0);
+            let phi = r.range(0.0, 2.0 * std::f64::consts::PI);
+            let s = (1.0 - z * z).sqrt();
+            [s * phi.cos(), s * phi.sin(), z]
+        };
+        (Ray64 { o, d, tmin: 0.0, tmax: f64::INFINITY }, target)
+    }
+}
+
+/// Stream number of the scene's rays in [`SplitMix64::for_item`].
+pub const RAY_STREAM: u64 = 0x7261_7973; // "rays"
 
 #[cfg(test)]
 mod tests {

@@ -49,29 +49,36 @@ struct Ctx {
     overflow: bool,
 }
 
+// Every step is branch-free (flags or-ed, results selected) so that `verdict_block`'s loop
+// vectorises; the scalar and block paths run this same code.
 impl Ctx {
+    #[inline(always)]
     fn check(&mut self, b: Bnd) -> Bnd {
         let m = b.v.abs() + b.e;
-        if m.is_nan() || m > self.em.max {
-            self.overflow = true;
-        }
+        // NaN or above the largest magnitude
+        self.overflow |= !(m <= self.em.max);
         b
     }
+    #[inline(always)]
     fn input(&mut self, x: f64) -> Bnd {
         self.check(Bnd { v: x, a: x.abs(), e: 0.0 })
     }
+    #[inline(always)]
     fn addsub(&mut self, x: Bnd, y: Bnd, sub: bool) -> Bnd {
         let v = if sub { x.v - y.v } else { x.v + y.v };
         let e0 = x.e + y.e;
         let e = e0 + self.em.u * (v.abs() + e0) + self.em.add_eta;
         self.check(Bnd { v, a: x.a + y.a, e })
     }
+    #[inline(always)]
     fn add(&mut self, x: Bnd, y: Bnd) -> Bnd {
         self.addsub(x, y, false)
     }
+    #[inline(always)]
     fn sub(&mut self, x: Bnd, y: Bnd) -> Bnd {
         self.addsub(x, y, true)
     }
+    #[inline(always)]
     fn mul(&mut self, x: Bnd, y: Bnd) -> Bnd {
         let v = x.v * y.v;
         let e0 = x.v.abs() * y.e + y.v.abs() * x.e + x.e * y.e;
@@ -114,6 +121,7 @@ pub struct Verdict {
 
 impl RtiBound {
     /// Bounds for one ray (origin, direction) and triangle given as the format's values in f64.
+    #[inline(always)]
     pub fn new(em: ErrorModel, div: DivMode, o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> Self {
         let mut c = Ctx { em, overflow: false };
         let o = o.map(|x| c.input(x));
@@ -146,27 +154,26 @@ impl RtiBound {
         let tp = dot(e2, q);
         let uv = c.add(up, vp);
         let denom = det.v.abs() - det.err();
+        // det not clear of zero (denom <= 0): the quotient is unbounded
+        let ok = !(denom <= 0.0);
         let quot = |num: Bnd, c: &mut Ctx| -> f64 {
-            if denom <= 0.0 {
-                return f64::INFINITY;
-            }
             let q = num.v / det.v;
             let d1 = (num.err() + q.abs() * det.err()) / denom;
             let mag = q.abs() + d1;
             let u = em.u;
             let extra = match div {
                 DivMode::RecipMul => {
-                    if 1.0 / denom > em.max {
-                        c.overflow = true;
-                    }
+                    c.overflow |= ok & (1.0 / denom > em.max);
                     (2.0 * u + u * u) * mag + em.eta * (num.v.abs() + num.err()) * (1.0 + u) + em.eta
                 }
                 DivMode::Divide => u * mag + em.eta,
             };
-            if mag + extra > em.max {
-                c.overflow = true;
+            c.overflow |= ok & (mag + extra > em.max);
+            if ok {
+                d1 + extra
+            } else {
+                f64::INFINITY
             }
-            d1 + extra
         };
         let t_err = quot(tp, &mut c);
         let u_err = quot(up, &mut c);
@@ -180,6 +187,7 @@ impl RtiBound {
     }
 
     /// The exact decision and whether it is decisive for the model with these options.
+    #[inline(always)]
     pub fn verdict(&self, cull: Cull, det_threshold: f64, tmin: f64, tmax: f64) -> Verdict {
         let clear = |x: f64, b: f64| x.abs() > b;
         let det_q = match cull {
@@ -193,25 +201,106 @@ impl RtiBound {
         let v_ok = sgn(self.vp.v) >= 0.0;
         let uv_ok = sgn(self.det.v - self.uv.v) >= 0.0;
         let t_ok = sgn(self.tp.v) >= 0.0;
-        let valid = det_ok && u_ok && v_ok && uv_ok && t_ok;
-        let mut decisive = !self.overflow
-            && clear(det_q, self.det.err())
-            && clear(self.det.v, self.det.err())
-            && clear(self.up.v, self.up.err())
-            && clear(self.vp.v, self.vp.err())
-            && clear(self.det.v - self.uv.v, self.det.err() + self.uv.err())
-            && clear(self.tp.v, self.tp.err());
+        let valid = det_ok & u_ok & v_ok & uv_ok & t_ok;
+        let decisive = !self.overflow
+            & clear(det_q, self.det.err())
+            & clear(self.det.v, self.det.err())
+            & clear(self.up.v, self.up.err())
+            & clear(self.vp.v, self.vp.err())
+            & clear(self.det.v - self.uv.v, self.det.err() + self.uv.err())
+            & clear(self.tp.v, self.tp.err());
         let t = self.t();
-        let mut hit = valid;
-        if valid {
-            hit = t >= tmin && t <= tmax;
-            if tmin.is_finite() {
-                decisive &= clear(t - tmin, self.t_err);
-            }
-            if tmax.is_finite() {
-                decisive &= clear(t - tmax, self.t_err);
-            }
+        // a valid case also decides t against the finite ends of [tmin, tmax]
+        let hit = valid & (t >= tmin) & (t <= tmax);
+        let t_clear =
+            (!tmin.is_finite() | clear(t - tmin, self.t_err)) & (!tmax.is_finite() | clear(t - tmax, self.t_err));
+        Verdict { decisive: decisive & (!valid | t_clear), hit }
+    }
+}
+
+/// One ray against a block of triangles: each lane's [`RtiBound::new`] and
+/// [`RtiBound::verdict`], the same code as one case, run over coordinate columns in f64 lanes.
+#[derive(Clone, Copy, Debug)]
+pub struct BlockRay {
+    /// Origin (the format's values in f64).
+    pub o: [f64; 3],
+    /// Direction.
+    pub d: [f64; 3],
+    /// Smallest accepted t.
+    pub tmin: f64,
+    /// Largest accepted t.
+    pub tmax: f64,
+}
+
+/// The options every lane of a block shares.
+#[derive(Clone, Copy, Debug)]
+pub struct BlockOpts {
+    /// The format's rounding model.
+    pub em: ErrorModel,
+    /// Division mode.
+    pub div: DivMode,
+    /// Face culling.
+    pub cull: Cull,
+    /// det threshold (the format's value in f64).
+    pub det_threshold: f64,
+}
+
+/// Per lane: the verdict's `decisive` and `hit`, and the bound `t_err`, for `ray` against
+/// triangle columns x0 y0 z0 x1 y1 z1 x2 y2 z2, on AVX-512F lanes, AVX2 lanes or the baseline
+/// (the widest the machine has within `cap`); bit-identical to [`RtiBound::new`] +
+/// [`RtiBound::verdict`] on each lane (same operations, same order; the level changes only the
+/// instructions).
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn verdict_block(
+    cap: crate::simd::Kernel,
+    opts: BlockOpts,
+    ray: BlockRay,
+    tris: [&[f64]; 9],
+    decisive: &mut [bool],
+    hit: &mut [bool],
+    t_err: &mut [f64],
+) {
+    use crate::simd::Kernel;
+    let n = hit.len();
+    assert!(decisive.len() == n && t_err.len() == n && tris.iter().all(|c| c.len() == n), "column lengths differ");
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::is_x86_feature_detected as has;
+        if cap >= Kernel::Avx512 && has!("avx512f") {
+            // SAFETY: AVX-512F is present (checked above)
+            return unsafe { block_avx512(opts, ray, tris, decisive, hit, t_err) };
         }
-        Verdict { decisive, hit }
+        if cap >= Kernel::Avx2 && has!("avx2") {
+            // SAFETY: AVX2 is present (checked above)
+            return unsafe { block_avx2(opts, ray, tris, decisive, hit, t_err) };
+        }
+    }
+    let _ = cap;
+    block_body(opts, ray, tris, decisive, hit, t_err)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn block_avx512(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: &mut [bool], te: &mut [f64]) {
+    block_body(o, r, c, dec, hit, te)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn block_avx2(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: &mut [bool], te: &mut [f64]) {
+    block_body(o, r, c, dec, hit, te)
+}
+
+#[inline(always)]
+fn block_body(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: &mut [bool], te: &mut [f64]) {
+    for i in 0..hit.len() {
+        let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
+        let b = RtiBound::new(o.em, o.div, r.o, r.d, v);
+        let vd = b.verdict(o.cull, o.det_threshold, r.tmin, r.tmax);
+        dec[i] = vd.decisive;
+        hit[i] = vd.hit;
+        te[i] = b.t_err;
     }
 }

@@ -551,3 +551,64 @@ mod generic {
         }
     }
 }
+
+/// The error bound on f64 lanes (`bound::verdict_block`) equals the scalar bound on every lane,
+/// for every instruction level the machine has (under `emu/avx512`: AVX-512F too).
+mod bound_block {
+    use super::*;
+    use datapath::bound::{verdict_block, BlockOpts, BlockRay, RtiBound};
+
+    fn edge(r: &mut SplitMix64) -> f64 {
+        match r.below(12) {
+            0 => 0.0,
+            1 => -0.0,
+            2 => f64::INFINITY,
+            3 => f64::NAN,
+            4 => f64::from_bits(r.next_u64() & 0x000f_ffff_ffff_ffff),
+            5 => 3.4e38 * r.range(0.5, 2.0),
+            6 => (r.below(9) as f64) - 4.0,
+            _ => r.range(-2.0, 2.0),
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(96))]
+        #[test]
+        fn the_bound_on_lanes_equals_the_scalar_bound(seed in any::<u64>(), n in 0usize..70, divide in any::<bool>(), cull in any::<bool>(), fmt in 0usize..3) {
+            let mut r = SplitMix64::new(seed);
+            let em = match fmt {
+                0 => Ieee::new(F32Native, FpOpts::default()).error_model(),
+                1 => Ieee::new(F16Half, FpOpts::default()).error_model(),
+                _ => {
+                    let q: datapath::AnyFormat = "q8.24".parse().unwrap();
+                    datapath::with_format!(q, |f| f.error_model())
+                }
+            };
+            let opts = BlockOpts {
+                em,
+                div: if divide { DivMode::Divide } else { DivMode::RecipMul },
+                cull: if cull { Cull::Backface } else { Cull::TwoSided },
+                det_threshold: if r.below(3) == 0 { 1e-3 } else { 0.0 },
+            };
+            let ray = BlockRay {
+                o: std::array::from_fn(|_| edge(&mut r)),
+                d: std::array::from_fn(|_| edge(&mut r)),
+                tmin: if r.below(3) == 0 { edge(&mut r) } else { 0.0 },
+                tmax: if r.below(3) == 0 { edge(&mut r) } else { f64::INFINITY },
+            };
+            let cols: [Vec<f64>; 9] = std::array::from_fn(|_| (0..n).map(|_| edge(&mut r)).collect());
+            for k in kernels_here() {
+                let (mut dec, mut hit, mut te) = (vec![false; n], vec![false; n], vec![0.0; n]);
+                verdict_block(k, opts, ray, std::array::from_fn(|c| &cols[c][..]), &mut dec, &mut hit, &mut te);
+                for i in 0..n {
+                    let v = std::array::from_fn(|p| std::array::from_fn(|a| cols[3 * p + a][i]));
+                    let b = RtiBound::new(opts.em, opts.div, ray.o, ray.d, v);
+                    let want = b.verdict(opts.cull, opts.det_threshold, ray.tmin, ray.tmax);
+                    prop_assert_eq!((dec[i], hit[i]), (want.decisive, want.hit), "{:?} lane {}", k, i);
+                    // NaN bounds compare as NaN (Rust leaves a NaN's encoding open)
+                    prop_assert!(te[i].to_bits() == b.t_err.to_bits() || (te[i].is_nan() && b.t_err.is_nan()), "{:?} lane {}", k, i);
+                }
+            }
+        }
+    }
+}

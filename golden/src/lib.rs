@@ -2,6 +2,7 @@
 //! models it judges (it shares no code with them).
 #![warn(missing_docs)]
 
+pub mod block;
 pub mod bvh;
 pub mod mt;
 pub mod slab;
