@@ -91,6 +91,15 @@ struct VerifyArgs {
     /// A plan (`raypipe plan --json`): verify only its formats within budget (unless --format).
     #[arg(long)]
     plan: Option<PathBuf>,
+    /// Worker threads (default: every core); the results do not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    threads: Option<u64>,
+    /// Rays per chunk of the streaming engine; the results do not depend on it.
+    #[arg(long, default_value_t = raypipe::verify::CHUNK_RAYS, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    chunk: u64,
+    /// No progress bar on stderr.
+    #[arg(long)]
+    quiet: bool,
     #[command(flatten)]
     rti: RtiArgs,
 }
@@ -396,9 +405,9 @@ fn emit<T: serde::Serialize>(json: bool, value: &T, render: impl FnOnce(&T) -> S
     Ok(())
 }
 
-/// Verify, plan and report hold every test of a run in memory (~160 bytes each; the
-/// streaming engine will lift this): a run of more tests is refused up front.
-const MAX_TESTS: u64 = 40_000_000;
+/// Triangles tested per ray at most: each worker holds one ray's test list (4 bytes each).
+/// Verify, plan and report stream their rays, so the number of rays is not limited.
+const MAX_SAMPLE: u64 = 1 << 24;
 /// Rays `traverse` holds (~75 bytes each) and `stats` holds (~200 bytes each) at most.
 const MAX_TRAVERSE_RAYS: u64 = 50_000_000;
 const MAX_STATS_RAYS: u64 = 20_000_000;
@@ -415,16 +424,9 @@ fn limit(what: &str, n: u64, max: u64, why: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// The tests a verify-like run of `rays` rays makes per format on `scene`.
-fn check_tests(rays: u64, scene: &Scene, sample: u64) -> Result<(), String> {
-    let per_ray = (scene.tris.len() as u64).min(sample).max(1);
-    let tests = rays.saturating_mul(per_ray);
-    limit(
-        &format!("tests per format (--rays {rays} x {per_ray} triangles per ray)"),
-        tests,
-        MAX_TESTS,
-        "every test is held in memory, ~160 bytes each; use fewer --rays or a smaller --sample",
-    )
+/// Refuses a per-ray test list this build cannot hold (the rays themselves are streamed).
+fn check_tests(_rays: u64, _scene: &Scene, sample: u64) -> Result<(), String> {
+    limit("--sample", sample, MAX_SAMPLE, "each worker holds one ray's test list")
 }
 
 /// The OBJ scene at `path`, or the built-in scene.
@@ -448,7 +450,9 @@ fn run_verify(a: VerifyArgs) -> Result<Outcome, String> {
         (true, None) => DEFAULT_FORMATS.iter().map(|f| f.parse().expect("built-in format name")).collect(),
     };
     check_tests(a.rays, &scene, a.sample)?;
-    let cfg = VerifyConfig { formats, rays: a.rays as usize, seed: a.seed, rti, sample: a.sample as usize };
+    let mut cfg = VerifyConfig::new(formats, a.rays as usize, a.seed, rti, a.sample as usize);
+    cfg.engine = engine::Engine::new(a.chunk).with_threads(a.threads.map(|t| t as usize));
+    cfg.progress = !a.quiet;
     let rep = verify(&cfg, &scene);
     emit(a.json, &rep, render)?;
     Ok(rep.outcome())
@@ -486,6 +490,9 @@ fn run() -> Result<Outcome, String> {
             sample: 512,
             json: false,
             plan: None,
+            threads: None,
+            chunk: raypipe::verify::CHUNK_RAYS,
+            quiet: false,
             rti: RtiArgs { cull: false, det_threshold: 0.0, tie: Tie::First },
         }),
         Some(Cmd::Verify(a)) => run_verify(a),

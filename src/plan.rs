@@ -170,13 +170,7 @@ pub fn plan(cfg: &PlanConfig, scene: &Scene) -> Result<Plan, String> {
     let leaf_size = cfg.pipelines;
     let b = crate::bvh::build(scene, leaf_size);
     let (closed, oriented) = topology(scene);
-    let vcfg = VerifyConfig {
-        formats: cfg.formats.clone(),
-        rays: cfg.rays,
-        seed: cfg.seed,
-        rti: Default::default(),
-        sample: 512,
-    };
+    let vcfg = VerifyConfig::new(cfg.formats.clone(), cfg.rays, cfg.seed, Default::default(), 512);
     let rep = verify(&vcfg, scene);
     let formats: Vec<FormatFit> = cfg
         .formats

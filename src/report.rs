@@ -156,13 +156,7 @@ pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
         count: cfg.stress_count.max(1),
         seed: cfg.seed,
     })?;
-    let vcfg = VerifyConfig {
-        formats: cfg.formats.clone(),
-        rays: cfg.rays,
-        seed: cfg.seed,
-        rti: RtiConfig::default(),
-        sample: 512,
-    };
+    let vcfg = VerifyConfig::new(cfg.formats.clone(), cfg.rays, cfg.seed, RtiConfig::default(), 512);
     let mut points = Vec::new();
     for f in &cfg.formats {
         let name = f.name();

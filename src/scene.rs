@@ -291,7 +291,7 @@ impl RayGen {
         let (lo, hi) = self.bounds;
         let o = [0, 1, 2].map(|a| r.range(lo[a], hi[a]));
         let target = r.below(scene.tris.len() as u64) as usize;
-        let d = if i % 2 == 0 {
+        let d = if i.is_multiple_of(2) {
             let t = &scene.tris[target];
             let (b1, b2) = (r.range(-0.1, 1.1), r.range(-0.1, 1.1));
             let (b1, b2) = if b1 + b2 > 1.2 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };

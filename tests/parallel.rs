@@ -1,4 +1,5 @@
-//! Multi-core runs give the same results as one thread (rayon pools of 1 and 2 threads).
+//! Multi-core runs give the same results as one thread: the streaming engine's reports do not
+//! depend on the thread count or the chunk size, and they equal the scalar per-test judge.
 
 use raypipe::scene::Scene;
 use raypipe::verify::{verify, verify_slab, VerifyConfig};
@@ -13,6 +14,7 @@ fn untimed<T: serde::Serialize>(r: &T) -> serde_json::Value {
         match v {
             serde_json::Value::Object(m) => {
                 m.remove("mtests_per_s");
+                m.remove("judged_mtests_per_s");
                 m.values_mut().for_each(strip);
             }
             serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
@@ -24,23 +26,145 @@ fn untimed<T: serde::Serialize>(r: &T) -> serde_json::Value {
     v
 }
 
+fn cfg(formats: &[&str], rays: usize, seed: u64) -> VerifyConfig {
+    VerifyConfig::new(formats.iter().map(|f| f.parse().unwrap()).collect(), rays, seed, Default::default(), 512)
+}
+
 #[test]
-fn verify_is_the_same_on_one_and_two_threads() {
+fn verify_does_not_depend_on_threads_or_chunks() {
     let scene = Scene::builtin();
-    let cfg = VerifyConfig {
-        formats: ["f32", "fp16", "q8.24:divide"].iter().map(|f| f.parse().unwrap()).collect(),
-        rays: 64,
-        seed: 5,
-        rti: Default::default(),
-        sample: 512,
+    let base = cfg(&["f32", "fp16", "q8.24:divide"], 64, 5);
+    let one = {
+        let mut c = base.clone();
+        c.engine = engine::Engine { threads: 1, chunk: 64 };
+        verify(&c, &scene)
     };
-    let one = pool(1).install(|| verify(&cfg, &scene));
-    let two = pool(2).install(|| verify(&cfg, &scene));
-    assert_eq!(untimed(&one), untimed(&two));
     assert!(one.formats.iter().all(|f| f.tests > 0));
-    let s1 = pool(1).install(|| verify_slab(&cfg, &scene));
-    let s2 = pool(2).install(|| verify_slab(&cfg, &scene));
-    assert_eq!(untimed(&s1), untimed(&s2));
+    for (threads, chunk) in [(2, 16), (2, 1), (3, 5), (1, 7), (4, 1000)] {
+        let mut c = base.clone();
+        c.engine = engine::Engine { threads, chunk };
+        assert_eq!(untimed(&one), untimed(&verify(&c, &scene)), "threads {threads} chunk {chunk}");
+    }
+    let s1 = pool(1).install(|| verify_slab(&base, &scene));
+    assert_eq!(untimed(&s1), untimed(&one.slab));
+}
+
+/// The streaming report against the scalar per-test path: `judge::judge` on every (ray,
+/// triangle) test, the scalar min-capture unit, `golden::closest_hit`, and the scalar slab
+/// model against `golden::slab_f64` / `slab_exact`. Counts and maxima are equal; each median is
+/// the lower edge of the 2^-10-wide bucket holding the exact upper median.
+#[test]
+fn the_streaming_engine_equals_the_scalar_judge() {
+    use datapath::rti::{Capture, Rti};
+    use datapath::slab::{Slab, SlabConfig};
+    use datapath::{with_format, Format};
+    let scene = Scene::builtin();
+    let c = cfg(&["f32", "bf16", "e5m10:ftz"], 24, 9);
+    let rep = verify(&c, &scene);
+    for (f, got) in c.formats.iter().zip(&rep.formats) {
+        with_format!(*f, |fmt| {
+            let rti = Rti::new(fmt, c.rti);
+            let faces = raypipe::judge::faces(&rti);
+            let mut n = [0u64; 10];
+            let (mut ulps, mut rels) = (Vec::new(), Vec::new());
+            let mut slab = vec![[0u64; 5]; 0];
+            let variants = SlabConfig::variants_for(&rti.fmt);
+            slab.resize(variants.len(), [0; 5]);
+            for (i, (ray, _)) in scene.rays(c.rays, c.seed).iter().enumerate() {
+                let _ = i;
+                let mut cap = Capture::default();
+                let mut q = Vec::new();
+                let (rq, _) = raypipe::judge::quantise(&rti, ray, &scene.tris[0]);
+                for (k, tri) in scene.tris.iter().enumerate() {
+                    let j = raypipe::judge::judge(&rti, ray, tri);
+                    n[0] += 1;
+                    n[1] += j.decisive as u64;
+                    n[2] += j.golden.hit as u64;
+                    n[3] += j.hit as u64;
+                    n[4] += (j.golden.hit && !j.hit) as u64;
+                    n[5] += (!j.golden.hit && j.hit) as u64;
+                    n[6] += j.violation().is_some() as u64;
+                    if j.hit && j.golden.hit {
+                        n[7] += 1;
+                        ulps.push(j.t_error() / j.ulp);
+                        rels.push(j.t_error() / j.golden.t.abs().max(f64::MIN_POSITIVE));
+                    }
+                    let out = rti.test(&rti.ray(ray.o, ray.d, ray.tmin, ray.tmax), &rti.tri(tri.v));
+                    n[9] += !out.valid as u64;
+                    rti.capture(&mut cap, &out, k as u32);
+                    q.push(raypipe::judge::quantise(&rti, ray, tri).1);
+                }
+                let g = golden::closest_hit(&rq, &q, faces);
+                n[8] += !match (g, cap.hit) {
+                    (None, false) => true,
+                    (Some((gi, _)), true) => gi == cap.id as usize,
+                    _ => false,
+                } as u64;
+                let qf = |x: f64| rti.fmt.to_f64(rti.fmt.from_f64(x));
+                for (v, acc) in variants.iter().zip(slab.iter_mut()) {
+                    let s = Slab::new(rti.fmt, SlabConfig::named(v).unwrap());
+                    let sr = s.prepare(ray.o, ray.d, ray.tmin, ray.tmax);
+                    let (oq, dq) = (ray.o.map(qf), ray.d.map(qf));
+                    for t in &scene.tris {
+                        let lo = std::array::from_fn(|a| t.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min));
+                        let hi = std::array::from_fn(|a| t.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max));
+                        let hit = s.test(&sr, &s.store_box(lo, hi).unwrap_or_else(|_| s.empty_box())).hit;
+                        let g = golden::slab_f64(oq, dq, qf(ray.tmin), qf(ray.tmax), lo, hi);
+                        let scale = 1f64.max(g.t_near.abs()).max(if g.t_far.is_finite() { g.t_far.abs() } else { 0.0 });
+                        let close = (g.t_far - g.t_near).abs() <= 1e-9 * scale;
+                        let exact = if close || g.hit != hit {
+                            acc[4] += 1;
+                            golden::slab_exact(oq, dq, qf(ray.tmin), qf(ray.tmax), lo, hi).unwrap_or(g.hit)
+                        } else {
+                            g.hit
+                        };
+                        acc[0] += 1;
+                        acc[1] += exact as u64;
+                        acc[2] += (exact && !hit) as u64;
+                        acc[3] += (!exact && hit) as u64;
+                    }
+                }
+            }
+            let want = [
+                got.tests,
+                got.decisive,
+                got.golden_hits,
+                got.model_hits,
+                got.false_misses,
+                got.false_hits,
+                got.violations,
+                got.shared_hits,
+                got.closest_disagreements,
+                got.divide_skipped,
+            ];
+            assert_eq!(n, want, "{}", got.format);
+            assert!(n[7] > 10, "{}: too few shared hits to compare errors", got.format);
+            for (xs, med, max) in [
+                (&mut ulps, got.t_err_ulps_median, got.t_err_ulps_max),
+                (&mut rels, got.t_err_rel_median, got.t_err_rel_max),
+            ] {
+                xs.sort_by(f64::total_cmp);
+                assert_eq!(max.to_bits(), xs.last().unwrap().to_bits(), "{}", got.format);
+                let m = xs[xs.len() / 2];
+                assert!(
+                    med <= m && m < med * (1.0 + 2f64.powi(-10)) + f64::MIN_POSITIVE,
+                    "{}: median {med} vs {m}",
+                    got.format
+                );
+            }
+            let rows: Vec<_> = rep.slab.iter().filter(|r| r.format == got.format).collect();
+            assert_eq!(rows.len(), variants.len());
+            for (r, a) in rows.iter().zip(&slab) {
+                assert_eq!(
+                    [r.tests, r.exact_hits, r.false_misses, r.false_hits, r.exact_calls],
+                    *a,
+                    "{} {}",
+                    r.format,
+                    r.variant
+                );
+            }
+        });
+    }
 }
 
 #[test]
@@ -56,9 +180,7 @@ fn stats_are_the_same_on_one_and_two_threads() {
 fn skipped_work_is_counted() {
     let scene = Scene::builtin();
     // RTI: every hit was valid, so the divides skipped are at most the tests without a hit
-    let cfg =
-        VerifyConfig { formats: vec!["f32".parse().unwrap()], rays: 16, seed: 2, rti: Default::default(), sample: 512 };
-    let f = &verify(&cfg, &scene).formats[0];
+    let f = &verify(&cfg(&["f32"], 16, 2), &scene).formats[0];
     assert!(f.divide_skipped > 0 && f.divide_skipped <= f.tests - f.model_hits, "{f:?}");
     // traversal: stopping at N = 1 skips box tests; an N no ray reaches skips none
     let t = |n: usize| {

@@ -21,186 +21,206 @@
 //! then the model's hit/miss must equal the exact one, and |t_model − t| <= `t_err`.
 
 use crate::format::{DivMode, ErrorModel};
+use crate::lanes::Lane;
 use crate::rti::Cull;
 
 /// Relative slack covering the f64 evaluation of the exact values.
 pub const F64_SLACK: f64 = 1.0 / (1u64 << 45) as f64;
 
-/// A signal's exact value, its absolute-monomial sum and its error bound.
+/// A signal's exact value, its absolute-monomial sum and its error bound (generic over [`Lane`]; `f64` is one case).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Bnd {
+pub struct Bnd<T = f64> {
     /// Exact value (f64 evaluation).
-    pub v: f64,
+    pub v: T,
     /// Sum of the absolute values of its monomials.
-    pub a: f64,
+    pub a: T,
     /// Upper bound on |computed − exact| in the format.
-    pub e: f64,
+    pub e: T,
 }
 
-impl Bnd {
+impl<T: Lane> Bnd<T> {
     /// Bound for use in decisions: `e` plus the f64 evaluation slack.
-    pub fn err(&self) -> f64 {
-        self.e + F64_SLACK * self.a
+    #[inline(always)]
+    pub fn err(&self) -> T {
+        self.e + T::splat(F64_SLACK) * self.a
     }
 }
 
-struct Ctx {
-    em: ErrorModel,
-    overflow: bool,
+/// The error model's constants as lanes, and the running overflow flag.
+struct Ctx<T: Lane> {
+    u: T,
+    eta: T,
+    add_eta: T,
+    max: T,
+    overflow: T::M,
 }
 
-// Every step is branch-free (flags or-ed, results selected) so that `verdict_block`'s loop
-// vectorises; the scalar and block paths run this same code.
-impl Ctx {
+// Every step is branch-free (flags or-ed, results selected): the same code serves one case
+// and vectorises when a loop runs it over columns (`verdict_block`).
+impl<T: Lane> Ctx<T> {
     #[inline(always)]
-    fn check(&mut self, b: Bnd) -> Bnd {
+    fn check(&mut self, b: Bnd<T>) -> Bnd<T> {
         let m = b.v.abs() + b.e;
         // NaN or above the largest magnitude
-        self.overflow |= !(m <= self.em.max);
+        self.overflow = self.overflow | !m.le(self.max);
         b
     }
     #[inline(always)]
-    fn input(&mut self, x: f64) -> Bnd {
-        self.check(Bnd { v: x, a: x.abs(), e: 0.0 })
+    fn input(&mut self, x: T) -> Bnd<T> {
+        self.check(Bnd { v: x, a: x.abs(), e: T::splat(0.0) })
     }
     #[inline(always)]
-    fn addsub(&mut self, x: Bnd, y: Bnd, sub: bool) -> Bnd {
+    fn addsub(&mut self, x: Bnd<T>, y: Bnd<T>, sub: bool) -> Bnd<T> {
         let v = if sub { x.v - y.v } else { x.v + y.v };
         let e0 = x.e + y.e;
-        let e = e0 + self.em.u * (v.abs() + e0) + self.em.add_eta;
+        let e = e0 + self.u * (v.abs() + e0) + self.add_eta;
         self.check(Bnd { v, a: x.a + y.a, e })
     }
     #[inline(always)]
-    fn add(&mut self, x: Bnd, y: Bnd) -> Bnd {
+    fn add(&mut self, x: Bnd<T>, y: Bnd<T>) -> Bnd<T> {
         self.addsub(x, y, false)
     }
     #[inline(always)]
-    fn sub(&mut self, x: Bnd, y: Bnd) -> Bnd {
+    fn sub(&mut self, x: Bnd<T>, y: Bnd<T>) -> Bnd<T> {
         self.addsub(x, y, true)
     }
     #[inline(always)]
-    fn mul(&mut self, x: Bnd, y: Bnd) -> Bnd {
+    fn mul(&mut self, x: Bnd<T>, y: Bnd<T>) -> Bnd<T> {
         let v = x.v * y.v;
         let e0 = x.v.abs() * y.e + y.v.abs() * x.e + x.e * y.e;
-        let e = e0 + self.em.u * (v.abs() + e0) + self.em.eta;
+        let e = e0 + self.u * (v.abs() + e0) + self.eta;
         self.check(Bnd { v, a: x.a * y.a, e })
+    }
+    #[inline(always)]
+    fn cross(&mut self, a: [Bnd<T>; 3], b: [Bnd<T>; 3]) -> [Bnd<T>; 3] {
+        let xa = self.mul(a[1], b[2]);
+        let xb = self.mul(a[2], b[1]);
+        let ya = self.mul(a[2], b[0]);
+        let yb = self.mul(a[0], b[2]);
+        let za = self.mul(a[0], b[1]);
+        let zb = self.mul(a[1], b[0]);
+        [self.sub(xa, xb), self.sub(ya, yb), self.sub(za, zb)]
+    }
+    #[inline(always)]
+    fn dot(&mut self, a: [Bnd<T>; 3], b: [Bnd<T>; 3]) -> Bnd<T> {
+        let x = self.mul(a[0], b[0]);
+        let y = self.mul(a[1], b[1]);
+        let z = self.mul(a[2], b[2]);
+        let xy = self.add(x, y);
+        self.add(xy, z)
+    }
+    /// The bound of `num / det` (t = t'/det and the barycentrics): see the module docs; +∞
+    /// when det is not clear of zero (`ok` false: `denom = |det| − e_det <= 0`).
+    #[inline(always)]
+    fn quot(&mut self, num: Bnd<T>, det: Bnd<T>, denom: T, ok: T::M, div: DivMode) -> T {
+        let q = num.v / det.v;
+        let d1 = (num.err() + q.abs() * det.err()) / denom;
+        let mag = q.abs() + d1;
+        let u = self.u;
+        let one = T::splat(1.0);
+        let extra = match div {
+            DivMode::RecipMul => {
+                self.overflow = self.overflow | (ok & (one / denom).gt(self.max));
+                (T::splat(2.0) * u + u * u) * mag + self.eta * (num.v.abs() + num.err()) * (one + u) + self.eta
+            }
+            DivMode::Divide => u * mag + self.eta,
+        };
+        self.overflow = self.overflow | (ok & (mag + extra).gt(self.max));
+        T::select(ok, d1 + extra, T::splat(f64::INFINITY))
     }
 }
 
-/// Running error bounds of every RTI signal the decision and the outputs depend on.
+/// Running error bounds of every RTI signal the decision and the outputs depend on (generic over [`Lane`]; `f64` is one case).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RtiBound {
+pub struct RtiBound<T: Lane = f64> {
     /// det = e1·(d × e2).
-    pub det: Bnd,
+    pub det: Bnd<T>,
     /// u' = s·(d × e2).
-    pub up: Bnd,
+    pub up: Bnd<T>,
     /// v' = d·(s × e1).
-    pub vp: Bnd,
+    pub vp: Bnd<T>,
     /// t' = e2·(s × e1).
-    pub tp: Bnd,
+    pub tp: Bnd<T>,
     /// u' + v'.
-    pub uv: Bnd,
+    pub uv: Bnd<T>,
     /// Bound on |t_model − t| (infinite when det is not decisive).
-    pub t_err: f64,
+    pub t_err: T,
     /// Bound on |u_model − u|.
-    pub u_err: f64,
+    pub u_err: T,
     /// Bound on |v_model − v|.
-    pub v_err: f64,
+    pub v_err: T,
     /// Some magnitude may exceed the format's range: no bound holds.
-    pub overflow: bool,
+    pub overflow: T::M,
 }
 
 /// The exact decision the bound predicts and whether the model must reproduce it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Verdict {
+pub struct Verdict<M = bool> {
     /// Every compared quantity is farther from its threshold than its error bound.
-    pub decisive: bool,
+    pub decisive: M,
     /// The exact (f64-evaluated) hit decision.
-    pub hit: bool,
+    pub hit: M,
 }
 
-impl RtiBound {
+impl<T: Lane> RtiBound<T> {
     /// Bounds for one ray (origin, direction) and triangle given as the format's values in f64.
     #[inline(always)]
-    pub fn new(em: ErrorModel, div: DivMode, o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> Self {
-        let mut c = Ctx { em, overflow: false };
-        let o = o.map(|x| c.input(x));
-        let d = d.map(|x| c.input(x));
-        let v = v.map(|p| p.map(|x| c.input(x)));
-        let e1: [Bnd; 3] = std::array::from_fn(|k| c.sub(v[1][k], v[0][k]));
-        let e2: [Bnd; 3] = std::array::from_fn(|k| c.sub(v[2][k], v[0][k]));
-        let s: [Bnd; 3] = std::array::from_fn(|k| c.sub(o[k], v[0][k]));
-        let mut cross = |a: [Bnd; 3], b: [Bnd; 3]| -> [Bnd; 3] {
-            let xa = c.mul(a[1], b[2]);
-            let xb = c.mul(a[2], b[1]);
-            let ya = c.mul(a[2], b[0]);
-            let yb = c.mul(a[0], b[2]);
-            let za = c.mul(a[0], b[1]);
-            let zb = c.mul(a[1], b[0]);
-            [c.sub(xa, xb), c.sub(ya, yb), c.sub(za, zb)]
+    pub fn new(em: ErrorModel, div: DivMode, o: [T; 3], d: [T; 3], v: [[T; 3]; 3]) -> Self {
+        let mut c = Ctx {
+            u: T::splat(em.u),
+            eta: T::splat(em.eta),
+            add_eta: T::splat(em.add_eta),
+            max: T::splat(em.max),
+            overflow: T::mask(false),
         };
-        let p = cross(d, e2);
-        let q = cross(s, e1);
-        let mut dot = |a: [Bnd; 3], b: [Bnd; 3]| -> Bnd {
-            let x = c.mul(a[0], b[0]);
-            let y = c.mul(a[1], b[1]);
-            let z = c.mul(a[2], b[2]);
-            let xy = c.add(x, y);
-            c.add(xy, z)
-        };
-        let det = dot(e1, p);
-        let up = dot(s, p);
-        let vp = dot(d, q);
-        let tp = dot(e2, q);
+        // written out (no array::map / from_fn): the lanes stay in registers
+        let o = [c.input(o[0]), c.input(o[1]), c.input(o[2])];
+        let d = [c.input(d[0]), c.input(d[1]), c.input(d[2])];
+        let v0 = [c.input(v[0][0]), c.input(v[0][1]), c.input(v[0][2])];
+        let v1 = [c.input(v[1][0]), c.input(v[1][1]), c.input(v[1][2])];
+        let v2 = [c.input(v[2][0]), c.input(v[2][1]), c.input(v[2][2])];
+        let e1 = [c.sub(v1[0], v0[0]), c.sub(v1[1], v0[1]), c.sub(v1[2], v0[2])];
+        let e2 = [c.sub(v2[0], v0[0]), c.sub(v2[1], v0[1]), c.sub(v2[2], v0[2])];
+        let s = [c.sub(o[0], v0[0]), c.sub(o[1], v0[1]), c.sub(o[2], v0[2])];
+        let p = c.cross(d, e2);
+        let q = c.cross(s, e1);
+        let det = c.dot(e1, p);
+        let up = c.dot(s, p);
+        let vp = c.dot(d, q);
+        let tp = c.dot(e2, q);
         let uv = c.add(up, vp);
         let denom = det.v.abs() - det.err();
         // det not clear of zero (denom <= 0): the quotient is unbounded
-        let ok = !(denom <= 0.0);
-        let quot = |num: Bnd, c: &mut Ctx| -> f64 {
-            let q = num.v / det.v;
-            let d1 = (num.err() + q.abs() * det.err()) / denom;
-            let mag = q.abs() + d1;
-            let u = em.u;
-            let extra = match div {
-                DivMode::RecipMul => {
-                    c.overflow |= ok & (1.0 / denom > em.max);
-                    (2.0 * u + u * u) * mag + em.eta * (num.v.abs() + num.err()) * (1.0 + u) + em.eta
-                }
-                DivMode::Divide => u * mag + em.eta,
-            };
-            c.overflow |= ok & (mag + extra > em.max);
-            if ok {
-                d1 + extra
-            } else {
-                f64::INFINITY
-            }
-        };
-        let t_err = quot(tp, &mut c);
-        let u_err = quot(up, &mut c);
-        let v_err = quot(vp, &mut c);
+        let ok = !denom.le(T::splat(0.0));
+        let t_err = c.quot(tp, det, denom, ok, div);
+        let u_err = c.quot(up, det, denom, ok, div);
+        let v_err = c.quot(vp, det, denom, ok, div);
         Self { det, up, vp, tp, uv, t_err, u_err, v_err, overflow: c.overflow }
     }
 
     /// Exact t (f64 evaluation).
-    pub fn t(&self) -> f64 {
+    #[inline(always)]
+    pub fn t(&self) -> T {
         self.tp.v / self.det.v
     }
 
     /// The exact decision and whether it is decisive for the model with these options.
     #[inline(always)]
-    pub fn verdict(&self, cull: Cull, det_threshold: f64, tmin: f64, tmax: f64) -> Verdict {
-        let clear = |x: f64, b: f64| x.abs() > b;
+    pub fn verdict(&self, cull: Cull, det_threshold: f64, tmin: f64, tmax: f64) -> Verdict<T::M> {
+        let clear = |x: T, b: T| x.abs().gt(b);
+        let zero = T::splat(0.0);
+        let thr = T::splat(det_threshold);
         let det_q = match cull {
-            Cull::TwoSided => self.det.v.abs() - det_threshold,
-            Cull::Backface => self.det.v - det_threshold,
+            Cull::TwoSided => self.det.v.abs() - thr,
+            Cull::Backface => self.det.v - thr,
         };
-        let pos = self.det.v > 0.0;
-        let sgn = |x: f64| if pos { x } else { -x };
-        let det_ok = det_q > 0.0;
-        let u_ok = sgn(self.up.v) >= 0.0;
-        let v_ok = sgn(self.vp.v) >= 0.0;
-        let uv_ok = sgn(self.det.v - self.uv.v) >= 0.0;
-        let t_ok = sgn(self.tp.v) >= 0.0;
+        let pos = self.det.v.gt(zero);
+        let sgn = |x: T| T::select(pos, x, -x);
+        let det_ok = det_q.gt(zero);
+        let u_ok = sgn(self.up.v).ge(zero);
+        let v_ok = sgn(self.vp.v).ge(zero);
+        let uv_ok = sgn(self.det.v - self.uv.v).ge(zero);
+        let t_ok = sgn(self.tp.v).ge(zero);
         let valid = det_ok & u_ok & v_ok & uv_ok & t_ok;
         let decisive = !self.overflow
             & clear(det_q, self.det.err())
@@ -210,10 +230,11 @@ impl RtiBound {
             & clear(self.det.v - self.uv.v, self.det.err() + self.uv.err())
             & clear(self.tp.v, self.tp.err());
         let t = self.t();
+        let (lo, hi) = (T::splat(tmin), T::splat(tmax));
         // a valid case also decides t against the finite ends of [tmin, tmax]
-        let hit = valid & (t >= tmin) & (t <= tmax);
-        let t_clear =
-            (!tmin.is_finite() | clear(t - tmin, self.t_err)) & (!tmax.is_finite() | clear(t - tmax, self.t_err));
+        let hit = valid & t.ge(lo) & t.le(hi);
+        let t_clear = (T::mask(!tmin.is_finite()) | clear(t - lo, self.t_err))
+            & (T::mask(!tmax.is_finite()) | clear(t - hi, self.t_err));
         Verdict { decisive: decisive & (!valid | t_clear), hit }
     }
 }
@@ -295,9 +316,12 @@ fn block_avx2(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: 
 
 #[inline(always)]
 fn block_body(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: &mut [bool], te: &mut [f64]) {
-    for i in 0..hit.len() {
+    let n = hit.len();
+    // one case per iteration, branch-free: the loop vectoriser carries 8 (AVX-512F) or 4
+    // (AVX2) iterations per instruction
+    for i in 0..n {
         let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
-        let b = RtiBound::new(o.em, o.div, r.o, r.d, v);
+        let b = RtiBound::<f64>::new(o.em, o.div, r.o, r.d, v);
         let vd = b.verdict(o.cull, o.det_threshold, r.tmin, r.tmax);
         dec[i] = vd.decisive;
         hit[i] = vd.hit;

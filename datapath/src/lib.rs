@@ -7,6 +7,7 @@ pub mod alloc;
 pub mod bound;
 pub mod bvh;
 pub mod format;
+pub mod lanes;
 pub mod probe;
 pub mod rng;
 pub mod rti;

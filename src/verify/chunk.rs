@@ -1,0 +1,496 @@
+//! What one chunk of `verify` does, and the per-format pass that runs the chunks on the engine.
+//!
+//! For each ray of a chunk (ray `i` and its test list are drawn from (seed, i) alone, see
+//! [`crate::scene::RayGen`] and [`test_list`]), its tests are cut into blocks of [`BLOCK`]
+//! triangles; per block:
+//!
+//! 1. gather: the model's stored triangles into the kernel's columns, the quantised triangles
+//!    (the format's values in f64) into nine f64 columns;
+//! 2. model: the fastest bit-identical batch path ([`datapath::simd::rti_batch`]);
+//! 3. golden: Möller–Trumbore in f64 lanes ([`golden::block::intersect_block`]) and the error
+//!    bound in f64 lanes ([`datapath::bound::verdict_block`]), each equal to its scalar code;
+//! 4. judge: per lane the counts, the t-error histograms and the first violation, as
+//!    [`crate::judge::Judged::violation`] defines them; the min-capture unit and the golden
+//!    closest hit run along the ray's blocks;
+//! 5. slab: the boxes of the same triangles through every variant's batch path, against the
+//!    f64 slab test in lanes ([`golden::block::slab_block`], shared by the variants) and the
+//!    exact rational decision where f64 cannot decide (near the boundary or disagreeing).
+//!
+//! The chunk's accumulators are merged by the engine; nothing else outlives the chunk.
+
+use super::{FormatReport, SlabReport, VerifyConfig};
+use crate::scene::Scene;
+use datapath::bound::{verdict_block, BlockOpts, BlockRay};
+use datapath::rng::SplitMix64;
+use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
+use datapath::simd::{self, Kernel};
+use datapath::slab::{Aabb, BoxesSoa, Slab, SlabConfig, SlabOutSoa};
+use datapath::Format;
+use engine::{Counts, First, Hist, Merge, Progress};
+use golden::block::{intersect_block, slab_block, Level};
+use golden::{Ray64, Tri64};
+use std::time::Instant;
+
+/// Stream number of the per-ray test lists in [`SplitMix64::for_item`].
+pub const LIST_STREAM: u64 = 0x7e57;
+
+/// Tests per block: the columns of one block (15 model columns, 9 + 6 f64 columns, outputs)
+/// stay in L1/L2 while the model, golden and bound read them.
+pub const BLOCK: usize = 256;
+
+/// Triangles tested per ray: every triangle of a scene with at most `sample`, else `sample`.
+pub fn tests_per_ray(scene: &Scene, sample: usize) -> usize {
+    scene.tris.len().min(sample)
+}
+
+/// Ray `i`'s test list into `out`: every triangle when the scene has at most `sample`, else
+/// its target followed by `sample - 1` triangles drawn with `SplitMix64::for_item(seed,
+/// LIST_STREAM, i).below(n)`.
+pub fn test_list(n: usize, sample: usize, seed: u64, i: u64, target: usize, out: &mut Vec<u32>) {
+    out.clear();
+    if n <= sample {
+        out.extend(0..n as u32);
+        return;
+    }
+    out.push(target as u32);
+    let mut r = SplitMix64::for_item(seed, LIST_STREAM, i);
+    out.extend((1..sample).map(|_| r.below(n as u64) as u32));
+}
+
+/// The `explain` command line of one test, in the scene's normalised coordinates.
+pub fn explain_cmd(fmt: &str, ray: &Ray64, tri: &Tri64, scale: f64) -> String {
+    let j = |xs: &[f64]| xs.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(",");
+    let tv: Vec<f64> = tri.v.iter().flatten().copied().collect();
+    format!(
+        "raypipe explain --format {fmt} --ray {},{} --tri {}  # scene coordinates x {scale:?}",
+        j(&ray.o),
+        j(&ray.d),
+        j(&tv)
+    )
+}
+
+/// One format's RTI results: counts (tests, decisive, golden hits, model hits, false misses,
+/// false hits, violations, shared hits, closest-hit disagreements, divides skipped), the t
+/// errors of shared hits in ulps and relative, the first violation by (ray, test), and the
+/// nanoseconds spent in the model's batch calls.
+#[derive(Default)]
+struct RtiAcc {
+    c: Counts<10>,
+    ulps: Hist,
+    rels: Hist,
+    first: First<(u64, u64), String>,
+    model_ns: u64,
+}
+
+impl Merge for RtiAcc {
+    fn merge(&mut self, o: Self) {
+        self.c.merge(o.c);
+        self.ulps.merge(o.ulps);
+        self.rels.merge(o.rels);
+        self.first.merge(o.first);
+        self.model_ns += o.model_ns;
+    }
+}
+
+/// One slab variant's results: counts (tests, exact hits, false misses, false hits, exact
+/// calls) and the nanoseconds in its batch calls.
+#[derive(Default)]
+struct SlabAcc {
+    c: Counts<5>,
+    model_ns: u64,
+}
+
+impl Merge for SlabAcc {
+    fn merge(&mut self, o: Self) {
+        self.c.merge(o.c);
+        self.model_ns += o.model_ns;
+    }
+}
+
+/// A slab variant ready to run: its unit and the scene's boxes stored in the format.
+struct Variant<F: Format> {
+    name: &'static str,
+    slab: Slab<F>,
+    conservative: bool,
+    stored: Vec<Aabb<F::V>>,
+}
+
+/// What every chunk of one format's pass shares (O(scene), built once).
+struct Setup<'a, F: Format> {
+    cfg: &'a VerifyConfig,
+    scene: &'a Scene,
+    rti: Rti<F>,
+    with_rti: bool,
+    mtris: Vec<Tri<F::V>>,
+    qtris: Vec<[f64; 9]>,
+    boxes: Vec<[f64; 6]>,
+    variants: Vec<Variant<F>>,
+    opts: BlockOpts,
+    faces: golden::Faces,
+    level: Level,
+    name: String,
+}
+
+/// A worker's reusable buffers (no allocation per chunk after the first).
+struct Scratch<V> {
+    list: Vec<u32>,
+    rays: RaysSoa<V>,
+    tris: TrisSoa<V>,
+    out: HitsSoa<V>,
+    cols: [Vec<f64>; 9],
+    ghit: Vec<bool>,
+    gt: Vec<f64>,
+    dec: Vec<bool>,
+    ehit: Vec<bool>,
+    terr: Vec<f64>,
+    bcols: [Vec<f64>; 6],
+    shit: Vec<bool>,
+    snear: Vec<f64>,
+    sfar: Vec<f64>,
+    exact: Vec<u8>,
+    boxes: BoxesSoa<V>,
+    sout: SlabOutSoa<V>,
+}
+
+impl<V: Copy + Default> Scratch<V> {
+    fn new() -> Self {
+        let f = || vec![0.0; BLOCK];
+        let b = || vec![false; BLOCK];
+        Scratch {
+            list: Vec::new(),
+            rays: RaysSoa::default(),
+            tris: TrisSoa::default(),
+            out: HitsSoa::default(),
+            cols: std::array::from_fn(|_| f()),
+            ghit: b(),
+            gt: f(),
+            dec: b(),
+            ehit: b(),
+            terr: f(),
+            bcols: std::array::from_fn(|_| f()),
+            shit: b(),
+            snear: f(),
+            sfar: f(),
+            exact: vec![0; BLOCK],
+            boxes: BoxesSoa::default(),
+            sout: SlabOutSoa::default(),
+        }
+    }
+}
+
+fn cols<const N: usize>(c: &[Vec<f64>; N], n: usize) -> [&[f64]; N] {
+    std::array::from_fn(|k| &c[k][..n])
+}
+
+impl<F: Format + 'static> Setup<'_, F>
+where
+    F::V: 'static + Default + Send,
+{
+    fn chunk(&self, s: &mut Scratch<F::V>, rays: std::ops::Range<u64>) -> (RtiAcc, Vec<SlabAcc>) {
+        let f = &self.rti.fmt;
+        let q = |x: f64| f.to_f64(f.from_f64(x));
+        let gen = self.scene.ray_gen(self.cfg.seed);
+        let mut acc = RtiAcc::default();
+        let mut sacc: Vec<SlabAcc> = self.variants.iter().map(|_| SlabAcc::default()).collect();
+        for i in rays {
+            let (ray, target) = gen.ray(self.scene, i);
+            test_list(self.scene.tris.len(), self.cfg.sample, self.cfg.seed, i, target, &mut s.list);
+            let rq = Ray64 { o: ray.o.map(q), d: ray.d.map(q), tmin: q(ray.tmin), tmax: q(ray.tmax) };
+            let mray = self.rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
+            let prepared: Vec<_> =
+                self.variants.iter().map(|v| v.slab.prepare(ray.o, ray.d, ray.tmin, ray.tmax)).collect();
+            let mut cap = Capture::default();
+            let mut gbest: Option<(usize, f64)> = None;
+            let list = std::mem::take(&mut s.list);
+            for (b, blk) in list.chunks(BLOCK).enumerate() {
+                let base = b * BLOCK;
+                if self.with_rti {
+                    self.rti_block(s, &mut acc, &ray, &rq, &mray, blk, base, i, &mut cap, &mut gbest);
+                }
+                if !self.variants.is_empty() {
+                    self.slab_block(s, &mut sacc, &rq, &prepared, blk);
+                }
+            }
+            if self.with_rti {
+                let same = match (gbest, cap.hit) {
+                    (None, false) => true,
+                    (Some((gi, _)), true) => list[gi] == list[cap.id as usize],
+                    _ => false,
+                };
+                acc.c.0[8] += !same as u64;
+            }
+            s.list = list;
+        }
+        (acc, sacc)
+    }
+
+    #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
+    fn rti_block(
+        &self,
+        s: &mut Scratch<F::V>,
+        acc: &mut RtiAcc,
+        ray: &Ray64,
+        rq: &Ray64,
+        mray: &datapath::rti::Ray<F::V>,
+        blk: &[u32],
+        base: usize,
+        ray_index: u64,
+        cap: &mut Capture<F::V>,
+        gbest: &mut Option<(usize, f64)>,
+    ) {
+        let f = &self.rti.fmt;
+        let n = blk.len();
+        s.rays.resize(n, F::V::default());
+        s.tris.resize(n, F::V::default());
+        s.out.resize(n);
+        for (k, &ti) in blk.iter().enumerate() {
+            s.rays.set(k, mray);
+            s.tris.set(k, &self.mtris[ti as usize]);
+            let qt = &self.qtris[ti as usize];
+            for c in 0..9 {
+                s.cols[c][k] = qt[c];
+            }
+        }
+        let t0 = Instant::now();
+        simd::rti_batch(&self.rti, &s.rays, &s.tris, &mut s.out);
+        acc.model_ns += t0.elapsed().as_nanos() as u64;
+        intersect_block(self.level, rq, self.faces, cols(&s.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
+        let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
+        verdict_block(
+            Kernel::Avx512Fp16,
+            self.opts,
+            bray,
+            cols(&s.cols, n),
+            &mut s.dec[..n],
+            &mut s.ehit[..n],
+            &mut s.terr[..n],
+        );
+        let c = &mut acc.c.0;
+        for k in 0..n {
+            let (mhit, gh, dec) = (s.out.hit[k], s.ghit[k], s.dec[k]);
+            let (gt, mt) = (s.gt[k], f.to_f64(s.out.t[k]));
+            c[0] += 1;
+            c[1] += dec as u64;
+            c[2] += gh as u64;
+            c[3] += mhit as u64;
+            c[4] += (gh && !mhit) as u64;
+            c[5] += (!gh && mhit) as u64;
+            if dec {
+                // the property of crate::judge::Judged::violation
+                let why = if mhit != gh || gh != s.ehit[k] {
+                    Some(format!("hit/miss: model {mhit} golden {gh} exact {}", s.ehit[k]))
+                } else if mhit && (mt - gt).abs() > s.terr[k] + gt.abs() * 1e-12 {
+                    Some(format!("t error {:e} exceeds bound {:e}", (mt - gt).abs(), s.terr[k]))
+                } else {
+                    None
+                };
+                if let Some(why) = why {
+                    c[6] += 1;
+                    let tri = &self.scene.tris[blk[k] as usize];
+                    acc.first.offer((ray_index, (base + k) as u64), || {
+                        format!("{why}: {}", explain_cmd(&self.name, ray, tri, self.scene.scale))
+                    });
+                }
+            }
+            if mhit && gh {
+                c[7] += 1;
+                let e = (mt - gt).abs();
+                acc.ulps.add(e / f.ulp(gt));
+                acc.rels.add(e / gt.abs().max(f64::MIN_POSITIVE));
+            }
+            c[9] += !s.out.valid[k] as u64;
+            let out = RtiOut { valid: s.out.valid[k], hit: mhit, t: s.out.t[k], u: s.out.u[k], v: s.out.v[k] };
+            self.rti.capture(cap, &out, (base + k) as u32);
+            if gh && gbest.is_none_or(|(_, bt)| gt < bt) {
+                *gbest = Some((base + k, gt));
+            }
+        }
+    }
+
+    #[allow(clippy::needless_range_loop)]
+    fn slab_block(
+        &self,
+        s: &mut Scratch<F::V>,
+        sacc: &mut [SlabAcc],
+        rq: &Ray64,
+        prepared: &[datapath::slab::SlabRay<F::V>],
+        blk: &[u32],
+    ) {
+        let n = blk.len();
+        for (k, &ti) in blk.iter().enumerate() {
+            let b = &self.boxes[ti as usize];
+            for c in 0..6 {
+                s.bcols[c][k] = b[c];
+            }
+        }
+        slab_block(
+            self.level,
+            rq.o,
+            rq.d,
+            rq.tmin,
+            rq.tmax,
+            cols(&s.bcols, n),
+            &mut s.shit[..n],
+            &mut s.snear[..n],
+            &mut s.sfar[..n],
+        );
+        // the exact decision of each lane, computed at most once for all variants (0: not yet)
+        s.exact[..n].fill(0);
+        for ((v, sr), acc) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()) {
+            for c in s.boxes.min.iter_mut().chain(s.boxes.max.iter_mut()) {
+                c.clear();
+            }
+            for &ti in blk {
+                s.boxes.push(&v.stored[ti as usize]);
+            }
+            s.sout.hit.resize(n, false);
+            s.sout.t_near.resize(n, F::V::default());
+            s.sout.t_far.resize(n, F::V::default());
+            let t0 = Instant::now();
+            simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
+            acc.model_ns += t0.elapsed().as_nanos() as u64;
+            let c = &mut acc.c.0;
+            for k in 0..n {
+                let hit = s.sout.hit[k];
+                let (g, near, far) = (s.shit[k], s.snear[k], s.sfar[k]);
+                let scale = 1.0f64.max(near.abs()).max(if far.is_finite() { far.abs() } else { 0.0 });
+                let close = (far - near).abs() <= 1e-9 * scale;
+                let exact = if close || g != hit {
+                    c[4] += 1;
+                    if s.exact[k] == 0 {
+                        let b = &self.boxes[blk[k] as usize];
+                        // verify's rays and boxes are finite; a ray that overflowed the format
+                        // has no exact decision and counts as the f64 reference says
+                        let e =
+                            golden::slab_exact(rq.o, rq.d, rq.tmin, rq.tmax, [b[0], b[1], b[2]], [b[3], b[4], b[5]])
+                                .unwrap_or(g);
+                        s.exact[k] = 1 + e as u8;
+                    }
+                    s.exact[k] == 2
+                } else {
+                    g
+                };
+                c[0] += 1;
+                c[1] += exact as u64;
+                c[2] += (exact && !hit) as u64;
+                c[3] += (!exact && hit) as u64;
+            }
+        }
+    }
+}
+
+fn rate(tests: u64, ns: u64) -> f64 {
+    if ns > 0 {
+        tests as f64 / ns as f64 * 1e3
+    } else {
+        0.0
+    }
+}
+
+/// One format's pass over every ray on the engine: the RTI report (when `with_rti`) and one
+/// slab report per variant the format accepts.
+pub fn run_format<F: Format + 'static>(
+    fmt: F,
+    cfg: &VerifyConfig,
+    scene: &Scene,
+    with_rti: bool,
+) -> (Option<FormatReport>, Vec<SlabReport>)
+where
+    F::V: 'static + Default + Send + Sync,
+{
+    let rti = Rti::new(fmt, cfg.rti);
+    let f = &rti.fmt;
+    let q = |x: f64| f.to_f64(f.from_f64(x));
+    let boxes: Vec<[f64; 6]> = scene
+        .tris
+        .iter()
+        .map(|t| {
+            let lo = |a: usize| t.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min);
+            let hi = |a: usize| t.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max);
+            [lo(0), lo(1), lo(2), hi(0), hi(1), hi(2)]
+        })
+        .collect();
+    // only the variants the format accepts (a conservative promise it cannot keep is refused)
+    let variants: Vec<Variant<F>> = SlabConfig::variants_for(f)
+        .into_iter()
+        .map(|name| {
+            let sc = SlabConfig::named(name).expect("built-in variant");
+            let slab = Slab::new(*f, sc);
+            let stored = boxes
+                .iter()
+                .map(|b| slab.store_box([b[0], b[1], b[2]], [b[3], b[4], b[5]]).unwrap_or_else(|_| slab.empty_box()))
+                .collect();
+            Variant { name, conservative: sc.is_conservative(f), slab, stored }
+        })
+        .collect();
+    let setup = Setup {
+        cfg,
+        scene,
+        with_rti,
+        mtris: if with_rti { scene.tris.iter().map(|t| rti.tri(t.v)).collect() } else { Vec::new() },
+        qtris: if with_rti {
+            scene.tris.iter().map(|t| std::array::from_fn(|k| q(t.v[k / 3][k % 3]))).collect()
+        } else {
+            Vec::new()
+        },
+        boxes,
+        variants,
+        opts: BlockOpts {
+            em: f.error_model(),
+            div: f.div_mode(),
+            cull: rti.cull,
+            det_threshold: f.to_f64(rti.det_thr),
+        },
+        faces: crate::judge::faces(&rti),
+        level: golden::block::best_level(),
+        name: f.name(),
+        rti: rti.clone(),
+    };
+    let progress = Progress::new(cfg.rays as u64, "rays", !cfg.progress);
+    progress.message(format!("{} ({} tests per ray)", setup.name, tests_per_ray(scene, cfg.sample)));
+    let wall = Instant::now();
+    let (acc, sacc) = engine::run(&cfg.engine, cfg.rays as u64, &progress, Scratch::new, |s, r| setup.chunk(s, r));
+    let wall_ns = wall.elapsed().as_nanos() as u64;
+    progress.finish();
+    // an empty run merges nothing: one empty accumulator per variant
+    let sacc = if sacc.is_empty() { setup.variants.iter().map(|_| SlabAcc::default()).collect() } else { sacc };
+    let c = acc.c.0;
+    let rep = with_rti.then(|| FormatReport {
+        format: setup.name.clone(),
+        width: f.width(),
+        tests: c[0],
+        decisive: c[1],
+        golden_hits: c[2],
+        model_hits: c[3],
+        false_misses: c[4],
+        false_hits: c[5],
+        violations: c[6],
+        shared_hits: c[7],
+        t_err_ulps_median: acc.ulps.median(),
+        t_err_ulps_max: acc.ulps.max(),
+        t_err_rel_median: acc.rels.median(),
+        t_err_rel_max: acc.rels.max(),
+        closest_disagreements: c[8],
+        divide_skipped: c[9],
+        mtests_per_s: rate(c[0], acc.model_ns),
+        judged_mtests_per_s: rate(c[0], wall_ns),
+        first_violation: acc.first.into_inner(),
+    });
+    let slab = setup
+        .variants
+        .iter()
+        .zip(sacc)
+        .map(|(v, a)| SlabReport {
+            format: setup.name.clone(),
+            variant: v.name.to_string(),
+            conservative: v.conservative,
+            tests: a.c.0[0],
+            exact_hits: a.c.0[1],
+            false_misses: a.c.0[2],
+            false_hits: a.c.0[3],
+            exact_calls: a.c.0[4],
+            mtests_per_s: rate(a.c.0[0], a.model_ns),
+        })
+        .collect();
+    (rep, slab)
+}
