@@ -424,8 +424,14 @@ fn limit(what: &str, n: u64, max: u64, why: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// Refuses a per-ray test list this build cannot hold (the rays themselves are streamed).
-fn check_tests(_rays: u64, _scene: &Scene, sample: u64) -> Result<(), String> {
+/// Rays of one verify / plan / report run at most. They are streamed (memory does not grow
+/// with them), but 10¹¹ rays × 512 tests is already months of one machine: a larger campaign
+/// is split into runs with different seeds.
+const MAX_RAYS: u64 = 100_000_000_000;
+
+/// Refuses a run this build cannot serve: too many rays, or a per-ray test list too long.
+fn check_tests(rays: u64, _scene: &Scene, sample: u64) -> Result<(), String> {
+    limit("--rays", rays, MAX_RAYS, "a single streamed run; split a larger campaign into runs with different seeds")?;
     limit("--sample", sample, MAX_SAMPLE, "each worker holds one ray's test list")
 }
 

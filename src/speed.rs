@@ -314,6 +314,32 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
             push(row(&format!("slab {name} scalar model (plain)"), pairs, SLAB_OPS, 3, || s.batch(&rs, &bs, &mut out)));
         });
     }
+    // the golden and the error bound on f64 lanes (one ray against a block of 256 triangles, as
+    // the engine runs them; f64 work, so no fraction of the binary32 peak)
+    {
+        let n = pairs.clamp(1, 256);
+        let ray =
+            cases.first().map_or(Ray64 { o: [0.0; 3], d: [0.0, 0.0, 1.0], tmin: 0.0, tmax: f64::INFINITY }, |c| c.0);
+        let cols: [Vec<f64>; 9] =
+            std::array::from_fn(|k| (0..n).map(|i| cases.get(i).map_or(0.0, |c| c.1.v[k / 3][k % 3])).collect());
+        let c9 = || -> [&[f64]; 9] { std::array::from_fn(|k| &cols[k][..]) };
+        let (mut hit, mut t) = (vec![false; n], vec![0.0; n]);
+        let level = golden::block::best_level();
+        push(row(&format!("golden mt f64 block ({level:?})"), n, 0.0, 3, || {
+            golden::block::intersect_block(level, &ray, golden::Faces::default(), c9(), &mut hit, &mut t)
+        }));
+        let (mut dec, mut te) = (vec![false; n], vec![0.0; n]);
+        let opts = datapath::bound::BlockOpts {
+            em: f32f.error_model(),
+            div: datapath::format::DivMode::RecipMul,
+            cull: datapath::rti::Cull::TwoSided,
+            det_threshold: 0.0,
+        };
+        let bray = datapath::bound::BlockRay { o: ray.o, d: ray.d, tmin: ray.tmin, tmax: ray.tmax };
+        push(row("error bound f64 block (widest here)", n, 0.0, 3, || {
+            datapath::bound::verdict_block(Kernel::Avx512Fp16, opts, bray, c9(), &mut dec, &mut hit, &mut te)
+        }));
+    }
     // a batch far beyond the caches: one pass over 1 M-pair columns against the same pairs
     // streamed through L1-sized chunks gathered from the scene (gather included)
     {
@@ -384,6 +410,35 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
                 datapath::simd::slab_batch(&s, &sr, &sb, &mut so);
             }));
             // (freed here, before the next placement's columns are made)
+        }
+    }
+    // the streaming engine end to end: `verify` on the built-in scene (every ray against all 368
+    // triangles, the slab variants included), tests judged per second of wall time, on one
+    // thread and on every core (the ratio is the engine's thread scaling)
+    {
+        let scene = crate::scene::Scene::builtin();
+        let rays = 2048;
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        for t in [1, threads] {
+            let mut cfg = crate::verify::VerifyConfig::new(
+                vec!["f32".parse().expect("built-in format")],
+                rays,
+                seed,
+                RtiConfig::default(),
+                512,
+            );
+            cfg.engine = engine::Engine::new(crate::verify::CHUNK_RAYS).with_threads(Some(t));
+            let best =
+                (0..3).map(|_| crate::verify::verify(&cfg, &scene).formats[0].judged_mtests_per_s).fold(0.0, f64::max);
+            rows.push(SpeedRow {
+                name: format!(
+                    "engine: verify f32 end to end, {rays} rays x 368 triangles + 5 slab variants, {t} thread(s)"
+                ),
+                mtests_per_s: best,
+                ops: 0.0,
+                peak: "binary32".into(),
+                fraction_of_peak: 0.0,
+            });
         }
     }
     // every fraction against the one, best, peak of the run: the best rate over the best peak

@@ -32,7 +32,8 @@ static A: Counting = Counting;
 /// Heap bytes above the level before the run, at the run's peak.
 fn peak_of(rays: usize) -> usize {
     let scene = Scene::builtin();
-    let cfg = VerifyConfig::new(vec!["f32".parse().unwrap(), "bf16".parse().unwrap()], rays, 3, Default::default(), 512);
+    let cfg =
+        VerifyConfig::new(vec!["f32".parse().unwrap(), "bf16".parse().unwrap()], rays, 3, Default::default(), 512);
     let before = NOW.load(Relaxed);
     PEAK.store(before, Relaxed);
     let rep = verify(&cfg, &scene);
