@@ -29,8 +29,9 @@ pub struct SpeedRow {
     pub mtests_per_s: f64,
     /// Floating-point ops per test.
     pub ops: f64,
-    /// The peak the fraction is taken against: "binary32", or "binary16" (the AVX512-FP16
-    /// peak, for binary16 rows on a machine that has it).
+    /// The peak the fraction is taken against: "binary32", "binary16" (the AVX512-FP16
+    /// peak, for binary16 rows on a machine that has it), or "none" (f64 work and whole runs:
+    /// `ops` 0, fraction 0).
     pub peak: String,
     /// Throughput × ops / the peak of its precision.
     pub fraction_of_peak: f64,
@@ -446,6 +447,12 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     let peak = peaks.iter().map(|p| p[0]).fold(0.0, f64::max);
     let peak16 = peaks.iter().map(|p| p[1]).fold(0.0, f64::max);
     for r in &mut rows {
+        // f64 work (the golden, the bound) and whole runs (the engine) have no op count: no
+        // fraction of a binary32 / binary16 peak
+        if r.ops == 0.0 {
+            r.peak = "none".into();
+            continue;
+        }
         let p = if r.peak == "binary16" { peak16 } else { peak };
         r.fraction_of_peak = r.mtests_per_s * 1e6 * r.ops / p;
     }
@@ -494,7 +501,11 @@ pub fn render(s: &SpeedReport) -> String {
         "| implementation | M tests/s | ops/test | fraction of peak |\n|---|---:|---:|---:|\n"
     };
     for r in &s.rows {
-        out += &format!("| {} | {:.1} | {} | {:.3} |", r.name, r.mtests_per_s, r.ops, r.fraction_of_peak);
+        out += &if r.peak == "none" {
+            format!("| {} | {:.1} | — | — |", r.name, r.mtests_per_s)
+        } else {
+            format!("| {} | {:.1} | {} | {:.3} |", r.name, r.mtests_per_s, r.ops, r.fraction_of_peak)
+        };
         out += &if with16 { format!(" {} |\n", r.peak) } else { "\n".into() };
     }
     out
