@@ -148,6 +148,7 @@ struct Scratch<V> {
     snear: Vec<f64>,
     sfar: Vec<f64>,
     exact: Vec<u8>,
+    prepared: Vec<datapath::slab::SlabRay<V>>,
     boxes: BoxesSoa<V>,
     sout: SlabOutSoa<V>,
 }
@@ -172,6 +173,7 @@ impl<V: Copy + Default> Scratch<V> {
             snear: f(),
             sfar: f(),
             exact: vec![0; BLOCK],
+            prepared: Vec::new(),
             boxes: BoxesSoa::default(),
             sout: SlabOutSoa::default(),
         }
@@ -197,8 +199,9 @@ where
             test_list(self.scene.tris.len(), self.cfg.sample, self.cfg.seed, i, target, &mut s.list);
             let rq = Ray64 { o: ray.o.map(q), d: ray.d.map(q), tmin: q(ray.tmin), tmax: q(ray.tmax) };
             let mray = self.rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
-            let prepared: Vec<_> =
-                self.variants.iter().map(|v| v.slab.prepare(ray.o, ray.d, ray.tmin, ray.tmax)).collect();
+            let mut prepared = std::mem::take(&mut s.prepared);
+            prepared.clear();
+            prepared.extend(self.variants.iter().map(|v| v.slab.prepare(ray.o, ray.d, ray.tmin, ray.tmax)));
             let mut cap = Capture::default();
             let mut gbest: Option<(usize, f64)> = None;
             let list = std::mem::take(&mut s.list);
@@ -220,6 +223,7 @@ where
                 acc.c.0[8] += !same as u64;
             }
             s.list = list;
+            s.prepared = prepared;
         }
         (acc, sacc)
     }
