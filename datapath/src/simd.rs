@@ -237,6 +237,22 @@ pub fn slab_kernel_f16(s: &Slab<Ieee<F16Half>>) -> Kernel {
     best_kernel(eligible(&s.fmt) && !s.cfg.directed, WIDEST_F16)
 }
 
+/// The directed variant's kernel applies to one-ray batches (its interval ends are the ray's,
+/// so every lane shares the choices the scalar model branches on) without widening or guard.
+fn directed_one_ok(c: &crate::slab::SlabConfig) -> bool {
+    c.directed && c.widen_ulps == 0 && !c.guard
+}
+
+/// The kernel `slab_ray_f32` (one ray, many boxes) uses: every variant, the directed one included.
+pub fn slab_ray_kernel_f32(s: &Slab<Ieee<F32Native>>) -> Kernel {
+    best_kernel(eligible(&s.fmt) && (!s.cfg.directed || directed_one_ok(&s.cfg)), WIDEST_F32)
+}
+
+/// The kernel `slab_ray_f16` uses: every variant, the directed one included.
+pub fn slab_ray_kernel_f16(s: &Slab<Ieee<F16Half>>) -> Kernel {
+    best_kernel(eligible(&s.fmt) && (!s.cfg.directed || directed_one_ok(&s.cfg)), WIDEST_F16)
+}
+
 /// Every box and output column holds `n` slots.
 fn slab_columns_ok<V>(boxes: &BoxesSoa<V>, out: &SlabOutSoa<V>, n: usize) -> bool {
     boxes.min.iter().chain(&boxes.max).all(|c| c.len() == n)
@@ -336,7 +352,7 @@ slab_entry!(
 );
 slab_entry!(
     /// [`Slab::batch_ray`] (one ray, many boxes) for binary32 on the fastest kernel available; the same bits.
-    slab_ray_f32, Ieee<F32Native>, f32, SlabRay<f32>, One, slab_kernel_f32, slab_f32, None
+    slab_ray_f32, Ieee<F32Native>, f32, SlabRay<f32>, One, slab_ray_kernel_f32, slab_f32, None
 );
 slab_entry!(
     /// [`Slab::batch`] for binary16 on the fastest kernel available; the same bits.
@@ -344,7 +360,7 @@ slab_entry!(
 );
 slab_entry!(
     /// [`Slab::batch_ray`] (one ray, many boxes) for binary16 on the fastest kernel available; the same bits.
-    slab_ray_f16, Ieee<F16Half>, f16, SlabRay<f16>, One, slab_kernel_f16, slab_f16, Some(kernels::v32h::slab_f16)
+    slab_ray_f16, Ieee<F16Half>, f16, SlabRay<f16>, One, slab_ray_kernel_f16, slab_f16, Some(kernels::v32h::slab_f16)
 );
 
 /// The body of a format-generic dispatch: calls `$f32` (or `$f16`) when the unit and its
@@ -618,6 +634,24 @@ mod isa {
         pub fn or_m(a: M, b: M) -> M {
             _mm256_or_ps(a, b)
         }
+        /// The mask's complement.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn not_m(a: M) -> M {
+            _mm256_xor_ps(a, _mm256_castsi256_ps(_mm256_set1_epi32(-1)))
+        }
+        /// `sel ? b : a` per lane, on masks.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn blend_m(a: M, b: M, sel: M) -> M {
+            _mm256_blendv_ps(a, b, sel)
+        }
+        /// Lanes whose sign bit is set.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn sign_m(x: __m256) -> M {
+            _mm256_castsi256_ps(_mm256_srai_epi32::<31>(_mm256_castps_si256(x)))
+        }
         /// Writes the mask's lanes as bools 0 / 1 to `p[i..i + 8]`.
         ///
         /// # Safety
@@ -776,6 +810,24 @@ mod isa {
         #[target_feature(enable = "avx512f")]
         pub fn or_m(a: M, b: M) -> M {
             a | b
+        }
+        /// The mask's complement.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn not_m(a: M) -> M {
+            !a
+        }
+        /// `sel ? b : a` per lane, on masks.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn blend_m(a: M, b: M, sel: M) -> M {
+            (a & !sel) | (b & sel)
+        }
+        /// Lanes whose sign bit is set.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn sign_m(x: __m512) -> M {
+            _mm512_test_epi32_mask(_mm512_castps_si512(x), _mm512_set1_epi32(i32::MIN))
         }
         /// Writes the mask's lanes as bools 0 / 1 to `p[i..i + 16]`.
         ///
@@ -956,6 +1008,24 @@ mod isa {
         pub fn or_m(a: M, b: M) -> M {
             a | b
         }
+        /// The mask's complement.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn not_m(a: M) -> M {
+            !a
+        }
+        /// `sel ? b : a` per lane, on masks.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn blend_m(a: M, b: M, sel: M) -> M {
+            (a & !sel) | (b & sel)
+        }
+        /// Lanes whose sign bit is set.
+        #[inline]
+        #[target_feature(enable = "avx512fp16,avx512bw,avx512f")]
+        pub fn sign_m(x: __m512h) -> M {
+            _mm512_movepi16_mask(_mm512_castph_si512(x))
+        }
         /// Writes the mask's lanes as bools 0 / 1 to `p[i..i + 32]`.
         ///
         /// # Safety
@@ -1122,6 +1192,19 @@ mod kernels {
         ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $bcast:expr) => {{
             // one loop per comparator and batch shape, so that neither is decided per vector
             let tof = $s.cfg.nan == SlabNan::TakeOnFalse;
+            if $s.cfg.directed {
+                match $rays {
+                    SlabRays::One(r) if tof => slab_kernel!(@dloop $x, $s, r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, true),
+                    SlabRays::One(r) => slab_kernel!(@dloop $x, $s, r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, false),
+                    // pairs of the directed variant are not eligible (see `slab_kernel_ray_*`)
+                    SlabRays::Pairs(r) => {
+                        for k in 0..$full {
+                            $out.set(k, $s.test(&r.get(k), &$boxes.get(k)));
+                        }
+                    }
+                }
+                return;
+            }
             match ($rays, tof) {
                 (SlabRays::Pairs(r), false) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, false),
                 (SlabRays::Pairs(r), true) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, true),
@@ -1180,6 +1263,98 @@ mod kernels {
         (@limits one $prep:ident, $load:ident, $i:ident) => {
             $prep.3
         };
+        // the directed variant, one ray against every box (see `Slab::trace_directed`, step for
+        // step): the entry plane's difference rounded to nearest and stepped outward to a
+        // bracket, the bracket end and the 1/d end chosen by their signs (the first by the ray's
+        // direction, uniform; the second per lane), ends standing for ±∞ giving the unbounded
+        // bound, the product stepped outward once. A parallel axis (uniform) tests the origin
+        // against the slab. Lanes whose plane difference is NaN (its sign would pick an end) are
+        // marked NaN and redone by the model, as are NaN outputs.
+        (@dloop $x:ident, $s:expr, $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $bcast:expr, $tof:expr) => {{
+            let (s, boxes, out) = ($s, $boxes, $out);
+            let (load, rd, store, up, bcast) = ($load, $round, $store, $up, $bcast);
+            let neg = |v| $x::xor(v, $x::splat(-0.0));
+            let down = |v| neg(up(neg(v)));
+            let bmin = boxes.min.each_ref().map(|c| c.as_ptr());
+            let bmax = boxes.max.each_ref().map(|c| c.as_ptr());
+            let r = $r;
+            use crate::Format as _;
+            let f = &s.fmt;
+            let prep = slab_kernel!(@prep one r, bmin, bmax, bcast);
+            let (top, bottom) = (f.from_f64(f64::INFINITY), f.from_f64(f64::NEG_INFINITY));
+            let (vtop, vbottom) = (bcast(top), bcast(bottom));
+            let is_top = |v| f.to_bits(v) == f.to_bits(top);
+            let is_bottom = |v| f.to_bits(v) == f.to_bits(bottom);
+            // per axis, uniform: direction sign, 1/d ends and whether each stands for ±∞
+            let dneg: [bool; 3] = std::array::from_fn(|a| f.sign_bit(r.inv_d[a]));
+            let inv_lo = r.inv_lo.map(bcast);
+            let inv_hi = r.inv_hi.map(bcast);
+            let lo_inf: [bool; 3] = std::array::from_fn(|a| is_bottom(r.inv_lo[a]));
+            let hi_inf: [bool; 3] = std::array::from_fn(|a| is_top(r.inv_hi[a]));
+            let all = $x::le($x::splat(0.0), $x::splat(0.0));
+            let none = $x::lt($x::splat(0.0), $x::splat(0.0));
+            let m = |b: bool| if b { all } else { none };
+            let (o_hit, o_near, o_far) = (out.hit.as_mut_ptr(), out.t_near.as_mut_ptr(), out.t_far.as_mut_ptr());
+            let mut nan_seen = 0;
+            let mut i = 0;
+            while i < $full {
+                let (mut tn, mut tf) = prep.3;
+                let mut outside = none;
+                let mut bad = none;
+                for a in 0..3 {
+                    let o = prep.2 .0[a];
+                    if r.parallel[a] {
+                        let inside = $x::and_m($x::le(load(bmin[a], i), o), $x::le(o, load(bmax[a], i)));
+                        outside = $x::or_m(outside, $x::not_m(inside));
+                        continue;
+                    }
+                    let de = rd($x::sub(load(prep.0[a], i), o));
+                    let dx = rd($x::sub(load(prep.1[a], i), o));
+                    bad = $x::or_m(bad, $x::unord(de, dx));
+                    // bracket end of the entry difference: d < 0 → its upper end, else its lower
+                    let (x_e, x_e_inf) = if dneg[a] {
+                        let v = up(de);
+                        (v, $x::le(vtop, v))
+                    } else {
+                        let v = down(de);
+                        (v, $x::le(v, vbottom))
+                    };
+                    let (x_x, x_x_inf) = if dneg[a] {
+                        let v = down(dx);
+                        (v, $x::le(v, vbottom))
+                    } else {
+                        let v = up(dx);
+                        (v, $x::le(vtop, v))
+                    };
+                    // the 1/d end by the bracket end's sign: negative → inv_hi (entry) / inv_lo (exit)
+                    let inv_e = $x::blend_sign(inv_lo[a], inv_hi[a], x_e);
+                    let inv_e_inf = $x::blend_m(m(lo_inf[a]), m(hi_inf[a]), $x::sign_m(x_e));
+                    let inv_x = $x::blend_sign(inv_hi[a], inv_lo[a], x_x);
+                    let inv_x_inf = $x::blend_m(m(hi_inf[a]), m(lo_inf[a]), $x::sign_m(x_x));
+                    let t_entry = $x::blend(down(rd($x::mul(x_e, inv_e))), vbottom, $x::or_m(x_e_inf, inv_e_inf));
+                    let t_exit = $x::blend(up(rd($x::mul(x_x, inv_x))), vtop, $x::or_m(x_x_inf, inv_x_inf));
+                    if $tof {
+                        tn = $x::blend(t_entry, tn, $x::le(t_entry, tn));
+                        tf = $x::blend(t_exit, tf, $x::le(tf, t_exit));
+                    } else {
+                        tn = $x::max(t_entry, tn);
+                        tf = $x::min(t_exit, tf);
+                    }
+                }
+                tn = $x::blend(tn, $x::canonical_nan(), bad);
+                let hit = $x::and_m($x::not_m(outside), $x::le(tn, tf));
+                // SAFETY: lanes i..i + L are in bounds.
+                unsafe { $x::flags(o_hit, i, hit) };
+                store(o_near, i, tn);
+                store(o_far, i, tf);
+                nan_seen |= $x::bits($x::unord(tn, tf));
+                i += $x::LANES;
+            }
+            if nan_seen != 0 {
+                // SAFETY: lanes 0..full are in bounds (as above).
+                unsafe { slab_redo(s, SlabRays::One(r), boxes, (o_hit, o_near, o_far), $full) };
+            }
+        }};
         (@loop $x:ident, $s:expr, $shape:ident $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $bcast:expr, $tof:expr) => {{
             let (s, boxes, out) = ($s, $boxes, $out);
             let (load, rd, store, up, bcast) = ($load, $round, $store, $up, $bcast);

@@ -194,6 +194,7 @@ mod slab {
     use super::*;
     use datapath::simd::{
         slab_batch_f16, slab_batch_f32, slab_kernel_f16, slab_kernel_f32, slab_ray_f16, slab_ray_f32,
+        slab_ray_kernel_f16, slab_ray_kernel_f32,
     };
     use datapath::slab::{Aabb, BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRay, SlabRaysSoa};
 
@@ -294,7 +295,9 @@ mod slab {
         let mut a = SlabOutSoa::with_len(n);
         s.batch(&rays, &boxes, &mut a);
         let fresh = || SlabOutSoa::with_len(n);
-        on_every_kernel(widest, &a, |b| pairs(&s, &rays, &boxes, b), fresh, |a, b| same(&f, a, b))?;
+        // the directed variant's pairs run the scalar model (its kernel takes one-ray batches)
+        let pairs_widest = if s.cfg.directed { Kernel::Scalar } else { widest };
+        on_every_kernel(pairs_widest, &a, |b| pairs(&s, &rays, &boxes, b), fresh, |a, b| same(&f, a, b))?;
         if n > 0 {
             let ray = rays.get(seed as usize % n);
             s.batch_ray(&ray, &boxes, &mut a);
@@ -381,24 +384,24 @@ mod slab {
         check_edges(WIDEST_F16, Ieee::new(F16Half, div), slab_batch_f16, slab_ray_f16).unwrap();
     }
 
-    const VARIANTS: [&str; 4] = ["plain", "conservative", "take-on-false", "embree"];
+    const VARIANTS: [&str; 5] = ["plain", "conservative", "take-on-false", "embree", "directed"];
 
     proptest! {
         #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
         #[test]
-        fn f32_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..4) {
+        fn f32_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..5) {
             check(WIDEST_F32, Ieee::new(F32Native, FpOpts::default()), VARIANTS[v], seed, n, slab_batch_f32, slab_ray_f32)?;
         }
 
         #[test]
-        fn f16_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..4) {
+        fn f16_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..5) {
             check(WIDEST_F16, Ieee::new(F16Half, FpOpts::default()), VARIANTS[v], seed, n, slab_batch_f16, slab_ray_f16)?;
         }
     }
 
     #[test]
-    fn the_slab_kernels_run_and_the_directed_variant_stays_scalar() {
+    fn the_slab_kernels_run_and_the_directed_variant_runs_on_one_ray_batches_only() {
         let f = Ieee::new(F32Native, FpOpts::default());
         let h = Ieee::new(F16Half, FpOpts::default());
         let best = *kernels_here().last().unwrap();
@@ -408,6 +411,8 @@ mod slab {
         let directed = SlabConfig::named("directed").unwrap();
         assert_eq!(slab_kernel_f32(&Slab::new(f, directed)), Kernel::Scalar);
         assert_eq!(slab_kernel_f16(&Slab::new(h, directed)), Kernel::Scalar);
+        assert_eq!(slab_ray_kernel_f32(&Slab::new(f, directed)), best.min(WIDEST_F32));
+        assert_eq!(slab_ray_kernel_f16(&Slab::new(h, directed)), best);
         // the generated batches are not vacuous: hits, misses and NaN distances occur, and the
         // conservative variant widens (its intervals differ from plain's)
         for (fmt_hits, nan) in [
@@ -428,6 +433,41 @@ mod slab {
         ] {
             assert!(fmt_hits > 200 && fmt_hits < 3800, "{fmt_hits}");
             assert!(nan);
+        }
+    }
+
+    /// The directed variant's one-ray kernel against the model over many rays (each proptest
+    /// case above takes one ray): parallel axes (d = ±0), infinite and NaN components, raw-bit
+    /// boxes; and the batches are not vacuous (hits, misses, unbounded ends occur).
+    #[test]
+    fn the_directed_one_ray_kernel_equals_the_model_on_many_rays() {
+        fn run<F: Format + Copy>(widest: Kernel, f: F, one: RayFn<F>) -> (usize, usize)
+        where
+            F::V: Default,
+        {
+            let s = Slab::new(f, SlabConfig::named("directed").unwrap());
+            let (mut hits, mut total) = (0, 0);
+            for seed in 0..300u64 {
+                let n = 40 + (seed as usize % 29);
+                let (rays, boxes) = batch(&s, seed, n);
+                let fresh = || SlabOutSoa::with_len(n);
+                for k in [0, n / 2, n - 1] {
+                    let ray = rays.get(k);
+                    let mut a = SlabOutSoa::with_len(n);
+                    s.batch_ray(&ray, &boxes, &mut a);
+                    hits += a.hit.iter().filter(|&&h| h).count();
+                    total += n;
+                    on_every_kernel(widest, &a, |b| one(&s, &ray, &boxes, b), fresh, |a, b| same(&f, a, b))
+                        .unwrap_or_else(|e| panic!("seed {seed} ray {k}: {e}"));
+                }
+            }
+            (hits, total)
+        }
+        for (hits, total) in [
+            run(WIDEST_F32, Ieee::new(F32Native, FpOpts::default()), slab_ray_f32),
+            run(WIDEST_F16, Ieee::new(F16Half, FpOpts::default()), slab_ray_f16),
+        ] {
+            assert!(hits > total / 50 && hits < total - total / 50, "{hits} of {total}");
         }
     }
 

@@ -107,12 +107,11 @@ impl Merge for SlabAcc {
     }
 }
 
-/// A slab variant ready to run: its unit and the scene's boxes stored in the format.
+/// A slab variant ready to run.
 struct Variant<F: Format> {
     name: &'static str,
     slab: Slab<F>,
     conservative: bool,
-    stored: Vec<Aabb<F::V>>,
 }
 
 /// What every chunk of one format's pass shares (O(scene), built once).
@@ -124,6 +123,8 @@ struct Setup<'a, F: Format> {
     mtris: Vec<Tri<F::V>>,
     qtris: Vec<[f64; 9]>,
     boxes: Vec<[f64; 6]>,
+    /// The scene's boxes stored in the format (outward-rounded; the same for every variant).
+    stored: Vec<Aabb<F::V>>,
     variants: Vec<Variant<F>>,
     opts: BlockOpts,
     faces: golden::Faces,
@@ -338,15 +339,20 @@ where
             &mut s.snear[..n],
             &mut s.sfar[..n],
         );
+        // the stored boxes, gathered once for every variant
+        for c in s.boxes.min.iter_mut().chain(s.boxes.max.iter_mut()) {
+            c.resize(n, F::V::default());
+        }
+        for (k, &ti) in blk.iter().enumerate() {
+            let b = &self.stored[ti as usize];
+            for a in 0..3 {
+                s.boxes.min[a][k] = b.min[a];
+                s.boxes.max[a][k] = b.max[a];
+            }
+        }
         // the exact decision of each lane, computed at most once for all variants (0: not yet)
         s.exact[..n].fill(0);
         for ((v, sr), acc) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()) {
-            for c in s.boxes.min.iter_mut().chain(s.boxes.max.iter_mut()) {
-                c.clear();
-            }
-            for &ti in blk {
-                s.boxes.push(&v.stored[ti as usize]);
-            }
             s.sout.hit.resize(n, false);
             s.sout.t_near.resize(n, F::V::default());
             s.sout.t_far.resize(n, F::V::default());
@@ -419,14 +425,17 @@ where
         .into_iter()
         .map(|name| {
             let sc = SlabConfig::named(name).expect("built-in variant");
-            let slab = Slab::new(*f, sc);
-            let stored = boxes
-                .iter()
-                .map(|b| slab.store_box([b[0], b[1], b[2]], [b[3], b[4], b[5]]).unwrap_or_else(|_| slab.empty_box()))
-                .collect();
-            Variant { name, conservative: sc.is_conservative(f), slab, stored }
+            Variant { name, conservative: sc.is_conservative(f), slab: Slab::new(*f, sc) }
         })
         .collect();
+    // box storage does not depend on the variant
+    let stored = match variants.first() {
+        Some(v) => boxes
+            .iter()
+            .map(|b| v.slab.store_box([b[0], b[1], b[2]], [b[3], b[4], b[5]]).unwrap_or_else(|_| v.slab.empty_box()))
+            .collect(),
+        None => Vec::new(),
+    };
     let setup = Setup {
         cfg,
         scene,
@@ -438,6 +447,7 @@ where
             Vec::new()
         },
         boxes,
+        stored,
         variants,
         opts: BlockOpts {
             em: f.error_model(),
