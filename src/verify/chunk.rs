@@ -248,8 +248,13 @@ where
         s.rays.resize(n, F::V::default());
         s.tris.resize(n, F::V::default());
         s.out.resize(n);
+        // every lane holds the ray: written in the ray's first block (the largest), kept after
+        if base == 0 {
+            for k in 0..n {
+                s.rays.set(k, mray);
+            }
+        }
         for (k, &ti) in blk.iter().enumerate() {
-            s.rays.set(k, mray);
             s.tris.set(k, &self.mtris[ti as usize]);
             let qt = &self.qtris[ti as usize];
             for c in 0..9 {
