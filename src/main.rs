@@ -67,6 +67,23 @@ impl RtiArgs {
     }
 }
 
+/// How a streamed run executes (the results do not depend on it).
+#[derive(clap::Args, Clone)]
+struct EngineArgs {
+    /// Worker threads (default: every core); the results do not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    threads: Option<u64>,
+    /// No progress bar on stderr.
+    #[arg(long)]
+    quiet: bool,
+}
+
+impl EngineArgs {
+    fn engine(&self, chunk: u64) -> engine::Engine {
+        engine::Engine::new(chunk).with_threads(self.threads.map(|t| t as usize))
+    }
+}
+
 #[derive(clap::Args, Clone)]
 struct VerifyArgs {
     /// OBJ scene (default: the built-in Cornell box + icosphere + needles).
@@ -169,6 +186,8 @@ enum Cmd {
         /// Print the results as JSON.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        run: EngineArgs,
     },
     /// The thesis's experiments (figs. 3-1, 3-2, 3-4, 3-5, restart overhead) over leaf sizes.
     Stats {
@@ -190,6 +209,8 @@ enum Cmd {
         /// Print the results as JSON.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        run: EngineArgs,
     },
     /// Render through the bit-accurate pipeline (slab traversal → RTI min-capture) and diff with the golden.
     Render {
@@ -408,9 +429,6 @@ fn emit<T: serde::Serialize>(json: bool, value: &T, render: impl FnOnce(&T) -> S
 /// Triangles tested per ray at most: each worker holds one ray's test list (4 bytes each).
 /// Verify, plan and report stream their rays, so the number of rays is not limited.
 const MAX_SAMPLE: u64 = 1 << 24;
-/// Rays `traverse` holds (~75 bytes each) and `stats` holds (~200 bytes each) at most.
-const MAX_TRAVERSE_RAYS: u64 = 50_000_000;
-const MAX_STATS_RAYS: u64 = 20_000_000;
 /// Pairs per `speed` call at most (15 columns of 4 bytes: 1 GiB).
 const MAX_SPEED_PAIRS: u64 = 1 << 24;
 /// Vectors per class at most (the set is built in memory before it is written).
@@ -527,8 +545,13 @@ fn run() -> Result<Outcome, String> {
             }
             Ok(Outcome::Pass)
         }
-        Some(Cmd::Traverse { scene, format, variant, rays, seed, n, leaf_size, levels, json }) => {
-            limit("--rays", rays, MAX_TRAVERSE_RAYS, "every ray is held in memory")?;
+        Some(Cmd::Traverse { scene, format, variant, rays, seed, n, leaf_size, levels, json, run }) => {
+            limit(
+                "--rays",
+                rays,
+                MAX_RAYS,
+                "a single streamed run; split a larger campaign into runs with different seeds",
+            )?;
             let scene = load_scene(scene.as_deref())?;
             let cfg = raypipe::traverse::TraverseConfig {
                 formats: format,
@@ -538,16 +561,24 @@ fn run() -> Result<Outcome, String> {
                 n: n as usize,
                 leaf_size,
                 levels: levels as usize,
+                engine: run.engine(raypipe::traverse::CHUNK_RAYS),
+                progress: !run.quiet,
             };
             let rep = raypipe::traverse::traverse(&cfg, &scene)?;
             emit(json, &rep, raypipe::traverse::render)?;
             Ok(Outcome::from(rep.passed))
         }
-        Some(Cmd::Stats { scene, rays, seed, leaf_sizes, svg, json }) => {
-            limit("--rays", rays, MAX_STATS_RAYS, "every ray is held in memory")?;
+        Some(Cmd::Stats { scene, rays, seed, leaf_sizes, svg, json, run }) => {
+            limit(
+                "--rays",
+                rays,
+                MAX_RAYS,
+                "a single streamed run; split a larger campaign into runs with different seeds",
+            )?;
             let out = svg.as_deref().map(|d| OutDir::check(d, &raypipe::stats::SVG_FILES)).transpose()?;
             let scene = load_scene(scene.as_deref())?;
-            let rep = raypipe::stats::stats(&scene, &leaf_sizes, rays as usize, seed)?;
+            let eng = run.engine(raypipe::traverse::CHUNK_RAYS);
+            let rep = raypipe::stats::stats_on(&eng, !run.quiet, &scene, &leaf_sizes, rays as usize, seed)?;
             emit(json, &rep, raypipe::stats::render)?;
             if let Some(out) = out {
                 for p in raypipe::stats::write_svgs(&rep, &out)? {

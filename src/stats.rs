@@ -61,97 +61,118 @@ pub struct StatsReport {
 
 const BACK_BINS: usize = 11;
 
-/// One ray's share of the figures.
-struct RayStats {
-    visited: Vec<u32>,
-    hit: bool,
-    wasted: u64,
-    hist_tests: u64,
-    stack_tests: u64,
-    backs: usize,
-    distances: Vec<u32>,
+/// One chunk's share of the figures: counts (rays hit, wasted RTI tests, history box tests,
+/// stack box tests, leaf visits), back traversals per ray, back-traversal distances, and the
+/// set of leaves visited.
+#[derive(Default)]
+struct StatsAcc {
+    c: engine::Counts<5>,
+    back: engine::Counts<BACK_BINS>,
+    dist: engine::Tally,
+    seen: engine::Bits,
 }
 
-/// Runs the sweep.
+impl engine::Merge for StatsAcc {
+    fn merge(&mut self, o: Self) {
+        self.c.merge(o.c);
+        self.back.merge(o.back);
+        self.dist.merge(o.dist);
+        self.seen.merge(o.seen);
+    }
+}
+
+/// Runs the sweep on the engine (rays by index, see [`crate::traverse::CameraRays`]).
 pub fn stats(scene: &Scene, leaf_sizes: &[u32], rays: usize, seed: u64) -> Result<StatsReport, String> {
-    let rays = crate::traverse::rays(scene, rays, seed);
+    stats_on(&engine::Engine::new(crate::traverse::CHUNK_RAYS), false, scene, leaf_sizes, rays, seed)
+}
+
+/// [`stats`] on a given engine, with progress on stderr when `progress`.
+pub fn stats_on(
+    eng: &engine::Engine,
+    progress: bool,
+    scene: &Scene,
+    leaf_sizes: &[u32],
+    rays: usize,
+    seed: u64,
+) -> Result<StatsReport, String> {
+    use engine::Merge as _;
+    let gen = crate::traverse::CameraRays::new(scene, rays, seed);
     let mut rows = Vec::new();
     for &ls in leaf_sizes {
         let b = build(scene, ls);
         let hw = b.layout_ids(256)?;
         let tree = b.golden_tree();
-        // rays in parallel; every figure is a sum of integers, merged in ray order
-        let per_ray = |ray: &golden::Ray64| {
-            let test = |i: u32| {
-                let n = &b.nodes[i as usize];
-                let r = slab_f64(ray.o, ray.d, ray.tmin, ray.tmax, n.min, n.max);
-                r.hit.then_some(r.t_near)
-            };
-            let all = history_traverse(&hw, usize::MAX, |&i| test(i));
-            // the nearest hit over every leaf reached, and the position of its leaf
-            let mut best: Option<(usize, f64)> = None;
-            for (k, &leaf) in all.leaves.iter().enumerate() {
-                for &t in &b.leaf_tris[leaf as usize] {
-                    let r = intersect(ray, &scene.tris[t as usize], Faces::default());
-                    if r.hit && best.is_none_or(|(_, bt)| r.t < bt) {
-                        best = Some((k, r.t));
+        let bar = engine::Progress::new(rays as u64, "rays", !progress);
+        bar.message(format!("leaf size {ls}"));
+        let acc = engine::run(
+            eng,
+            rays as u64,
+            &bar,
+            || (),
+            |_, range| {
+                let mut acc = StatsAcc::default();
+                for k in range {
+                    let ray = gen.ray(k);
+                    let test = |i: u32| {
+                        let n = &b.nodes[i as usize];
+                        let r = slab_f64(ray.o, ray.d, ray.tmin, ray.tmax, n.min, n.max);
+                        r.hit.then_some(r.t_near)
+                    };
+                    let all = history_traverse(&hw, usize::MAX, |&i| test(i));
+                    // the nearest hit over every leaf reached, and the position of its leaf
+                    let mut best: Option<(usize, f64)> = None;
+                    for (k, &leaf) in all.leaves.iter().enumerate() {
+                        for &t in &b.leaf_tris[leaf as usize] {
+                            let r = intersect(&ray, &scene.tris[t as usize], Faces::default());
+                            if r.hit && best.is_none_or(|(_, bt)| r.t < bt) {
+                                best = Some((k, r.t));
+                            }
+                        }
+                    }
+                    let upto = best.map_or(all.leaves.len(), |(k, _)| k + 1);
+                    let h = history_traverse(&hw, upto.max(1), |&i| test(i));
+                    let g = stack_traverse(&tree, upto.max(1), test);
+                    let tests: u64 = all.leaves[..upto].iter().map(|&l| b.leaf_tris[l as usize].len() as u64).sum();
+                    for &leaf in &all.leaves[..upto] {
+                        acc.seen.insert(leaf as usize);
+                    }
+                    let add =
+                        [best.is_some() as u64, tests - best.is_some() as u64, h.box_tests, g.box_tests, upto as u64];
+                    for (a, x) in acc.c.0.iter_mut().zip(add) {
+                        *a += x;
+                    }
+                    acc.back.0[(h.passes.saturating_sub(1) as usize).min(BACK_BINS - 1)] += 1;
+                    for d in h.back_distances {
+                        acc.dist.add((d as usize).min(b.depth + 1), 1);
                     }
                 }
-            }
-            let upto = best.map_or(all.leaves.len(), |(k, _)| k + 1);
-            let h = history_traverse(&hw, upto.max(1), |&i| test(i));
-            let g = stack_traverse(&tree, upto.max(1), test);
-            let tests: u64 = all.leaves[..upto].iter().map(|&l| b.leaf_tris[l as usize].len() as u64).sum();
-            RayStats {
-                visited: all.leaves[..upto].to_vec(),
-                hit: best.is_some(),
-                wasted: tests - best.is_some() as u64,
-                hist_tests: h.box_tests,
-                stack_tests: g.box_tests,
-                backs: h.passes.saturating_sub(1) as usize,
-                distances: h.back_distances,
-            }
-        };
-        let parts: Vec<RayStats> = {
-            use rayon::prelude::*;
-            rays.par_iter().map(per_ray).collect()
-        };
-        let mut per_leaf = vec![0u64; b.leaf_tris.len()];
-        let mut wasted = 0u64;
-        let mut back = vec![0u64; BACK_BINS];
-        let mut dist = vec![0u64; b.depth + 2];
-        let (mut hist_tests, mut stack_tests, mut rays_hit) = (0u64, 0u64, 0u64);
-        for p in parts {
-            for leaf in p.visited {
-                per_leaf[leaf as usize] += 1;
-            }
-            rays_hit += p.hit as u64;
-            wasted += p.wasted;
-            hist_tests += p.hist_tests;
-            stack_tests += p.stack_tests;
-            back[p.backs.min(BACK_BINS - 1)] += 1;
-            for d in p.distances {
-                dist[(d as usize).min(b.depth + 1)] += 1;
-            }
-        }
-        let visited: Vec<u64> = per_leaf.into_iter().filter(|&c| c > 0).collect();
+                acc
+            },
+        );
+        bar.finish();
+        let mut dist = engine::Tally(vec![0u64; b.depth + 2]);
+        dist.merge(acc.dist);
+        let dist = dist.0;
+        let [rays_hit, wasted, hist_tests, stack_tests, visits] = acc.c.0;
+        let back = acc.back.0.to_vec();
         let total_back: u64 = dist.iter().sum();
+        let n = rays.max(1) as f64;
         rows.push(LeafSizeStats {
             leaf_size: ls,
             leaves: b.leaf_tris.len(),
             depth: b.depth,
-            rays: rays.len() as u64,
+            rays: rays as u64,
             rays_hit,
-            rays_per_leaf: visited.iter().sum::<u64>() as f64 / visited.len().max(1) as f64,
-            wasted_rti_per_ray: wasted as f64 / rays.len() as f64,
-            no_back_traversal: back[0] as f64 / rays.len() as f64,
+            rays_per_leaf: visits as f64 / acc.seen.count().max(1) as f64,
+            wasted_rti_per_ray: wasted as f64 / n,
+            no_back_traversal: back[0] as f64 / n,
             within_8_levels: dist.iter().take(9).sum::<u64>() as f64 / total_back.max(1) as f64,
             back_traversals: back,
             back_distance: dist,
             restart_overhead: hist_tests as f64 / stack_tests.max(1) as f64,
         });
     }
-    Ok(StatsReport { scene: scene.name.clone(), triangles: scene.tris.len(), rays: rays.len(), seed, rows })
+    Ok(StatsReport { scene: scene.name.clone(), triangles: scene.tris.len(), rays, seed, rows })
 }
 
 /// The report as text tables.

@@ -29,6 +29,10 @@ pub struct TraverseConfig {
     pub leaf_size: u32,
     /// Level pipelines (history width / 2) available.
     pub levels: usize,
+    /// Threads and rays per chunk (the results do not depend on either).
+    pub engine: engine::Engine,
+    /// Show progress on stderr (when it is a terminal and the run lasts over a second).
+    pub progress: bool,
 }
 
 /// Results for one format.
@@ -92,29 +96,57 @@ pub struct TraverseReport {
 
 /// Primary rays on a pinhole camera in front of the scene (looking +z), then random ones.
 pub fn rays(scene: &Scene, count: usize, seed: u64) -> Vec<Ray64> {
-    let (lo, hi) = scene.bounds();
-    let c: [f64; 3] = std::array::from_fn(|a| (lo[a] + hi[a]) / 2.0);
-    let ext = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max).max(1e-6);
-    let eye = [c[0], c[1], lo[2] - 1.5 * ext];
-    let primary = count / 2;
-    let side = (primary as f64).sqrt().ceil().max(1.0) as usize;
-    let mut out = Vec::with_capacity(count);
-    for k in 0..primary {
-        let (i, j) = (k % side, k / side);
-        let sx = ((i as f64 + 0.5) / side as f64 - 0.5) * 0.8;
-        let sy = ((j as f64 + 0.5) / side as f64 - 0.5) * 0.8;
-        out.push(Ray64 { o: eye, d: [sx, sy, 1.0], tmin: 0.0, tmax: f64::INFINITY });
+    let g = CameraRays::new(scene, count, seed);
+    (0..count as u64).map(|k| g.ray(k)).collect()
+}
+
+/// Stream number of the random rays of [`CameraRays`] in [`SplitMix64::for_item`].
+pub const RANDOM_RAYS_STREAM: u64 = 0x7472_6176; // "trav"
+
+/// Makes ray `k` of [`rays`] without the rays before it: rays `0..count/2` are the primary
+/// rays of a `side × side` pinhole grid (`side = ⌈√(count/2)⌉`, row-major from the lower left)
+/// from an eye 1.5 scene extents in front of the scene; ray `k >= count/2` is random, drawn
+/// from `SplitMix64::for_item(seed, RANDOM_RAYS_STREAM, k)`: origin uniform in the bounds,
+/// direction uniform on the sphere.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRays {
+    lo: [f64; 3],
+    hi: [f64; 3],
+    eye: [f64; 3],
+    primary: u64,
+    side: u64,
+    seed: u64,
+}
+
+impl CameraRays {
+    /// The generator of `count` rays of `scene` under `seed`.
+    pub fn new(scene: &Scene, count: usize, seed: u64) -> Self {
+        let (lo, hi) = scene.bounds();
+        let c: [f64; 3] = std::array::from_fn(|a| (lo[a] + hi[a]) / 2.0);
+        let ext = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max).max(1e-6);
+        let primary = count as u64 / 2;
+        let side = (primary as f64).sqrt().ceil().max(1.0) as u64;
+        CameraRays { lo, hi, eye: [c[0], c[1], lo[2] - 1.5 * ext], primary, side, seed }
     }
-    let mut r = SplitMix64::new(seed);
-    while out.len() < count {
-        let o = std::array::from_fn(|a| r.range(lo[a], hi[a]));
+    /// Ray `k`.
+    pub fn ray(&self, k: u64) -> Ray64 {
+        if k < self.primary {
+            let (i, j) = (k % self.side, k / self.side);
+            let sx = ((i as f64 + 0.5) / self.side as f64 - 0.5) * 0.8;
+            let sy = ((j as f64 + 0.5) / self.side as f64 - 0.5) * 0.8;
+            return Ray64 { o: self.eye, d: [sx, sy, 1.0], tmin: 0.0, tmax: f64::INFINITY };
+        }
+        let mut r = SplitMix64::for_item(self.seed, RANDOM_RAYS_STREAM, k);
+        let o = std::array::from_fn(|a| r.range(self.lo[a], self.hi[a]));
         let z = r.range(-1.0, 1.0);
         let phi = r.range(0.0, std::f64::consts::TAU);
         let s = (1.0 - z * z).sqrt();
-        out.push(Ray64 { o, d: [s * phi.cos(), s * phi.sin(), z], tmin: 0.0, tmax: f64::INFINITY });
+        Ray64 { o, d: [s * phi.cos(), s * phi.sin(), z], tmin: 0.0, tmax: f64::INFINITY }
     }
-    out
 }
+
+/// Rays per chunk of `traverse` and `stats` on the engine.
+pub const CHUNK_RAYS: u64 = 256;
 
 /// Runs the equivalence check.
 pub fn traverse(cfg: &TraverseConfig, scene: &Scene) -> Result<TraverseReport, String> {
@@ -125,10 +157,10 @@ pub fn traverse(cfg: &TraverseConfig, scene: &Scene) -> Result<TraverseReport, S
     let b = build(scene, cfg.leaf_size);
     let hw = b.layout_ids(cfg.levels)?;
     let tree = b.golden_tree();
-    let rays = rays(scene, cfg.rays, cfg.seed);
+    let gen = CameraRays::new(scene, cfg.rays, cfg.seed);
     let mut rows = Vec::new();
     for f in &cfg.formats {
-        rows.push(with_format!(*f, |f| one_format(f, sc, &b, &hw, &tree, &rays, cfg.n))?);
+        rows.push(with_format!(*f, |f| one_format(f, sc, &b, &hw, &tree, &gen, cfg))?);
     }
     Ok(TraverseReport {
         scene: scene.name.clone(),
@@ -144,62 +176,88 @@ pub fn traverse(cfg: &TraverseConfig, scene: &Scene) -> Result<TraverseReport, S
     })
 }
 
+/// Counters of [`TraverseRow`] in field order from `rays` to `box_tests_skipped`.
+const COUNTERS: usize = 13;
+
 fn one_format<F: Format>(
     f: F,
     sc: SlabConfig,
     b: &SceneBvh,
     hw: &HwTree<u32>,
     tree: &Tree,
-    rays: &[Ray64],
-    n: usize,
+    gen: &CameraRays,
+    cfg: &TraverseConfig,
 ) -> Result<TraverseRow, String> {
     let s = Slab::new(f, sc);
     let boxes: Vec<_> =
         b.nodes.iter().map(|nd| s.store_box(nd.min, nd.max)).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
-    let mut row = TraverseRow {
+    let n = cfg.n;
+    let progress = engine::Progress::new(cfg.rays as u64, "rays", !cfg.progress);
+    progress.message(f.name());
+    let acc = engine::run(
+        &cfg.engine,
+        cfg.rays as u64,
+        &progress,
+        || (),
+        |_, range| {
+            let mut c = engine::Counts::<COUNTERS>::default();
+            for k in range {
+                let ray = gen.ray(k);
+                let sr = s.prepare(ray.o, ray.d, ray.tmin, ray.tmax);
+                let test = |i: u32| {
+                    let o = s.test(&sr, &boxes[i as usize]);
+                    o.hit.then(|| f.to_f64(o.t_near))
+                };
+                let g = stack_traverse(tree, n, test);
+                let h = history_traverse(hw, n, |&i| test(i));
+                let skipped = if h.leaves.len() == n {
+                    history_traverse(hw, usize::MAX, |&i| test(i)).box_tests - h.box_tests
+                } else {
+                    0
+                };
+                let t = trail_traverse(hw, n, |&i| test(i));
+                let with_leaves = !g.leaves.is_empty();
+                let add = [
+                    1,
+                    (h.leaves != g.leaves) as u64,
+                    (t.leaves != g.leaves) as u64,
+                    g.leaves.len() as u64,
+                    with_leaves as u64,
+                    (with_leaves && h.passes == 1) as u64,
+                    g.box_tests,
+                    h.box_tests,
+                    t.box_tests,
+                    h.passes.saturating_sub(1),
+                    h.back_distances.iter().filter(|&&d| d <= 8).count() as u64,
+                    h.back_distances.len() as u64,
+                    skipped,
+                ];
+                for (a, b) in c.0.iter_mut().zip(add) {
+                    *a += b;
+                }
+            }
+            c
+        },
+    );
+    progress.finish();
+    let [rays, history_mismatches, trail_mismatches, leaves, rays_with_leaves, rays_without_restart, stack_box_tests, history_box_tests, trail_box_tests, restarts, back_within_8, back_total, box_tests_skipped] =
+        acc.0;
+    Ok(TraverseRow {
         format: f.name(),
-        rays: 0,
-        history_mismatches: 0,
-        trail_mismatches: 0,
-        leaves: 0,
-        rays_with_leaves: 0,
-        rays_without_restart: 0,
-        stack_box_tests: 0,
-        history_box_tests: 0,
-        trail_box_tests: 0,
-        restarts: 0,
-        back_within_8: 0,
-        back_total: 0,
-        box_tests_skipped: 0,
-    };
-    for ray in rays {
-        let sr = s.prepare(ray.o, ray.d, ray.tmin, ray.tmax);
-        let test = |i: u32| {
-            let o = s.test(&sr, &boxes[i as usize]);
-            o.hit.then(|| f.to_f64(o.t_near))
-        };
-        let g = stack_traverse(tree, n, test);
-        let h = history_traverse(hw, n, |&i| test(i));
-        if h.leaves.len() == n {
-            row.box_tests_skipped += history_traverse(hw, usize::MAX, |&i| test(i)).box_tests - h.box_tests;
-        }
-        let t = trail_traverse(hw, n, |&i| test(i));
-        row.rays += 1;
-        row.history_mismatches += (h.leaves != g.leaves) as u64;
-        row.trail_mismatches += (t.leaves != g.leaves) as u64;
-        row.leaves += g.leaves.len() as u64;
-        if !g.leaves.is_empty() {
-            row.rays_with_leaves += 1;
-            row.rays_without_restart += (h.passes == 1) as u64;
-        }
-        row.stack_box_tests += g.box_tests;
-        row.history_box_tests += h.box_tests;
-        row.trail_box_tests += t.box_tests;
-        row.restarts += h.passes.saturating_sub(1);
-        row.back_total += h.back_distances.len() as u64;
-        row.back_within_8 += h.back_distances.iter().filter(|&&d| d <= 8).count() as u64;
-    }
-    Ok(row)
+        rays,
+        history_mismatches,
+        trail_mismatches,
+        leaves,
+        rays_with_leaves,
+        rays_without_restart,
+        stack_box_tests,
+        history_box_tests,
+        trail_box_tests,
+        restarts,
+        back_within_8,
+        back_total,
+        box_tests_skipped,
+    })
 }
 
 /// The report as text.

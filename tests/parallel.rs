@@ -168,12 +168,38 @@ fn the_streaming_engine_equals_the_scalar_judge() {
 }
 
 #[test]
-fn stats_are_the_same_on_one_and_two_threads() {
+fn stats_and_traverse_do_not_depend_on_threads_or_chunks() {
     let scene = Scene::builtin();
-    let one = pool(1).install(|| raypipe::stats::stats(&scene, &[2, 8], 300, 4).unwrap());
-    let two = pool(2).install(|| raypipe::stats::stats(&scene, &[2, 8], 300, 4).unwrap());
-    assert_eq!(serde_json::to_string(&one).unwrap(), serde_json::to_string(&two).unwrap());
+    let on = |threads, chunk| {
+        raypipe::stats::stats_on(&engine::Engine { threads, chunk }, false, &scene, &[2, 8], 300, 4).unwrap()
+    };
+    let one = on(1, 1000);
+    for (t, c) in [(2, 256), (3, 7), (2, 1)] {
+        assert_eq!(serde_json::to_string(&one).unwrap(), serde_json::to_string(&on(t, c)).unwrap(), "{t} {c}");
+    }
     assert!(one.rows.iter().all(|r| r.rays_hit > 0));
+    let tr = |threads, chunk| {
+        raypipe::traverse::traverse(&traverse_cfg(200, 3, engine::Engine { threads, chunk }), &scene).unwrap()
+    };
+    let one = tr(1, 1000);
+    assert!(one.passed && one.rows.iter().all(|r| r.leaves > 0));
+    for (t, c) in [(2, 256), (3, 7), (2, 1)] {
+        assert_eq!(serde_json::to_string(&one).unwrap(), serde_json::to_string(&tr(t, c)).unwrap(), "{t} {c}");
+    }
+}
+
+fn traverse_cfg(n: usize, seed: u64, engine: engine::Engine) -> raypipe::traverse::TraverseConfig {
+    raypipe::traverse::TraverseConfig {
+        formats: ["f32", "fp16", "q8.24:divide"].iter().map(|f| f.parse().unwrap()).collect(),
+        variant: "plain".into(),
+        rays: 200,
+        seed,
+        n,
+        leaf_size: 4,
+        levels: 64,
+        engine,
+        progress: false,
+    }
 }
 
 #[test]
@@ -184,20 +210,7 @@ fn skipped_work_is_counted() {
     assert!(f.divide_skipped > 0 && f.divide_skipped <= f.tests - f.model_hits, "{f:?}");
     // traversal: stopping at N = 1 skips box tests; an N no ray reaches skips none
     let t = |n: usize| {
-        raypipe::traverse::traverse(
-            &raypipe::traverse::TraverseConfig {
-                formats: vec!["f32".parse().unwrap()],
-                variant: "plain".into(),
-                rays: 200,
-                seed: 3,
-                n,
-                leaf_size: 4,
-                levels: 64,
-            },
-            &scene,
-        )
-        .unwrap()
-        .rows[0]
+        raypipe::traverse::traverse(&traverse_cfg(n, 3, engine::Engine::new(256)), &scene).unwrap().rows[0]
             .box_tests_skipped
     };
     assert!(t(1) > 0);

@@ -153,6 +153,62 @@ impl Merge for Hist {
     }
 }
 
+/// A set of small indices as a bitmap, merged by union.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Bits(Vec<u64>);
+
+impl Bits {
+    /// Adds index `i`.
+    pub fn insert(&mut self, i: usize) {
+        let w = i / 64;
+        if w >= self.0.len() {
+            self.0.resize(w + 1, 0);
+        }
+        self.0[w] |= 1 << (i % 64);
+    }
+    /// Indices in the set.
+    pub fn count(&self) -> u64 {
+        self.0.iter().map(|w| w.count_ones() as u64).sum()
+    }
+}
+
+impl Merge for Bits {
+    fn merge(&mut self, other: Self) {
+        if other.0.len() > self.0.len() {
+            self.0.resize(other.0.len(), 0);
+        }
+        for (a, b) in self.0.iter_mut().zip(other.0) {
+            *a |= b;
+        }
+    }
+}
+
+/// Integer counters of a length known only at run time (e.g. one per tree level), merged by
+/// element-wise addition; a shorter operand counts as zeros.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Tally(pub Vec<u64>);
+
+impl Tally {
+    /// Adds `n` at index `i`.
+    pub fn add(&mut self, i: usize, n: u64) {
+        if i >= self.0.len() {
+            self.0.resize(i + 1, 0);
+        }
+        self.0[i] += n;
+    }
+}
+
+impl Merge for Tally {
+    fn merge(&mut self, other: Self) {
+        if other.0.len() > self.0.len() {
+            self.0.resize(other.0.len(), 0);
+        }
+        for (a, b) in self.0.iter_mut().zip(other.0) {
+            *a += b;
+        }
+    }
+}
+
 impl<T: Merge> Merge for Vec<T> {
     /// Element-wise; an empty vector is the identity.
     fn merge(&mut self, other: Self) {
@@ -222,6 +278,29 @@ mod tests {
     }
 
     proptest! {
+        #[test]
+        fn sets_and_tallies_merge_to_one_pass(xs in prop::collection::vec(0usize..500, 0..100), cut in 0usize..100) {
+            let cut = cut.min(xs.len());
+            let make = |v: &[usize]| {
+                let (mut b, mut t) = (Bits::default(), Tally::default());
+                v.iter().for_each(|&i| { b.insert(i); t.add(i % 37, 1); });
+                (b, t)
+            };
+            let one = make(&xs);
+            let (mut a, b) = (make(&xs[..cut]), make(&xs[cut..]));
+            a.merge(b);
+            prop_assert_eq!(a.0.count(), one.0.count());
+            prop_assert_eq!(&a.1 .0.iter().sum::<u64>(), &(xs.len() as u64));
+            let mut distinct = xs.clone();
+            distinct.sort();
+            distinct.dedup();
+            prop_assert_eq!(one.0.count(), distinct.len() as u64);
+            // the trailing-zero shape may differ; the counts per index may not
+            for i in 0..37 {
+                prop_assert_eq!(a.1 .0.get(i).copied().unwrap_or(0), one.1 .0.get(i).copied().unwrap_or(0));
+            }
+        }
+
         #[test]
         fn merging_in_any_split_equals_one_pass(xs in prop::collection::vec(0.0f64..1e6, 0..200), cut in 0usize..200, key in 0u64..300) {
             let cut = cut.min(xs.len());

@@ -27,6 +27,6 @@ pub mod acc;
 pub mod progress;
 pub mod run;
 
-pub use acc::{Counts, First, Hist, Merge};
+pub use acc::{Bits, Counts, First, Hist, Merge, Tally};
 pub use progress::Progress;
 pub use run::{run, Engine};
