@@ -370,6 +370,8 @@ enum Cmd {
         /// Print the results as JSON.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        run: EngineArgs,
     },
     /// Print the RTI stage table (markdown).
     Stages {
@@ -738,8 +740,10 @@ fn run() -> Result<Outcome, String> {
             emit(json, &rep, raypipe::speed::render)?;
             Ok(Outcome::Pass)
         }
-        Some(Cmd::Stress { format, variant, count, seed, json }) => {
-            let cfg = raypipe::stress::StressConfig { formats: format, variants: variant, count: count as usize, seed };
+        Some(Cmd::Stress { format, variant, count, seed, json, run }) => {
+            let mut cfg = raypipe::stress::StressConfig::new(format, variant, count as usize, seed);
+            cfg.engine = run.engine(raypipe::stress::CHUNK_CASES);
+            cfg.progress = !run.quiet;
             let rep = raypipe::stress::stress(&cfg)?;
             emit(json, &rep, raypipe::stress::render)?;
             Ok(Outcome::from(rep.passed))

@@ -150,12 +150,7 @@ pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
     if scenes.is_empty() || cfg.rays == 0 {
         return Err("report needs at least one scene and one ray".into());
     }
-    let st = stress(&StressConfig {
-        formats: cfg.formats.clone(),
-        variants: cfg.variants.clone(),
-        count: cfg.stress_count.max(1),
-        seed: cfg.seed,
-    })?;
+    let st = stress(&StressConfig::new(cfg.formats.clone(), cfg.variants.clone(), cfg.stress_count.max(1), cfg.seed))?;
     let vcfg = VerifyConfig::new(cfg.formats.clone(), cfg.rays, cfg.seed, RtiConfig::default(), 512);
     let mut points = Vec::new();
     for f in &cfg.formats {

@@ -24,8 +24,22 @@ pub struct StressConfig {
     pub variants: Vec<String>,
     /// Cases per class.
     pub count: usize,
-    /// Seed (each class draws from its own stream derived from it).
+    /// Seed (case i of a class draws from its own stream derived from it).
     pub seed: u64,
+    /// Threads and cases per chunk (the results do not depend on either).
+    pub engine: engine::Engine,
+    /// Show progress on stderr (when it is a terminal and the run lasts over a second).
+    pub progress: bool,
+}
+
+/// Cases per chunk of `stress` on the engine.
+pub const CHUNK_CASES: u64 = 16;
+
+impl StressConfig {
+    /// A configuration on every core, the default chunk, no progress output.
+    pub fn new(formats: Vec<AnyFormat>, variants: Vec<String>, count: usize, seed: u64) -> Self {
+        StressConfig { formats, variants, count, seed, engine: engine::Engine::new(CHUNK_CASES), progress: false }
+    }
 }
 
 /// RTI stress classes.
@@ -262,12 +276,52 @@ fn rti_case(class: usize, r: &mut SplitMix64, sphere: &[Tri64], min_normal: f64,
     }
 }
 
-fn class_rng(seed: u64, unit: u64, class: usize) -> SplitMix64 {
-    SplitMix64::new(SplitMix64::new(seed ^ (unit << 32) ^ class as u64).next_u64())
+/// Stream number of the stress cases in [`SplitMix64::for_item`].
+pub const STRESS_STREAM: u64 = 0x7374_7273; // "strs"
+
+/// The generator of case `i` of `class` in `unit` (1: RTI, 2: slab):
+/// `SplitMix64::for_item(seed ^ (unit << 32) ^ class, STRESS_STREAM, i)`, so any case can be
+/// made without the cases before it.
+pub fn case_rng(seed: u64, unit: u64, class: usize, i: u64) -> SplitMix64 {
+    SplitMix64::for_item(seed ^ (unit << 32) ^ class as u64, STRESS_STREAM, i)
+}
+
+/// Runs `classes × count` cases on the engine: item j is case `j mod count` of class
+/// `j / count`; `case(class, rng, counters)` adds one case's counts.
+fn run_classes<const N: usize>(
+    cfg: &StressConfig,
+    unit: u64,
+    classes: usize,
+    what: String,
+    case: impl Fn(usize, &mut SplitMix64, &mut [u64; N]) + Sync + Send,
+) -> Vec<[u64; N]> {
+    let count = cfg.count as u64;
+    let items = classes as u64 * count;
+    let progress = engine::Progress::new(items, "cases", !cfg.progress);
+    progress.message(what);
+    let acc: Vec<engine::Counts<N>> = engine::run(
+        &cfg.engine,
+        items,
+        &progress,
+        || (),
+        |_, range| {
+            let mut acc = vec![engine::Counts::<N>::default(); classes];
+            for j in range {
+                let class = (j / count) as usize;
+                let mut r = case_rng(cfg.seed, unit, class, j % count);
+                case(class, &mut r, &mut acc[class].0);
+            }
+            acc
+        },
+    );
+    progress.finish();
+    if acc.is_empty() {
+        return vec![[0; N]; classes];
+    }
+    acc.into_iter().map(|c| c.0).collect()
 }
 
 fn rti_rows<F: Format>(f: F, cfg: &StressConfig) -> Vec<RtiStressRow> {
-    use rayon::prelude::*;
     let rti = Rti::new(f, RtiConfig::default());
     let sphere = icosphere([0.0; 3], 1.0, 2);
     let em = f.error_model();
@@ -276,45 +330,43 @@ fn rti_rows<F: Format>(f: F, cfg: &StressConfig) -> Vec<RtiStressRow> {
         datapath::format::FormatKind::Fixed { .. } => em.eta,
     };
     let q = |x: f64| f.to_f64(f.from_f64(x));
-    (0..RTI_STRESS.len())
-        .into_par_iter()
-        .map(|class| {
-            let mut r = class_rng(cfg.seed, 1, class);
-            let mut row = RtiStressRow {
-                class: RTI_STRESS[class].0.into(),
-                format: f.name(),
-                tests: 0,
-                undecided: 0,
-                false_misses: 0,
-                false_hits: 0,
-                undecided_hits: 0,
-                cracks: 0,
-            };
-            for _ in 0..cfg.count {
-                let c = rti_case(class, &mut r, &sphere, min_normal, em.max);
-                let mray = rti.ray(c.ray.o, c.ray.d, c.ray.tmin, c.ray.tmax);
-                let qray = Ray64 { o: c.ray.o.map(q), d: c.ray.d.map(q), tmin: q(c.ray.tmin), tmax: q(c.ray.tmax) };
-                let (mut exact_any, mut model_any) = (false, false);
-                for t in &c.tris {
-                    let hit = rti.test(&mray, &rti.tri(t.v)).hit;
-                    let qt = Tri64 { v: t.v.map(|p| p.map(q)) };
-                    row.tests += 1;
-                    model_any |= hit;
-                    match golden::intersect_exact(&qray, &qt, Faces::default()) {
-                        None => {
-                            row.undecided += 1;
-                            row.undecided_hits += hit as u64;
-                        }
-                        Some(e) => {
-                            exact_any |= e;
-                            row.false_misses += (e && !hit) as u64;
-                            row.false_hits += (!e && hit) as u64;
-                        }
-                    }
+    // tests, undecided, false misses, false hits, undecided hits, cracks
+    let counts = run_classes::<6>(cfg, 1, RTI_STRESS.len(), format!("rti {}", f.name()), |class, r, c| {
+        let case = rti_case(class, r, &sphere, min_normal, em.max);
+        let mray = rti.ray(case.ray.o, case.ray.d, case.ray.tmin, case.ray.tmax);
+        let qray = Ray64 { o: case.ray.o.map(q), d: case.ray.d.map(q), tmin: q(case.ray.tmin), tmax: q(case.ray.tmax) };
+        let (mut exact_any, mut model_any) = (false, false);
+        for t in &case.tris {
+            let hit = rti.test(&mray, &rti.tri(t.v)).hit;
+            let qt = Tri64 { v: t.v.map(|p| p.map(q)) };
+            c[0] += 1;
+            model_any |= hit;
+            match golden::intersect_exact(&qray, &qt, Faces::default()) {
+                None => {
+                    c[1] += 1;
+                    c[4] += hit as u64;
                 }
-                row.cracks += (c.mesh && exact_any && !model_any) as u64;
+                Some(e) => {
+                    exact_any |= e;
+                    c[2] += (e && !hit) as u64;
+                    c[3] += (!e && hit) as u64;
+                }
             }
-            row
+        }
+        c[5] += (case.mesh && exact_any && !model_any) as u64;
+    });
+    counts
+        .into_iter()
+        .enumerate()
+        .map(|(class, c)| RtiStressRow {
+            class: RTI_STRESS[class].0.into(),
+            format: f.name(),
+            tests: c[0],
+            undecided: c[1],
+            false_misses: c[2],
+            false_hits: c[3],
+            undecided_hits: c[4],
+            cracks: c[5],
         })
         .collect()
 }
@@ -501,55 +553,53 @@ fn slab_edge_case(class: usize, r: &mut SplitMix64, e: Edges) -> ([f64; 8], [f64
 }
 
 fn slab_rows<F: Format>(f: F, sc: SlabConfig, variant: &str, cfg: &StressConfig) -> Vec<SlabStressRow> {
-    use rayon::prelude::*;
     let s = Slab::new(f, sc);
     let edges = datapath::format::edges(&f);
     let q = |x: f64| f.to_f64(f.from_f64(x));
-    (0..SLAB_STRESS.len())
-        .into_par_iter()
-        .map(|class| {
-            let mut r = class_rng(cfg.seed, 2, class);
-            let mut row = SlabStressRow {
-                class: SLAB_STRESS[class].0.into(),
-                format: f.name(),
-                variant: variant.into(),
-                conservative: sc.is_conservative(&f),
-                tests: 0,
-                undecided: 0,
-                unstorable: 0,
-                exact_hits: 0,
-                false_misses: 0,
-                false_hits: 0,
-                undecided_hits: 0,
-            };
-            for _ in 0..cfg.count {
-                let (x, lo, hi) = slab_case(class, &mut r, edges);
-                // the box corners as the format holds them, so that a point on a face (origin
-                // or aim) stays on it after quantisation; store_box keeps them exactly
-                let (lo, hi) = (lo.map(q), hi.map(q));
-                let Ok(b) = s.store_box(lo, hi) else {
-                    row.unstorable += 1;
-                    continue;
-                };
-                let sr = s.prepare([x[0], x[1], x[2]], [x[3], x[4], x[5]], x[6], x[7]);
-                let hit = s.test(&sr, &b).hit;
-                row.tests += 1;
-                let (oq, dq) = ([q(x[0]), q(x[1]), q(x[2])], [q(x[3]), q(x[4]), q(x[5])]);
-                if oq.iter().chain(&dq).any(|v| !v.is_finite()) {
-                    row.undecided += 1;
-                    row.undecided_hits += hit as u64;
-                    continue;
-                }
-                let Some(e) = golden::slab_exact(oq, dq, q(x[6]), q(x[7]), lo, hi) else {
-                    row.undecided += 1;
-                    row.undecided_hits += hit as u64;
-                    continue;
-                };
-                row.exact_hits += e as u64;
-                row.false_misses += (e && !hit) as u64;
-                row.false_hits += (!e && hit) as u64;
-            }
-            row
+    // tests, undecided, unstorable, exact hits, false misses, false hits, undecided hits
+    let what = format!("slab {} {variant}", f.name());
+    let counts = run_classes::<7>(cfg, 2, SLAB_STRESS.len(), what, |class, r, c| {
+        let (x, lo, hi) = slab_case(class, r, edges);
+        // the box corners as the format holds them, so that a point on a face (origin or aim)
+        // stays on it after quantisation; store_box keeps them exactly
+        let (lo, hi) = (lo.map(q), hi.map(q));
+        let Ok(b) = s.store_box(lo, hi) else {
+            c[2] += 1;
+            return;
+        };
+        let sr = s.prepare([x[0], x[1], x[2]], [x[3], x[4], x[5]], x[6], x[7]);
+        let hit = s.test(&sr, &b).hit;
+        c[0] += 1;
+        let (oq, dq) = ([q(x[0]), q(x[1]), q(x[2])], [q(x[3]), q(x[4]), q(x[5])]);
+        let exact = if oq.iter().chain(&dq).any(|v| !v.is_finite()) {
+            None
+        } else {
+            golden::slab_exact(oq, dq, q(x[6]), q(x[7]), lo, hi)
+        };
+        let Some(e) = exact else {
+            c[1] += 1;
+            c[6] += hit as u64;
+            return;
+        };
+        c[3] += e as u64;
+        c[4] += (e && !hit) as u64;
+        c[5] += (!e && hit) as u64;
+    });
+    counts
+        .into_iter()
+        .enumerate()
+        .map(|(class, c)| SlabStressRow {
+            class: SLAB_STRESS[class].0.into(),
+            format: f.name(),
+            variant: variant.into(),
+            conservative: sc.is_conservative(&f),
+            tests: c[0],
+            undecided: c[1],
+            unstorable: c[2],
+            exact_hits: c[3],
+            false_misses: c[4],
+            false_hits: c[5],
+            undecided_hits: c[6],
         })
         .collect()
 }

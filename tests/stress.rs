@@ -5,12 +5,12 @@
 use raypipe::stress::{stress, StressConfig, RTI_STRESS, SLAB_STRESS};
 
 fn cfg(formats: &[&str], variants: &[&str], count: usize) -> StressConfig {
-    StressConfig {
-        formats: formats.iter().map(|f| f.parse().unwrap()).collect(),
-        variants: variants.iter().map(|v| v.to_string()).collect(),
+    StressConfig::new(
+        formats.iter().map(|f| f.parse().unwrap()).collect(),
+        variants.iter().map(|v| v.to_string()).collect(),
         count,
-        seed: 9,
-    }
+        9,
+    )
 }
 
 /// Every format the issue names, in every variant that promises conservativeness, across every
@@ -95,9 +95,11 @@ fn rti_classes_count_failures_cracks_and_undecided_inputs() {
 #[test]
 fn the_suite_is_deterministic_and_thread_independent() {
     let c = cfg(&["fp16"], &["plain"], 20);
-    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(|| stress(&c).unwrap());
-    let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap().install(|| stress(&c).unwrap());
-    assert_eq!(serde_json::to_string(&one).unwrap(), serde_json::to_string(&two).unwrap());
+    let on = |threads, chunk| stress(&StressConfig { engine: engine::Engine { threads, chunk }, ..c.clone() }).unwrap();
+    let one = on(1, 1 << 20);
+    for (t, ch) in [(2, 64), (3, 7), (2, 1)] {
+        assert_eq!(serde_json::to_string(&one).unwrap(), serde_json::to_string(&on(t, ch)).unwrap(), "{t} {ch}");
+    }
     let other = stress(&StressConfig { seed: 10, ..c.clone() }).unwrap();
     assert_ne!(serde_json::to_string(&one).unwrap(), serde_json::to_string(&other).unwrap());
     assert!(stress(&StressConfig { count: 0, ..c }).unwrap_err().contains("--count"));

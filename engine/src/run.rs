@@ -42,9 +42,13 @@ pub fn run<S, A: Merge>(
     let chunk = engine.chunk.max(1);
     let chunks = items.div_ceil(chunk);
     let body = || {
-        (0..chunks)
+        // one task per chunk (rayon's adaptive splitting alone leaves a run of slow chunks on
+        // one thread)
+        (0..usize::try_from(chunks).expect("the chunk count fits in usize"))
             .into_par_iter()
+            .with_max_len(1)
             .map_init(&init, |s, c| {
+                let c = c as u64;
                 let r = c * chunk..((c + 1) * chunk).min(items);
                 let n = r.end - r.start;
                 let a = work(s, r);
