@@ -9,6 +9,7 @@ pub mod hdl;
 pub mod manifest;
 pub mod outdir;
 pub mod pack;
+mod rows;
 pub mod traverse;
 
 pub use pack::{pack, unpack, Bits};

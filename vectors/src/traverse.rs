@@ -7,8 +7,8 @@
 //! for a class only when its traversal shows the property (a tie between siblings, a leaf at
 //! the deepest level, three or more passes, the N limit reached, ...).
 
-use crate::gen::{is_float, Layout, Rows};
 use crate::manifest::Kind;
+use crate::rows::{is_float, Layout, Rows};
 use datapath::bvh::{hist, history_traverse, HwTree, Level, NodeDesc, StacklessResult, LEAF_FLAG};
 use datapath::rng::SplitMix64;
 use datapath::slab::{Aabb, Slab, SlabConfig};
@@ -279,7 +279,7 @@ pub(crate) fn generate<F: Format>(
     let root = &tree.nodes[tree.root as usize];
     let golden = golden_tree(&tree.nodes, tree.root);
     let w = f.width();
-    let k = crate::gen::kind_of(&f);
+    let k = crate::rows::kind_of(&f);
     let mut files = vec![
         Rows::new("traverse_rays.hex", "inputs: the ray stream", rays_layout),
         Rows::new("traverse_expected.hex", "expected outputs per ray", expected_layout(n, depth)),
@@ -301,7 +301,7 @@ pub(crate) fn generate<F: Format>(
     }
     let crosses = crosses(level);
     let float = is_float(&f);
-    let per_class = crate::gen::per_class_rows(seed, crosses.len(), count, |c, r| {
+    let per_class = crate::rows::per_class_rows(seed, crosses.len(), count, |c, r| {
         let (gen, keep) = crosses[c];
         if gen == 8 && !float {
             return Ok(None);
@@ -334,7 +334,7 @@ pub(crate) fn generate<F: Format>(
         }
         Ok(None) // the class is rare or impossible on this tree: its count says so
     })?;
-    let counts = crate::gen::push_rows(&mut files[..2], per_class);
+    let counts = crate::rows::push_rows(&mut files[..2], per_class);
     let mut params = BTreeMap::new();
     params.insert("leaves".into(), n as u64);
     params.insert("levels".into(), depth as u64);
@@ -347,7 +347,7 @@ pub(crate) fn generate<F: Format>(
     let mut options = BTreeMap::new();
     options.insert("scene".into(), tree.name.clone());
     options.insert("variant".into(), variant.to_string());
-    crate::gen::slab_options(&mut options, &sc);
+    crate::rows::slab_options(&mut options, &sc);
     options.insert(
         "traversal".into(),
         "2-bit ray history, restart from the root (raypipe README, section 'BVH traversal: the 2-bit ray history'); the right child is nearer only when its entry t_near is less than the left's (format compare), ties and NaN go left".into(),
