@@ -449,9 +449,14 @@ fn limit(what: &str, n: u64, max: u64, why: &str) -> Result<(), String> {
 /// is split into runs with different seeds.
 const MAX_RAYS: u64 = 100_000_000_000;
 
+/// Refuses more rays than one streamed run takes.
+fn check_rays(rays: u64) -> Result<(), String> {
+    limit("--rays", rays, MAX_RAYS, "a single streamed run; split a larger campaign into runs with different seeds")
+}
+
 /// Refuses a run this build cannot serve: too many rays, or a per-ray test list too long.
 fn check_tests(rays: u64, _scene: &Scene, sample: u64) -> Result<(), String> {
-    limit("--rays", rays, MAX_RAYS, "a single streamed run; split a larger campaign into runs with different seeds")?;
+    check_rays(rays)?;
     limit("--sample", sample, MAX_SAMPLE, "each worker holds one ray's test list")
 }
 
@@ -548,12 +553,7 @@ fn run() -> Result<Outcome, String> {
             Ok(Outcome::Pass)
         }
         Some(Cmd::Traverse { scene, format, variant, rays, seed, n, leaf_size, levels, json, run }) => {
-            limit(
-                "--rays",
-                rays,
-                MAX_RAYS,
-                "a single streamed run; split a larger campaign into runs with different seeds",
-            )?;
+            check_rays(rays)?;
             let scene = load_scene(scene.as_deref())?;
             let cfg = raypipe::traverse::TraverseConfig {
                 formats: format,
@@ -571,12 +571,7 @@ fn run() -> Result<Outcome, String> {
             Ok(Outcome::from(rep.passed))
         }
         Some(Cmd::Stats { scene, rays, seed, leaf_sizes, svg, json, run }) => {
-            limit(
-                "--rays",
-                rays,
-                MAX_RAYS,
-                "a single streamed run; split a larger campaign into runs with different seeds",
-            )?;
+            check_rays(rays)?;
             let out = svg.as_deref().map(|d| OutDir::check(d, &raypipe::stats::SVG_FILES)).transpose()?;
             let scene = load_scene(scene.as_deref())?;
             let eng = run.engine(raypipe::traverse::CHUNK_RAYS);

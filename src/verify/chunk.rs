@@ -118,6 +118,8 @@ struct Variant<F: Format> {
 struct Setup<'a, F: Format> {
     cfg: &'a VerifyConfig,
     scene: &'a Scene,
+    /// The ray generator (the scene's bounds, computed once).
+    gen: crate::scene::RayGen,
     rti: Rti<F>,
     with_rti: bool,
     mtris: Vec<Tri<F::V>>,
@@ -192,11 +194,10 @@ where
     fn chunk(&self, s: &mut Scratch<F::V>, rays: std::ops::Range<u64>) -> (RtiAcc, Vec<SlabAcc>) {
         let f = &self.rti.fmt;
         let q = |x: f64| f.to_f64(f.from_f64(x));
-        let gen = self.scene.ray_gen(self.cfg.seed);
         let mut acc = RtiAcc::default();
         let mut sacc: Vec<SlabAcc> = self.variants.iter().map(|_| SlabAcc::default()).collect();
         for i in rays {
-            let (ray, target) = gen.ray(self.scene, i);
+            let (ray, target) = self.gen.ray(self.scene, i);
             test_list(self.scene.tris.len(), self.cfg.sample, self.cfg.seed, i, target, &mut s.list);
             let rq = Ray64 { o: ray.o.map(q), d: ray.d.map(q), tmin: q(ray.tmin), tmax: q(ray.tmax) };
             let mray = self.rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
@@ -444,6 +445,7 @@ where
     let setup = Setup {
         cfg,
         scene,
+        gen: scene.ray_gen(cfg.seed),
         with_rti,
         mtris: if with_rti { scene.tris.iter().map(|t| rti.tri(t.v)).collect() } else { Vec::new() },
         qtris: if with_rti {
