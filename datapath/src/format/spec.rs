@@ -202,6 +202,14 @@ mod tests {
             "q8.24:floor+nearest",
             "bf16:canonical+propagate",
             "fp16:ftz+ftz",
+            // widths whose sum overflows u32 (found by the `format` fuzz target): a wrapped
+            // sum of 2..=64 must not be accepted as a format
+            "q4294967295.3",
+            "q4294967295.1",
+            "q1.4294967295",
+            "q4294967295.4294967295",
+            "e4294967295m3",
+            "e8m4294967295",
         ] {
             let e = n.parse::<AnyFormat>().unwrap_err();
             assert!(e.contains("format"), "{n}: {e}");
