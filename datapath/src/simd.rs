@@ -35,9 +35,11 @@
 //! The AVX-512F and AVX512-FP16 kernels are tested by the same property tests as the AVX2
 //! ones, on an emulated machine with both (`emu/avx512`, Bochs 3.0) when the host has neither.
 
-use crate::format::{DivMode, F16Half, F32Native, Ieee, NanMode, Subnormals};
+use crate::format::narrow::Narrow;
+use crate::format::{Bf16, DivMode, F16Half, F32Native, Ieee, IeeeBackend, NanMode, Soft, Subnormals};
 use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
 use crate::slab::{BoxesSoa, Slab, SlabNan, SlabOutSoa, SlabRay, SlabRaysSoa};
+use crate::Format as _;
 use half::f16;
 
 /// Which implementation ran (ordered: a cap of `Avx2` allows `Scalar` and `Avx2`).
@@ -226,6 +228,116 @@ pub fn rti_batch_f16(
     )
 }
 
+/// The binary64-lane constants of a float format, when its narrow batch path applies.
+fn narrow_of<B: IeeeBackend>(f: &Ieee<B>) -> Option<Narrow> {
+    Narrow::of(f.backend.layout(), f.opts)
+}
+
+/// The det threshold as the narrow kernels' lanes hold it (read-flushed under FTZ).
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+fn narrow_thr<B: IeeeBackend>(rti: &Rti<Ieee<B>>, n: &Narrow) -> f64 {
+    let t = rti.fmt.to_f64(rti.det_thr);
+    if n.ftz && t.abs() < n.min_normal {
+        0.0
+    } else {
+        t
+    }
+}
+
+/// The widest kernel of the narrow float formats (binary64 lanes: 4 on AVX2, 8 on AVX-512F).
+pub const WIDEST_NARROW: Kernel = Kernel::Avx512;
+
+/// The kernel `rti_batch_bf16` / `rti_batch_soft` use for this unit on this machine: the
+/// binary64-lane path for bf16 and `eEmM` with M ≤ 24, E ≤ 10 and the canonical NaN rule.
+pub fn kernel_narrow<B: IeeeBackend>(rti: &Rti<Ieee<B>>) -> Kernel {
+    best_kernel(narrow_of(&rti.fmt).is_some() && rti.fmt.to_f64(rti.det_thr) >= 0.0, WIDEST_NARROW)
+}
+
+/// [`Rti::batch`] for bf16 on the fastest kernel available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn rti_batch_bf16(
+    rti: &Rti<Ieee<Bf16>>,
+    rays: &RaysSoa<u16>,
+    tris: &TrisSoa<u16>,
+    out: &mut HitsSoa<u16>,
+) -> Kernel {
+    let which = kernel_narrow(rti);
+    rti_dispatch(
+        rti,
+        rays,
+        tris,
+        out,
+        which,
+        #[cfg(target_arch = "x86_64")]
+        (kernels::v4d::rti_bf16, kernels::v8d::rti_bf16, None),
+    )
+}
+
+/// [`Rti::batch`] for a custom `eEmM` layout on the fastest kernel available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn rti_batch_soft(
+    rti: &Rti<Ieee<Soft>>,
+    rays: &RaysSoa<u64>,
+    tris: &TrisSoa<u64>,
+    out: &mut HitsSoa<u64>,
+) -> Kernel {
+    let which = kernel_narrow(rti);
+    rti_dispatch(
+        rti,
+        rays,
+        tris,
+        out,
+        which,
+        #[cfg(target_arch = "x86_64")]
+        (kernels::v4d::rti_soft, kernels::v8d::rti_soft, None),
+    )
+}
+
+/// The kernel `op_batch_soft` uses for this format (the narrow path's eligibility).
+pub fn op_kernel_soft(f: &Ieee<Soft>) -> Kernel {
+    best_kernel(narrow_of(f).is_some(), WIDEST_NARROW)
+}
+
+/// One operation (`Add`, `Sub`, `Mul` or `Div` in the format's division mode) of an `eEmM`
+/// format on whole columns, `out[i] = a[i] op b[i]`, on the fastest kernel available: the
+/// format's own `add` … `div` bits (FTZ and NaN rules included).
+///
+/// # Panics
+/// If the slice lengths differ or `op` is `Logic`.
+pub fn op_batch_soft(f: &Ieee<Soft>, op: crate::rti::Op, a: &[u64], b: &[u64], out: &mut [u64]) -> Kernel {
+    use crate::rti::Op;
+    assert!(a.len() == b.len() && b.len() == out.len(), "batch lengths differ");
+    assert!(op != Op::Logic, "op_batch_soft computes arithmetic only");
+    let which = op_kernel_soft(f);
+    let lanes = match which {
+        Kernel::Scalar => usize::MAX,
+        Kernel::Avx2 => 4,
+        _ => 8,
+    };
+    let full = if lanes == usize::MAX { 0 } else { a.len() / lanes * lanes };
+    #[cfg(target_arch = "x86_64")]
+    match which {
+        // SAFETY: `which` names a kernel only after run-time feature detection; every slice
+        // holds the same n >= full slots (checked above).
+        Kernel::Avx2 => unsafe { kernels::v4d::op_soft(f, op, a, b, out, full) },
+        Kernel::Scalar => {}
+        _ => unsafe { kernels::v8d::op_soft(f, op, a, b, out, full) },
+    }
+    for i in full..a.len() {
+        out[i] = match op {
+            Op::Add => f.add(a[i], b[i]),
+            Op::Sub => f.sub(a[i], b[i]),
+            Op::Mul => f.mul(a[i], b[i]),
+            _ => f.div(a[i], b[i]),
+        };
+    }
+    which
+}
+
 /// The kernel `slab_batch_f32` / `slab_ray_f32` use for this unit on this machine (the
 /// round-to-nearest variants; the directed one runs the scalar model).
 pub fn slab_kernel_f32(s: &Slab<Ieee<F32Native>>) -> Kernel {
@@ -404,6 +516,17 @@ pub fn rti_batch<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
+    {
+        use std::any::Any;
+        let (unit, a, b) = (rti as &dyn Any, rays as &dyn Any, tris as &dyn Any);
+        let o = || "the output type follows the format";
+        if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
+            return rti_batch_bf16(unit, a, b, (out as &mut dyn Any).downcast_mut().expect(o()));
+        }
+        if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
+            return rti_batch_soft(unit, a, b, (out as &mut dyn Any).downcast_mut().expect(o()));
+        }
+    }
     by_format!(rti, rays, tris, out, rti_batch_f32, rti_batch_f16, rti.batch(rays, tris, out))
 }
 
@@ -912,6 +1035,394 @@ mod isa {
         let r = _mm512_add_epi16(b, step);
         let r = _mm512_mask_blend_epi16(zero, r, _mm512_set1_epi16(1));
         _mm512_mask_blend_epi16(keep, r, b)
+    }
+
+    /// AVX2, 4 binary64 lanes holding a narrow format's values exactly (see
+    /// [`crate::format::narrow`]); a mask is a vector of all-ones / all-zeros lanes.
+    #[allow(dead_code)] // max and min: no slab kernel runs on binary64 lanes
+    pub(super) mod v4d {
+        use crate::format::narrow::Narrow;
+        use std::arch::x86_64::*;
+        /// Lanes per vector.
+        pub const LANES: usize = 4;
+        /// A mask.
+        pub type M = __m256d;
+        table_ops!("avx2", __m256d, M, "binary64";
+            add = _mm256_add_pd, sub = _mm256_sub_pd, mul = _mm256_mul_pd, div = _mm256_div_pd,
+            max = _mm256_max_pd, min = _mm256_min_pd, cmp = _mm256_cmp_pd);
+        /// Every lane x.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn splat(x: f64) -> __m256d {
+            _mm256_set1_pd(x)
+        }
+        /// Every lane the integer x.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn int(x: u64) -> __m256i {
+            _mm256_set1_epi64x(x as i64)
+        }
+        /// A shift count for the `sll` / `srl` forms.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn count(n: u32) -> __m128i {
+            _mm_cvtsi64_si128(n as i64)
+        }
+        /// Every lane binary64's canonical NaN (stored as the format's canonical NaN).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn canonical_nan() -> __m256d {
+            _mm256_castsi256_pd(int(0x7ff8_0000_0000_0000))
+        }
+        /// Both masks.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn and_m(a: M, b: M) -> M {
+            _mm256_and_pd(a, b)
+        }
+        /// Either mask.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn or_m(a: M, b: M) -> M {
+            _mm256_or_pd(a, b)
+        }
+        /// The mask as lane bits (lane k in bit k).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn bits(m: M) -> u32 {
+            _mm256_movemask_pd(m) as u32
+        }
+        /// `m ? b : a` per lane.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn blend(a: __m256d, b: __m256d, m: M) -> __m256d {
+            _mm256_blendv_pd(a, b, m)
+        }
+        /// The sign bits of x (everything else cleared).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn sign(x: __m256d) -> __m256d {
+            _mm256_and_pd(x, _mm256_set1_pd(-0.0))
+        }
+        /// |x| by clearing the sign bit.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn abs(x: __m256d) -> __m256d {
+            _mm256_andnot_pd(_mm256_set1_pd(-0.0), x)
+        }
+        /// a ⊕ b, bitwise.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn xor(a: __m256d, b: __m256d) -> __m256d {
+            _mm256_xor_pd(a, b)
+        }
+        /// Writes the mask's lanes as bools 0 / 1 to `p[i..i + 4]`.
+        ///
+        /// # Safety
+        /// `p[i..i + 4]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn flags(p: *mut bool, i: usize, m: M) {
+            // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
+            unsafe { (p.add(i) as *mut u32).write_unaligned(super::SPREAD[bits(m) as usize] as u32) }
+        }
+        /// The target rounding of [`Narrow::round`] on every lane (steps 1–5 there).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn round(x: __m256d, n: &Narrow) -> __m256d {
+            let b = _mm256_castpd_si256(x);
+            let lsb = _mm256_and_si256(_mm256_srl_epi64(b, count(n.shift)), int(1));
+            let r = _mm256_and_si256(_mm256_add_epi64(_mm256_add_epi64(b, int(n.half)), lsb), int(n.keep));
+            let r = _mm256_castsi256_pd(r);
+            let (a, s) = (abs(x), sign(x));
+            let c = splat(n.magic);
+            let tiny = _mm256_or_pd(_mm256_sub_pd(_mm256_add_pd(a, c), c), s);
+            let r = blend(r, tiny, lt(a, splat(n.min_normal)));
+            let r = blend(r, _mm256_or_pd(splat(f64::INFINITY), s), lt(splat(n.max_finite), abs(r)));
+            let r = blend(r, x, unord(x, x));
+            flush(r, n)
+        }
+        /// Under FTZ, subnormal lanes become zeros of the same sign (operand read, result write).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn flush(x: __m256d, n: &Narrow) -> __m256d {
+            match n.ftz {
+                true => blend(x, sign(x), lt(abs(x), splat(n.min_normal))),
+                false => x,
+            }
+        }
+        /// Loads 4 bf16 encodings as binary64 (exact), read-flushed under FTZ.
+        ///
+        /// # Safety
+        /// `p[i..i + 4]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn load_bf16(p: *const u16, i: usize, n: &Narrow) -> __m256d {
+            let h = unsafe { _mm_loadl_epi64(p.add(i) as *const __m128i) };
+            flush(_mm256_cvtps_pd(_mm_castsi128_ps(_mm_slli_epi32::<16>(_mm_cvtepu16_epi32(h)))), n)
+        }
+        /// Stores 4 lanes holding bf16 values (or the canonical NaN) as bf16 encodings.
+        ///
+        /// # Safety
+        /// `p[i..i + 4]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn store_bf16(p: *mut u16, i: usize, x: __m256d) {
+            // exact: every lane is a bf16 value; binary64's canonical NaN narrows to 0x7fc0_0000
+            let w = _mm_srli_epi32::<16>(_mm_castps_si128(_mm256_cvtpd_ps(x)));
+            unsafe { _mm_storel_epi64(p.add(i) as *mut __m128i, _mm_packus_epi32(w, w)) }
+        }
+        /// Loads 4 `eEmM` encodings as binary64 (exact), read-flushed under FTZ.
+        ///
+        /// # Safety
+        /// `p[i..i + 4]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn load_soft(p: *const u64, i: usize, n: &Narrow) -> __m256d {
+            let (l, m) = (n.lay, n.lay.man_bits);
+            let b = unsafe { _mm256_loadu_si256(p.add(i) as *const __m256i) };
+            let emax = (1u64 << l.exp_bits) - 1;
+            let e = _mm256_and_si256(_mm256_srl_epi64(b, count(m)), int(emax));
+            let f = _mm256_and_si256(b, int((1u64 << m) - 1));
+            let s = _mm256_slli_epi64::<63>(_mm256_srl_epi64(b, count(l.width() - 1)));
+            let frac = _mm256_sll_epi64(f, count(52 - m));
+            let bexp = _mm256_sll_epi64(_mm256_add_epi64(e, int((1023 - l.bias()) as u64)), count(52));
+            let normal = _mm256_or_si256(_mm256_or_si256(s, bexp), frac);
+            let special = _mm256_or_si256(_mm256_or_si256(s, int(0x7ff0_0000_0000_0000)), frac);
+            // a subnormal: fraction × 2^(emin − M), the fraction converted exactly via 2^52
+            let two52 = splat(4503599627370496.0);
+            let fv = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(f, int(0x4330_0000_0000_0000))), two52);
+            let sub = _mm256_or_pd(_mm256_mul_pd(fv, splat(n.step)), _mm256_castsi256_pd(s));
+            let sub = if n.ftz { _mm256_castsi256_pd(s) } else { sub };
+            let r = blend(_mm256_castsi256_pd(normal), sub, _mm256_castsi256_pd(_mm256_cmpeq_epi64(e, int(0))));
+            blend(r, _mm256_castsi256_pd(special), _mm256_castsi256_pd(_mm256_cmpeq_epi64(e, int(emax))))
+        }
+        /// Stores 4 lanes holding `eEmM` values (or a NaN, stored as the canonical NaN) as
+        /// encodings.
+        ///
+        /// # Safety
+        /// `p[i..i + 4]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn store_soft(p: *mut u64, i: usize, x: __m256d, n: &Narrow) {
+            let (l, m) = (n.lay, n.lay.man_bits);
+            let b = _mm256_castpd_si256(x);
+            let s = _mm256_sll_epi64(_mm256_srli_epi64::<63>(b), count(l.width() - 1));
+            let a = abs(x);
+            let bexp = _mm256_srli_epi64::<52>(_mm256_castpd_si256(a));
+            let e = _mm256_sub_epi64(bexp, int((1023 - l.bias()) as u64));
+            let frac = _mm256_srl_epi64(_mm256_and_si256(b, int((1u64 << 52) - 1)), count(52 - m));
+            let normal = _mm256_or_si256(s, _mm256_or_si256(_mm256_sll_epi64(e, count(m)), frac));
+            // a subnormal: |x| / 2^(emin − M) is an integer < 2^52, read off 2^52 + it
+            let two52 = splat(4503599627370496.0);
+            let q = _mm256_castpd_si256(_mm256_add_pd(_mm256_mul_pd(a, splat(n.inv_step)), two52));
+            let sub = _mm256_or_si256(s, _mm256_and_si256(q, int((1u64 << 52) - 1)));
+            let inf = _mm256_or_si256(s, int(l.exp_mask()));
+            let r = blend(_mm256_castsi256_pd(normal), _mm256_castsi256_pd(sub), lt(a, splat(n.min_normal)));
+            let r = blend(r, _mm256_castsi256_pd(inf), _mm256_cmp_pd::<_CMP_EQ_OQ>(a, splat(f64::INFINITY)));
+            let r = blend(r, _mm256_castsi256_pd(int(l.canonical_nan())), unord(x, x));
+            unsafe { _mm256_storeu_si256(p.add(i) as *mut __m256i, _mm256_castpd_si256(r)) }
+        }
+    }
+
+    /// AVX-512F, 8 binary64 lanes holding a narrow format's values exactly; masks as `__mmask8`.
+    #[allow(dead_code)] // max and min: no slab kernel runs on binary64 lanes
+    pub(super) mod v8d {
+        use crate::format::narrow::Narrow;
+        use std::arch::x86_64::*;
+        /// Lanes per vector.
+        pub const LANES: usize = 8;
+        /// A mask.
+        pub type M = __mmask8;
+        table_ops!("avx512f", __m512d, M, "binary64";
+            add = _mm512_add_pd, sub = _mm512_sub_pd, mul = _mm512_mul_pd, div = _mm512_div_pd,
+            max = _mm512_max_pd, min = _mm512_min_pd, cmp = _mm512_cmp_pd_mask);
+        /// Every lane x.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn splat(x: f64) -> __m512d {
+            _mm512_set1_pd(x)
+        }
+        /// Every lane the integer x.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn int(x: u64) -> __m512i {
+            _mm512_set1_epi64(x as i64)
+        }
+        /// A shift count for the `sll` / `srl` forms.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn count(n: u32) -> __m128i {
+            _mm_cvtsi64_si128(n as i64)
+        }
+        /// The lanes as integers.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn ib(x: __m512d) -> __m512i {
+            _mm512_castpd_si512(x)
+        }
+        /// The integers as lanes.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn fb(x: __m512i) -> __m512d {
+            _mm512_castsi512_pd(x)
+        }
+        /// Every lane binary64's canonical NaN (stored as the format's canonical NaN).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn canonical_nan() -> __m512d {
+            fb(int(0x7ff8_0000_0000_0000))
+        }
+        /// Both masks.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn and_m(a: M, b: M) -> M {
+            a & b
+        }
+        /// Either mask.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn or_m(a: M, b: M) -> M {
+            a | b
+        }
+        /// The mask as lane bits (lane k in bit k).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn bits(m: M) -> u32 {
+            m as u32
+        }
+        /// `m ? b : a` per lane.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn blend(a: __m512d, b: __m512d, m: M) -> __m512d {
+            _mm512_mask_blend_pd(m, a, b)
+        }
+        /// The sign bits of x (everything else cleared).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn sign(x: __m512d) -> __m512d {
+            fb(_mm512_and_si512(ib(x), int(1 << 63)))
+        }
+        /// |x| by clearing the sign bit.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn abs(x: __m512d) -> __m512d {
+            fb(_mm512_and_si512(ib(x), int(!(1 << 63))))
+        }
+        /// a ⊕ b, bitwise.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn xor(a: __m512d, b: __m512d) -> __m512d {
+            fb(_mm512_xor_si512(ib(a), ib(b)))
+        }
+        /// Writes the mask's lanes as bools 0 / 1 to `p[i..i + 8]`.
+        ///
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn flags(p: *mut bool, i: usize, m: M) {
+            // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
+            unsafe { (p.add(i) as *mut u64).write_unaligned(super::SPREAD[m as usize]) }
+        }
+        /// The target rounding of [`Narrow::round`] on every lane (steps 1–5 there).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn round(x: __m512d, n: &Narrow) -> __m512d {
+            let b = ib(x);
+            let lsb = _mm512_and_si512(_mm512_srl_epi64(b, count(n.shift)), int(1));
+            let r = fb(_mm512_and_si512(_mm512_add_epi64(_mm512_add_epi64(b, int(n.half)), lsb), int(n.keep)));
+            let (a, s) = (abs(x), sign(x));
+            let c = splat(n.magic);
+            let tiny = fb(_mm512_or_si512(ib(_mm512_sub_pd(_mm512_add_pd(a, c), c)), ib(s)));
+            let r = blend(r, tiny, lt(a, splat(n.min_normal)));
+            let r = blend(r, fb(_mm512_or_si512(int(0x7ff0_0000_0000_0000), ib(s))), lt(splat(n.max_finite), abs(r)));
+            let r = blend(r, x, unord(x, x));
+            flush(r, n)
+        }
+        /// Under FTZ, subnormal lanes become zeros of the same sign (operand read, result write).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn flush(x: __m512d, n: &Narrow) -> __m512d {
+            match n.ftz {
+                true => blend(x, sign(x), lt(abs(x), splat(n.min_normal))),
+                false => x,
+            }
+        }
+        /// Loads 8 bf16 encodings as binary64 (exact), read-flushed under FTZ.
+        ///
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f,avx2")]
+        pub unsafe fn load_bf16(p: *const u16, i: usize, n: &Narrow) -> __m512d {
+            let h = unsafe { _mm_loadu_si128(p.add(i) as *const __m128i) };
+            flush(_mm512_cvtps_pd(_mm256_castsi256_ps(_mm256_slli_epi32::<16>(_mm256_cvtepu16_epi32(h)))), n)
+        }
+        /// Stores 8 lanes holding bf16 values (or the canonical NaN) as bf16 encodings.
+        ///
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f,avx2")]
+        pub unsafe fn store_bf16(p: *mut u16, i: usize, x: __m512d) {
+            // exact: every lane is a bf16 value; binary64's canonical NaN narrows to 0x7fc0_0000
+            let w = _mm256_srli_epi32::<16>(_mm256_castps_si256(_mm512_cvtpd_ps(x)));
+            // packing works per 128-bit half: take quadwords 0 and 2
+            let packed = _mm256_permute4x64_epi64::<0b1000>(_mm256_packus_epi32(w, w));
+            unsafe { _mm_storeu_si128(p.add(i) as *mut __m128i, _mm256_castsi256_si128(packed)) }
+        }
+        /// Loads 8 `eEmM` encodings as binary64 (exact), read-flushed under FTZ.
+        ///
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn load_soft(p: *const u64, i: usize, n: &Narrow) -> __m512d {
+            let (l, m) = (n.lay, n.lay.man_bits);
+            let b = unsafe { _mm512_loadu_si512(p.add(i) as *const __m512i) };
+            let emax = (1u64 << l.exp_bits) - 1;
+            let e = _mm512_and_si512(_mm512_srl_epi64(b, count(m)), int(emax));
+            let f = _mm512_and_si512(b, int((1u64 << m) - 1));
+            let s = _mm512_slli_epi64::<63>(_mm512_srl_epi64(b, count(l.width() - 1)));
+            let frac = _mm512_sll_epi64(f, count(52 - m));
+            let bexp = _mm512_sll_epi64(_mm512_add_epi64(e, int((1023 - l.bias()) as u64)), count(52));
+            let normal = fb(_mm512_or_si512(_mm512_or_si512(s, bexp), frac));
+            let special = fb(_mm512_or_si512(_mm512_or_si512(s, int(0x7ff0_0000_0000_0000)), frac));
+            // a subnormal: fraction × 2^(emin − M), the fraction converted exactly via 2^52
+            let two52 = splat(4503599627370496.0);
+            let fv = _mm512_sub_pd(fb(_mm512_or_si512(f, int(0x4330_0000_0000_0000))), two52);
+            let sub = fb(_mm512_or_si512(ib(_mm512_mul_pd(fv, splat(n.step))), s));
+            let sub = if n.ftz { fb(s) } else { sub };
+            let r = blend(normal, sub, _mm512_cmpeq_epi64_mask(e, int(0)));
+            blend(r, special, _mm512_cmpeq_epi64_mask(e, int(emax)))
+        }
+        /// Stores 8 lanes holding `eEmM` values (or a NaN, stored as the canonical NaN) as
+        /// encodings.
+        ///
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn store_soft(p: *mut u64, i: usize, x: __m512d, n: &Narrow) {
+            let (l, m) = (n.lay, n.lay.man_bits);
+            let b = ib(x);
+            let s = _mm512_sll_epi64(_mm512_srli_epi64::<63>(b), count(l.width() - 1));
+            let a = abs(x);
+            let bexp = _mm512_srli_epi64::<52>(ib(a));
+            let e = _mm512_sub_epi64(bexp, int((1023 - l.bias()) as u64));
+            let frac = _mm512_srl_epi64(_mm512_and_si512(b, int((1u64 << 52) - 1)), count(52 - m));
+            let normal = fb(_mm512_or_si512(s, _mm512_or_si512(_mm512_sll_epi64(e, count(m)), frac)));
+            // a subnormal: |x| / 2^(emin − M) is an integer < 2^52, read off 2^52 + it
+            let two52 = splat(4503599627370496.0);
+            let q = ib(_mm512_add_pd(_mm512_mul_pd(a, splat(n.inv_step)), two52));
+            let sub = fb(_mm512_or_si512(s, _mm512_and_si512(q, int((1u64 << 52) - 1))));
+            let inf = fb(_mm512_or_si512(s, int(l.exp_mask())));
+            let r = blend(normal, sub, lt(a, splat(n.min_normal)));
+            let r = blend(r, inf, _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(a, splat(f64::INFINITY)));
+            let r = blend(r, fb(int(l.canonical_nan())), unord(x, x));
+            unsafe { _mm512_storeu_si512(p.add(i) as *mut __m512i, ib(r)) }
+        }
     }
 
     /// AVX512-FP16: 32 binary16 lanes computed natively (`vaddph` … `vdivph`, each correctly
@@ -1540,4 +2051,95 @@ mod kernels {
     kernels_for!(v8, "avx2", "avx2,f16c");
     kernels_for!(v16, "avx512f", "avx512f,avx2");
     kernels_for!(v32h, binary16 "avx512fp16,avx512bw,avx512f");
+
+    /// The RTI kernels of the narrow float formats (bf16, `eEmM` with M ≤ 24 and E ≤ 10) on
+    /// the binary64 lanes of one instruction set (`v4d`, `v8d`): the same stage table, every
+    /// operation in binary64 then rounded to the format ([`crate::format::narrow`]).
+    macro_rules! narrow_for {
+        ($x:ident, $feat:literal) => {
+            pub(in crate::simd) mod $x {
+                use super::super::isa::$x;
+                use super::*;
+                use crate::format::{Bf16, Soft};
+
+                /// The bf16 RTI kernel on lanes `0..full`.
+                #[target_feature(enable = $feat)]
+                pub fn rti_bf16(
+                    rti: &Rti<Ieee<Bf16>>,
+                    rays: &RaysSoa<u16>,
+                    tris: &TrisSoa<u16>,
+                    out: &mut HitsSoa<u16>,
+                    full: usize,
+                ) {
+                    let n = &super::super::narrow_of(&rti.fmt).expect("the dispatch checked the format");
+                    // SAFETY (loads and stores): the caller checked that every column holds
+                    // `full` lanes; the column types are plain values.
+                    rti_kernel!(
+                        $x,
+                        rti,
+                        rays,
+                        tris,
+                        out,
+                        full,
+                        |c: &Vec<u16>, i: usize| unsafe { $x::load_bf16(c.as_ptr(), i, n) },
+                        |x| $x::round(x, n),
+                        |c: &mut Vec<u16>, i: usize, x| unsafe { $x::store_bf16(c.as_mut_ptr(), i, x) },
+                        super::super::narrow_thr(rti, n)
+                    );
+                }
+
+                /// The `eEmM` RTI kernel on lanes `0..full`.
+                #[target_feature(enable = $feat)]
+                pub fn rti_soft(
+                    rti: &Rti<Ieee<Soft>>,
+                    rays: &RaysSoa<u64>,
+                    tris: &TrisSoa<u64>,
+                    out: &mut HitsSoa<u64>,
+                    full: usize,
+                ) {
+                    let n = &super::super::narrow_of(&rti.fmt).expect("the dispatch checked the format");
+                    // SAFETY (loads and stores): as above.
+                    rti_kernel!(
+                        $x,
+                        rti,
+                        rays,
+                        tris,
+                        out,
+                        full,
+                        |c: &Vec<u64>, i: usize| unsafe { $x::load_soft(c.as_ptr(), i, n) },
+                        |x| $x::round(x, n),
+                        |c: &mut Vec<u64>, i: usize, x| unsafe { $x::store_soft(c.as_mut_ptr(), i, x, n) },
+                        super::super::narrow_thr(rti, n)
+                    );
+                }
+
+                /// One operation of an `eEmM` format on lanes `0..full`: `out[i] = a[i] op b[i]`.
+                #[target_feature(enable = $feat)]
+                pub fn op_soft(f: &Ieee<Soft>, op: crate::rti::Op, a: &[u64], b: &[u64], out: &mut [u64], full: usize) {
+                    use crate::rti::Op;
+                    let n = &super::super::narrow_of(f).expect("the dispatch checked the format");
+                    let rd = |x| $x::round(x, n);
+                    let mut i = 0;
+                    while i < full {
+                        // SAFETY: the caller checked that every slice holds `full` lanes.
+                        let (x, y) = unsafe { ($x::load_soft(a.as_ptr(), i, n), $x::load_soft(b.as_ptr(), i, n)) };
+                        let r = match (op, f.opts.div) {
+                            (Op::Add, _) => rd($x::add(x, y)),
+                            (Op::Sub, _) => rd($x::sub(x, y)),
+                            (Op::Mul, _) => rd($x::mul(x, y)),
+                            (Op::Div, DivMode::Divide) => rd($x::div(x, y)),
+                            (Op::Div, DivMode::RecipMul) => rd($x::mul(x, rd($x::div($x::splat(1.0), y)))),
+                            (Op::Logic, _) => unreachable!("the dispatch refuses Logic"),
+                        };
+                        // SAFETY: as above; a NaN lane is stored as the canonical NaN.
+                        unsafe { $x::store_soft(out.as_mut_ptr(), i, r, n) };
+                        i += $x::LANES;
+                    }
+                }
+            }
+        };
+    }
+
+    narrow_for!(v4d, "avx2");
+    narrow_for!(v8d, "avx512f,avx2");
 }

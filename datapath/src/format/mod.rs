@@ -8,6 +8,7 @@
 mod backends;
 mod fixed;
 pub mod layout;
+pub mod narrow;
 mod spec;
 
 pub use backends::{Bf16, F16Half, F32Native, IeeeBackend, Soft};

@@ -1,0 +1,135 @@
+//! Narrow IEEE-like floats held exactly in binary64 lanes: the constants of the SIMD batch
+//! path for bf16 and custom `eEmM` layouts with precision p = M + 1 ≤ 25 and E ≤ 10.
+//!
+//! Every operation (+ − × ÷) is computed in binary64 (rounded to nearest-even) and the result
+//! rounded once more to the target, nearest-even, with [`Narrow::round`]'s rule. This equals
+//! the target's correctly rounded operation:
+//!
+//! * **Double rounding is innocuous** for + − × ÷ when the wide precision is at least 2p + 2
+//!   (Figueroa, "When is double rounding innocuous?", SIGNUM 1995): binary64 has 53 ≥ 2·25 + 2
+//!   bits, so rounding the exact result to binary64 and then to p bits gives the same value as
+//!   rounding the exact result to p bits. The theorem needs the binary64 result to carry its
+//!   full 53 bits wherever the target can round to a nonzero value.
+//! * **Range**: with E ≤ 10 the target's magnitudes lie in [2^(emin − M), 2^(emax + 1)) with
+//!   emin ≥ −510 and emax ≤ 511. Any exact result whose target rounding is nonzero and finite
+//!   is ≥ 2^(emin − M − 1) ≥ 2^−535, far above binary64's smallest normal 2^−1022, so binary64
+//!   holds it with 53 bits (the theorem applies; in the target's subnormal range its precision
+//!   is smaller than p, which only helps). An exact result below 2^−1022 rounds to ±0 in the
+//!   target whatever binary64 makes of it (binary64 rounding cannot lift it above 2^−1022,
+//!   still far below half the target's least subnormal), with the sign of the exact result.
+//!   A binary64 overflow (|result| ≥ 2^1024) happens only where the target overflows too
+//!   (its largest finite value is below 2^512), and both give ±∞.
+//! * E = 11 layouts share binary64's exponent range, where binary64's own subnormals lose
+//!   bits: they keep the scalar model.
+//!
+//! The target rounding of a binary64 value x ([`Narrow::round`], the lanes do the same):
+//! 1. NaN stays NaN (its payload is never read: the NaN rule is canonical, see below);
+//! 2. |x| < 2^emin (the target's subnormal range): (|x| + C) − C with C = 2^(emin − M + 52),
+//!    whose unit in the last place is the target's subnormal step 2^(emin − M): binary64's
+//!    nearest-even addition rounds |x| to that step, the subtraction is exact; the sign of x
+//!    is put back (a result that rounds to zero is a zero of x's sign);
+//! 3. otherwise the binary64 encoding b is rounded to M fraction bits with integer
+//!    arithmetic: b + (2^(S−1) − 1) + ((b >> S) & 1), low S = 52 − M bits cleared (ties to
+//!    even; a carry out of the fraction steps the exponent, as it must);
+//! 4. a result above the largest finite value becomes ±∞ (nearest-even overflow);
+//! 5. under FTZ, a result that is subnormal after rounding becomes zero of the same sign.
+//!
+//! Eligible formats: bf16 and `eEmM` with M ≤ 24 and E ≤ 10, either subnormal mode, either
+//! division mode, and the canonical NaN rule (a NaN result is the canonical NaN, so payloads
+//! never matter); the propagate NaN rule keeps the scalar model.
+
+use super::{FloatLayout, FpOpts, NanMode, Subnormals};
+
+/// The constants of one narrow format's binary64-lane arithmetic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Narrow {
+    /// The layout.
+    pub lay: FloatLayout,
+    /// Under FTZ: subnormal operands read as zero, subnormal results become zero.
+    pub ftz: bool,
+    /// S = 52 − M, the binary64 fraction bits the rounding drops.
+    pub shift: u32,
+    /// 2^(S−1) − 1, the rounding increment below a tie.
+    pub half: u64,
+    /// The mask that clears the low S bits.
+    pub keep: u64,
+    /// C = 2^(emin − M + 52), the subnormal rounding constant.
+    pub magic: f64,
+    /// 2^emin, the smallest normal magnitude.
+    pub min_normal: f64,
+    /// The largest finite magnitude.
+    pub max_finite: f64,
+    /// 2^(emin − M), the subnormal step (decode: fraction × step).
+    pub step: f64,
+    /// 2^(M − emin), the inverse of the step (encode).
+    pub inv_step: f64,
+}
+
+impl Narrow {
+    /// The constants of this layout and options, when the binary64-lane path models it.
+    pub fn of(lay: FloatLayout, opts: FpOpts) -> Option<Self> {
+        if lay.exp_bits > 10 || lay.man_bits > 24 || opts.nan != NanMode::Canonical {
+            return None;
+        }
+        let m = lay.man_bits as i32;
+        let shift = 52 - lay.man_bits;
+        Some(Self {
+            lay,
+            ftz: opts.subnormals == Subnormals::Ftz,
+            shift,
+            half: (1u64 << (shift - 1)) - 1,
+            keep: !((1u64 << shift) - 1),
+            magic: super::layout::pow2(lay.emin() - m + 52),
+            min_normal: lay.min_normal(),
+            max_finite: lay.max_finite(),
+            step: super::layout::pow2(lay.emin() - m),
+            inv_step: super::layout::pow2(m - lay.emin()),
+        })
+    }
+
+    /// The target rounding of a binary64 value (steps 1–5 of the module documentation); the
+    /// scalar statement of what the lanes compute.
+    pub fn round(&self, x: f64) -> f64 {
+        if x.is_nan() {
+            return x;
+        }
+        let a = x.abs();
+        let r = if a < self.min_normal {
+            ((a + self.magic) - self.magic).copysign(x)
+        } else {
+            let b = x.to_bits();
+            f64::from_bits((b + self.half + ((b >> self.shift) & 1)) & self.keep)
+        };
+        let r = if r.abs() > self.max_finite { f64::INFINITY.copysign(x) } else { r };
+        if self.ftz && r.abs() < self.min_normal {
+            0.0f64.copysign(r)
+        } else {
+            r
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rounding equals the soft-float layout's correctly rounded conversion on every
+    /// binary64 neighbour of every e5m4 value and midpoint (IEEE subnormals).
+    #[test]
+    fn round_equals_the_correctly_rounded_conversion() {
+        let lay = FloatLayout::validate(5, 4).unwrap();
+        let n = Narrow::of(lay, FpOpts::default()).unwrap();
+        for b in 0..(1u64 << lay.width()) {
+            let v = lay.to_f64(b);
+            if !v.is_finite() {
+                continue;
+            }
+            let next = lay.to_f64(b + 1);
+            let mid = if next.is_finite() && !next.is_nan() { (v + next) / 2.0 } else { v * 1.03 };
+            for x in [v, mid, f64::from_bits(mid.to_bits() + 1), f64::from_bits(mid.to_bits() - 1)] {
+                let want = lay.to_f64(lay.from_f64(x));
+                assert_eq!(n.round(x).to_bits(), want.to_bits(), "x = {x:e}");
+            }
+        }
+    }
+}
