@@ -265,6 +265,21 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         k[1] = rti_batch_f16(&r16, &rays16, &tris16, &mut o16)
     }));
     push(row("rti fp16 scalar model", pairs, RTI_OPS, 3, || r16.batch(&rays16, &tris16, &mut o16)));
+    // the narrow float formats' batch path (binary64 lanes, see datapath::format::narrow) beside
+    // their scalar models; wider formats (E = 11 or M > 24, the propagate NaN rule) and fixed
+    // point run the scalar model only
+    for name in ["bf16", "e8m16"] {
+        let any: datapath::AnyFormat = name.parse().expect("a built-in format name");
+        datapath::with_format!(any, |f| {
+            let rti = Rti::new(f, RtiConfig::default());
+            let (rays, tris) = columns(&rti, &cases);
+            let mut out = HitsSoa::with_len(pairs);
+            push(row(&format!("rti {name} kernel (dispatch)"), pairs, RTI_OPS, 7, || {
+                datapath::simd::rti_batch(&rti, &rays, &tris, &mut out);
+            }));
+            push(row(&format!("rti {name} scalar model"), pairs, RTI_OPS, 3, || rti.batch(&rays, &tris, &mut out)));
+        });
+    }
     // on a machine with AVX512-FP16, the AVX-512F binary16 kernel too (binary16 through
     // conversions, against the same, AVX512-FP16, peak)
     if datapath::simd::kernels_here().contains(&Kernel::Avx512Fp16) {

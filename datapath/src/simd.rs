@@ -244,6 +244,28 @@ fn narrow_thr<B: IeeeBackend>(rti: &Rti<Ieee<B>>, n: &Narrow) -> f64 {
     }
 }
 
+/// The scalar model on the lanes `bad` (bit j: slot `base + j`): the narrow kernels' filter
+/// fall-through.
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+fn redo_lanes<F: crate::Format>(
+    rti: &Rti<F>,
+    rays: &RaysSoa<F::V>,
+    tris: &TrisSoa<F::V>,
+    out: &mut HitsSoa<F::V>,
+    base: usize,
+    bad: u32,
+) {
+    for j in (0..32).filter(|&j| bad >> j & 1 == 1) {
+        let i = base + j;
+        let o = rti.test(&rays.get(i), &tris.get(i));
+        out.hit[i] = o.hit;
+        out.valid[i] = o.valid;
+        out.t[i] = o.t;
+        out.u[i] = o.u;
+        out.v[i] = o.v;
+    }
+}
+
 /// The widest kernel of the narrow float formats (binary64 lanes: 4 on AVX2, 8 on AVX-512F).
 pub const WIDEST_NARROW: Kernel = Kernel::Avx512;
 
@@ -319,21 +341,28 @@ pub fn op_batch_soft(f: &Ieee<Soft>, op: crate::rti::Op, a: &[u64], b: &[u64], o
         _ => 8,
     };
     let full = if lanes == usize::MAX { 0 } else { a.len() / lanes * lanes };
+    let scalar = |i: usize| match op {
+        Op::Add => f.add(a[i], b[i]),
+        Op::Sub => f.sub(a[i], b[i]),
+        Op::Mul => f.mul(a[i], b[i]),
+        _ => f.div(a[i], b[i]),
+    };
+    let mut redo = Vec::new();
     #[cfg(target_arch = "x86_64")]
     match which {
         // SAFETY: `which` names a kernel only after run-time feature detection; every slice
         // holds the same n >= full slots (checked above).
-        Kernel::Avx2 => unsafe { kernels::v4d::op_soft(f, op, a, b, out, full) },
+        Kernel::Avx2 => unsafe { kernels::v4d::op_soft(f, op, a, b, out, full, &mut redo) },
         Kernel::Scalar => {}
-        _ => unsafe { kernels::v8d::op_soft(f, op, a, b, out, full) },
+        _ => unsafe { kernels::v8d::op_soft(f, op, a, b, out, full, &mut redo) },
     }
-    for i in full..a.len() {
-        out[i] = match op {
-            Op::Add => f.add(a[i], b[i]),
-            Op::Sub => f.sub(a[i], b[i]),
-            Op::Mul => f.mul(a[i], b[i]),
-            _ => f.div(a[i], b[i]),
-        };
+    for (i, mask) in redo {
+        for k in (0..32).filter(|k| mask >> k & 1 == 1) {
+            out[i + k] = scalar(i + k);
+        }
+    }
+    for (i, o) in out.iter_mut().enumerate().skip(full) {
+        *o = scalar(i);
     }
     which
 }
@@ -519,12 +548,12 @@ where
     {
         use std::any::Any;
         let (unit, a, b) = (rti as &dyn Any, rays as &dyn Any, tris as &dyn Any);
-        let o = || "the output type follows the format";
+        const O: &str = "the output type follows the format";
         if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
-            return rti_batch_bf16(unit, a, b, (out as &mut dyn Any).downcast_mut().expect(o()));
+            return rti_batch_bf16(unit, a, b, (out as &mut dyn Any).downcast_mut().expect(O));
         }
         if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
-            return rti_batch_soft(unit, a, b, (out as &mut dyn Any).downcast_mut().expect(o()));
+            return rti_batch_soft(unit, a, b, (out as &mut dyn Any).downcast_mut().expect(O));
         }
     }
     by_format!(rti, rays, tris, out, rti_batch_f32, rti_batch_f16, rti.batch(rays, tris, out))
@@ -1126,23 +1155,32 @@ mod isa {
             // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
             unsafe { (p.add(i) as *mut u32).write_unaligned(super::SPREAD[bits(m) as usize] as u32) }
         }
-        /// The target rounding of [`Narrow::round`] on every lane (steps 1–5 there).
+        /// Every lane rounded to the format's precision p, nearest-even, by Veltkamp's
+        /// splitting (g = x·(2^S + 1), then g − (g − x)); correct for |x| in [2^emin, max]
+        /// and for zeros, which is what [`poison`] checks.
         #[inline]
         #[target_feature(enable = "avx2")]
-        pub fn round(x: __m256d, n: &Narrow) -> __m256d {
-            let b = _mm256_castpd_si256(x);
-            let lsb = _mm256_and_si256(_mm256_srl_epi64(b, count(n.shift)), int(1));
-            let r = _mm256_and_si256(_mm256_add_epi64(_mm256_add_epi64(b, int(n.half)), lsb), int(n.keep));
-            let r = _mm256_castsi256_pd(r);
-            let (a, s) = (abs(x), sign(x));
-            let c = splat(n.magic);
-            let tiny = _mm256_or_pd(_mm256_sub_pd(_mm256_add_pd(a, c), c), s);
-            let r = blend(r, tiny, lt(a, splat(n.min_normal)));
-            let r = blend(r, _mm256_or_pd(splat(f64::INFINITY), s), lt(splat(n.max_finite), abs(r)));
-            let r = blend(r, x, unord(x, x));
-            flush(r, n)
+        pub fn split(x: __m256d, n: &Narrow) -> __m256d {
+            let g = mul(x, splat(n.split));
+            // g − (g − x) is g + (x − g) (nearest-even rounding is symmetric) with -0 kept
+            sub(g, sub(g, x))
         }
-        /// Under FTZ, subnormal lanes become zeros of the same sign (operand read, result write).
+        /// The binary64 just below each lane's magnitude (a NaN for ±0).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn pred(x: __m256d) -> __m256d {
+            _mm256_castsi256_pd(_mm256_sub_epi64(_mm256_castpd_si256(abs(x)), int(1)))
+        }
+        /// `r`, or a NaN where the unrounded `x` lies outside {±0} ∪ [2^emin, max] (a
+        /// subnormal, an overflow, an infinity): the NaN reaches the lane's t, u or v, and
+        /// the lane is recomputed by the scalar model.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn poison(r: __m256d, x: __m256d, n: &Narrow) -> __m256d {
+            let out = or_m(lt(splat(n.max_finite), abs(x)), lt(pred(x), splat(n.below_min)));
+            blend(r, _mm256_castsi256_pd(int(0x7ff8_0000_0000_0000)), out)
+        }
+        /// Under FTZ, subnormal lanes read as zeros of the same sign (the operand read).
         #[inline]
         #[target_feature(enable = "avx2")]
         pub fn flush(x: __m256d, n: &Narrow) -> __m256d {
@@ -1151,15 +1189,15 @@ mod isa {
                 false => x,
             }
         }
-        /// Loads 4 bf16 encodings as binary64 (exact), read-flushed under FTZ.
+        /// Loads 4 bf16 encodings as binary64 (exact).
         ///
         /// # Safety
         /// `p[i..i + 4]` must be in bounds.
         #[inline]
         #[target_feature(enable = "avx2")]
-        pub unsafe fn load_bf16(p: *const u16, i: usize, n: &Narrow) -> __m256d {
+        pub unsafe fn load_bf16(p: *const u16, i: usize) -> __m256d {
             let h = unsafe { _mm_loadl_epi64(p.add(i) as *const __m128i) };
-            flush(_mm256_cvtps_pd(_mm_castsi128_ps(_mm_slli_epi32::<16>(_mm_cvtepu16_epi32(h)))), n)
+            _mm256_cvtps_pd(_mm_castsi128_ps(_mm_slli_epi32::<16>(_mm_cvtepu16_epi32(h))))
         }
         /// Stores 4 lanes holding bf16 values (or the canonical NaN) as bf16 encodings.
         ///
@@ -1172,7 +1210,7 @@ mod isa {
             let w = _mm_srli_epi32::<16>(_mm_castps_si128(_mm256_cvtpd_ps(x)));
             unsafe { _mm_storel_epi64(p.add(i) as *mut __m128i, _mm_packus_epi32(w, w)) }
         }
-        /// Loads 4 `eEmM` encodings as binary64 (exact), read-flushed under FTZ.
+        /// Loads 4 `eEmM` encodings as binary64 (exact).
         ///
         /// # Safety
         /// `p[i..i + 4]` must be in bounds.
@@ -1193,7 +1231,6 @@ mod isa {
             let two52 = splat(4503599627370496.0);
             let fv = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(f, int(0x4330_0000_0000_0000))), two52);
             let sub = _mm256_or_pd(_mm256_mul_pd(fv, splat(n.step)), _mm256_castsi256_pd(s));
-            let sub = if n.ftz { _mm256_castsi256_pd(s) } else { sub };
             let r = blend(_mm256_castsi256_pd(normal), sub, _mm256_castsi256_pd(_mm256_cmpeq_epi64(e, int(0))));
             blend(r, _mm256_castsi256_pd(special), _mm256_castsi256_pd(_mm256_cmpeq_epi64(e, int(emax))))
         }
@@ -1325,22 +1362,32 @@ mod isa {
             // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
             unsafe { (p.add(i) as *mut u64).write_unaligned(super::SPREAD[m as usize]) }
         }
-        /// The target rounding of [`Narrow::round`] on every lane (steps 1–5 there).
+        /// Every lane rounded to the format's precision p, nearest-even, by Veltkamp's
+        /// splitting (g = x·(2^S + 1), then g − (g − x)); correct for |x| in [2^emin, max]
+        /// and for zeros, which is what [`poison`] checks.
         #[inline]
         #[target_feature(enable = "avx512f")]
-        pub fn round(x: __m512d, n: &Narrow) -> __m512d {
-            let b = ib(x);
-            let lsb = _mm512_and_si512(_mm512_srl_epi64(b, count(n.shift)), int(1));
-            let r = fb(_mm512_and_si512(_mm512_add_epi64(_mm512_add_epi64(b, int(n.half)), lsb), int(n.keep)));
-            let (a, s) = (abs(x), sign(x));
-            let c = splat(n.magic);
-            let tiny = fb(_mm512_or_si512(ib(_mm512_sub_pd(_mm512_add_pd(a, c), c)), ib(s)));
-            let r = blend(r, tiny, lt(a, splat(n.min_normal)));
-            let r = blend(r, fb(_mm512_or_si512(int(0x7ff0_0000_0000_0000), ib(s))), lt(splat(n.max_finite), abs(r)));
-            let r = blend(r, x, unord(x, x));
-            flush(r, n)
+        pub fn split(x: __m512d, n: &Narrow) -> __m512d {
+            let g = mul(x, splat(n.split));
+            // g − (g − x) is g + (x − g) (nearest-even rounding is symmetric) with -0 kept
+            sub(g, sub(g, x))
         }
-        /// Under FTZ, subnormal lanes become zeros of the same sign (operand read, result write).
+        /// The binary64 just below each lane's magnitude (a NaN for ±0).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn pred(x: __m512d) -> __m512d {
+            fb(_mm512_sub_epi64(ib(abs(x)), int(1)))
+        }
+        /// `r`, or a NaN where the unrounded `x` lies outside {±0} ∪ [2^emin, max] (a
+        /// subnormal, an overflow, an infinity): the NaN reaches the lane's t, u or v, and
+        /// the lane is recomputed by the scalar model.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn poison(r: __m512d, x: __m512d, n: &Narrow) -> __m512d {
+            let out = or_m(lt(splat(n.max_finite), abs(x)), lt(pred(x), splat(n.below_min)));
+            blend(r, fb(int(0x7ff8_0000_0000_0000)), out)
+        }
+        /// Under FTZ, subnormal lanes read as zeros of the same sign (the operand read).
         #[inline]
         #[target_feature(enable = "avx512f")]
         pub fn flush(x: __m512d, n: &Narrow) -> __m512d {
@@ -1349,15 +1396,15 @@ mod isa {
                 false => x,
             }
         }
-        /// Loads 8 bf16 encodings as binary64 (exact), read-flushed under FTZ.
+        /// Loads 8 bf16 encodings as binary64 (exact).
         ///
         /// # Safety
         /// `p[i..i + 8]` must be in bounds.
         #[inline]
         #[target_feature(enable = "avx512f,avx2")]
-        pub unsafe fn load_bf16(p: *const u16, i: usize, n: &Narrow) -> __m512d {
+        pub unsafe fn load_bf16(p: *const u16, i: usize) -> __m512d {
             let h = unsafe { _mm_loadu_si128(p.add(i) as *const __m128i) };
-            flush(_mm512_cvtps_pd(_mm256_castsi256_ps(_mm256_slli_epi32::<16>(_mm256_cvtepu16_epi32(h)))), n)
+            _mm512_cvtps_pd(_mm256_castsi256_ps(_mm256_slli_epi32::<16>(_mm256_cvtepu16_epi32(h))))
         }
         /// Stores 8 lanes holding bf16 values (or the canonical NaN) as bf16 encodings.
         ///
@@ -1372,7 +1419,7 @@ mod isa {
             let packed = _mm256_permute4x64_epi64::<0b1000>(_mm256_packus_epi32(w, w));
             unsafe { _mm_storeu_si128(p.add(i) as *mut __m128i, _mm256_castsi256_si128(packed)) }
         }
-        /// Loads 8 `eEmM` encodings as binary64 (exact), read-flushed under FTZ.
+        /// Loads 8 `eEmM` encodings as binary64 (exact).
         ///
         /// # Safety
         /// `p[i..i + 8]` must be in bounds.
@@ -1393,7 +1440,6 @@ mod isa {
             let two52 = splat(4503599627370496.0);
             let fv = _mm512_sub_pd(fb(_mm512_or_si512(f, int(0x4330_0000_0000_0000))), two52);
             let sub = fb(_mm512_or_si512(ib(_mm512_mul_pd(fv, splat(n.step))), s));
-            let sub = if n.ftz { fb(s) } else { sub };
             let r = blend(normal, sub, _mm512_cmpeq_epi64_mask(e, int(0)));
             blend(r, special, _mm512_cmpeq_epi64_mask(e, int(emax)))
         }
@@ -1589,21 +1635,23 @@ mod kernels {
     /// `$load(column, i)` gives the lanes as binary32, `$round(x)` rounds a binary32 result to
     /// the format, `$store(column, i, x)` writes results, `$thr` is the det threshold as binary32.
     macro_rules! rti_kernel {
-        ($x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr) => {{
+        ($x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $start:expr, $end:expr) => {{
             // one loop per (culling, division mode), so that neither is decided per vector
             let backface = $rti.cull == Cull::Backface;
             match ($rti.fmt.opts.div, backface) {
-                (DivMode::RecipMul, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, false, true),
-                (DivMode::RecipMul, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, true, true),
-                (DivMode::Divide, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, false, false),
-                (DivMode::Divide, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, true, false),
+                (DivMode::RecipMul, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $start, $end, false, true),
+                (DivMode::RecipMul, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $start, $end, true, true),
+                (DivMode::Divide, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $start, $end, false, false),
+                (DivMode::Divide, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $start, $end, true, false),
             }
         }};
-        (@loop $x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $backface:expr, $recip:expr) => {{
+        (@loop $x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $start:expr, $end:expr, $backface:expr, $recip:expr) => {{
             let (rays, tris, out) = ($rays, $tris, $out);
             let load = $load;
             let rd = $round;
             let store = $store;
+            // called before and after each block of vectors (the narrow formats' filter)
+            let (start, end) = ($start, $end);
             let sub = |a, b| rd($x::sub(a, b));
             let add = |a, b| rd($x::add(a, b));
             let mul = |a, b| rd($x::mul(a, b));
@@ -1621,9 +1669,12 @@ mod kernels {
             // filling the scheduler with instructions that wait for it.
             const BLOCK: usize = 8;
             let mut keep = [[zero; 4]; BLOCK];
+            // the NaN lanes of each vector of the block (bit j: lane j), for `end`
+            let mut nan_bits = [0u32; BLOCK];
             let mut base = 0;
             while base < $full {
                 let nv = (($full - base) / L).min(BLOCK);
+                start();
                 for (k, slot) in keep.iter_mut().enumerate().take(nv) {
                     let i = base + L * k;
                     let [ox, oy, oz] = [0, 1, 2].map(|a| load(&rays.o[a], i));
@@ -1681,15 +1732,16 @@ mod kernels {
                     }
                     // NaN lanes are rare: canonicalise only when one of the results is NaN
                     let canon = |x| $x::blend(x, nan, $x::unord(x, x));
-                    let (t, u, w) = if $x::bits($x::or_m($x::unord(t, u), $x::unord(w, w))) == 0 {
-                        (t, u, w)
-                    } else {
-                        (canon(t), canon(u), canon(w))
-                    };
+                    // (uv feeds only a compare: a NaN there marks the lane too, which the
+                    // narrow formats' filter needs; for the others it is NaN only when u or v is)
+                    let nan_lanes = $x::bits($x::or_m($x::unord(t, u), $x::unord(w, uv)));
+                    nan_bits[k] = nan_lanes;
+                    let (t, u, w) = if nan_lanes == 0 { (t, u, w) } else { (canon(t), canon(u), canon(w)) };
                     store(&mut out.t, i, t);
                     store(&mut out.u, i, u);
                     store(&mut out.v, i, w);
                 }
+                end(base, nv, &nan_bits, &mut *out);
                 base += L * nv;
             }
         }};
@@ -2024,7 +2076,9 @@ mod kernels {
                     |c: &Vec<$v>, i: usize| unsafe { $x::$load(c.as_ptr(), i) },
                     $round,
                     |c: &mut Vec<$v>, i: usize, x| unsafe { $x::$store(c.as_mut_ptr(), i, x) },
-                    ($thr)(rti)
+                    ($thr)(rti),
+                    || {},
+                    |_: usize, _: usize, _: &[u32; 8], _: &mut HitsSoa<$v>| {}
                 );
             }
 
@@ -2054,13 +2108,47 @@ mod kernels {
 
     /// The RTI kernels of the narrow float formats (bf16, `eEmM` with M ≤ 24 and E ≤ 10) on
     /// the binary64 lanes of one instruction set (`v4d`, `v8d`): the same stage table, every
-    /// operation in binary64 then rounded to the format ([`crate::format::narrow`]).
+    /// operation in binary64 then rounded to the format's precision by [`isa::v4d::split`],
+    /// behind a filter ([`crate::format::narrow`]): each lane tracks the largest magnitude and
+    /// the smallest nonzero magnitude of every unrounded result (and, under FTZ, of every
+    /// operand read); a lane where either left [2^emin, max] at any step (a subnormal, an
+    /// overflow, an infinity) is recomputed by the scalar model after its block.
     macro_rules! narrow_for {
         ($x:ident, $feat:literal) => {
             pub(in crate::simd) mod $x {
                 use super::super::isa::$x;
                 use super::*;
+                use crate::format::narrow::Narrow;
                 use crate::format::{Bf16, Soft};
+
+                /// One format's RTI kernel on lanes `0..full`: its column loads and stores.
+                macro_rules! narrow_rti {
+                    ($rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $v:ty, $load:expr, $store:expr) => {{
+                        let (rti, rays, tris) = ($rti, $rays, $tris);
+                        let n: &Narrow = &super::super::narrow_of(&rti.fmt).expect("the dispatch checked the format");
+                        let load = $load;
+                        rti_kernel!(
+                            $x,
+                            rti,
+                            rays,
+                            tris,
+                            $out,
+                            $full,
+                            |c: &Vec<$v>, i: usize| $x::flush(load(c, i), n),
+                            |x| $x::poison($x::split(x, n), x, n),
+                            $store,
+                            super::super::narrow_thr(rti, n),
+                            || {},
+                            |base: usize, nv: usize, nan: &[u32; 8], out: &mut HitsSoa<$v>| {
+                                for (k, &bad) in nan.iter().enumerate().take(nv) {
+                                    if bad != 0 {
+                                        super::super::redo_lanes(rti, rays, tris, out, base + $x::LANES * k, bad);
+                                    }
+                                }
+                            }
+                        )
+                    }};
+                }
 
                 /// The bf16 RTI kernel on lanes `0..full`.
                 #[target_feature(enable = $feat)]
@@ -2071,20 +2159,17 @@ mod kernels {
                     out: &mut HitsSoa<u16>,
                     full: usize,
                 ) {
-                    let n = &super::super::narrow_of(&rti.fmt).expect("the dispatch checked the format");
                     // SAFETY (loads and stores): the caller checked that every column holds
                     // `full` lanes; the column types are plain values.
-                    rti_kernel!(
-                        $x,
+                    narrow_rti!(
                         rti,
                         rays,
                         tris,
                         out,
                         full,
-                        |c: &Vec<u16>, i: usize| unsafe { $x::load_bf16(c.as_ptr(), i, n) },
-                        |x| $x::round(x, n),
-                        |c: &mut Vec<u16>, i: usize, x| unsafe { $x::store_bf16(c.as_mut_ptr(), i, x) },
-                        super::super::narrow_thr(rti, n)
+                        u16,
+                        |c: &Vec<u16>, i: usize| unsafe { $x::load_bf16(c.as_ptr(), i) },
+                        |c: &mut Vec<u16>, i: usize, x| unsafe { $x::store_bf16(c.as_mut_ptr(), i, x) }
                     );
                 }
 
@@ -2097,42 +2182,58 @@ mod kernels {
                     out: &mut HitsSoa<u64>,
                     full: usize,
                 ) {
-                    let n = &super::super::narrow_of(&rti.fmt).expect("the dispatch checked the format");
+                    let n: &Narrow = &super::super::narrow_of(&rti.fmt).expect("the dispatch checked the format");
                     // SAFETY (loads and stores): as above.
-                    rti_kernel!(
-                        $x,
+                    narrow_rti!(
                         rti,
                         rays,
                         tris,
                         out,
                         full,
+                        u64,
                         |c: &Vec<u64>, i: usize| unsafe { $x::load_soft(c.as_ptr(), i, n) },
-                        |x| $x::round(x, n),
-                        |c: &mut Vec<u64>, i: usize, x| unsafe { $x::store_soft(c.as_mut_ptr(), i, x, n) },
-                        super::super::narrow_thr(rti, n)
+                        |c: &mut Vec<u64>, i: usize, x| unsafe { $x::store_soft(c.as_mut_ptr(), i, x, n) }
                     );
                 }
 
-                /// One operation of an `eEmM` format on lanes `0..full`: `out[i] = a[i] op b[i]`.
+                /// One operation of an `eEmM` format on lanes `0..full`: `out[i] = a[i] op b[i]`,
+                /// behind the same filter; returns the lanes (bit k: lane k of the vector at
+                /// `i`) the caller must recompute, as `(i, mask)` pairs in `redo`.
                 #[target_feature(enable = $feat)]
-                pub fn op_soft(f: &Ieee<Soft>, op: crate::rti::Op, a: &[u64], b: &[u64], out: &mut [u64], full: usize) {
+                pub fn op_soft(
+                    f: &Ieee<Soft>,
+                    op: crate::rti::Op,
+                    a: &[u64],
+                    b: &[u64],
+                    out: &mut [u64],
+                    full: usize,
+                    redo: &mut Vec<(usize, u32)>,
+                ) {
                     use crate::rti::Op;
                     let n = &super::super::narrow_of(f).expect("the dispatch checked the format");
-                    let rd = |x| $x::round(x, n);
                     let mut i = 0;
                     while i < full {
                         // SAFETY: the caller checked that every slice holds `full` lanes.
                         let (x, y) = unsafe { ($x::load_soft(a.as_ptr(), i, n), $x::load_soft(b.as_ptr(), i, n)) };
+                        let (x, y) = ($x::flush(x, n), $x::flush(y, n));
+                        let rd = |v| $x::poison($x::split(v, n), v, n);
                         let r = match (op, f.opts.div) {
                             (Op::Add, _) => rd($x::add(x, y)),
                             (Op::Sub, _) => rd($x::sub(x, y)),
                             (Op::Mul, _) => rd($x::mul(x, y)),
                             (Op::Div, DivMode::Divide) => rd($x::div(x, y)),
-                            (Op::Div, DivMode::RecipMul) => rd($x::mul(x, rd($x::div($x::splat(1.0), y)))),
+                            (Op::Div, DivMode::RecipMul) => {
+                                let inv = rd($x::div($x::splat(1.0), y));
+                                rd($x::mul(x, inv))
+                            }
                             (Op::Logic, _) => unreachable!("the dispatch refuses Logic"),
                         };
                         // SAFETY: as above; a NaN lane is stored as the canonical NaN.
                         unsafe { $x::store_soft(out.as_mut_ptr(), i, r, n) };
+                        let bad = $x::bits($x::unord(r, r));
+                        if bad != 0 {
+                            redo.push((i, bad));
+                        }
                         i += $x::LANES;
                     }
                 }

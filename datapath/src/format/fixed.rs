@@ -52,7 +52,7 @@ impl Fixed {
         div: DivMode,
     ) -> Result<Self, String> {
         // checked: `q4294967295.3` must not wrap to a 2-bit format
-        let w = int_bits.checked_add(frac_bits).unwrap_or(u32::MAX);
+        let w = int_bits.saturating_add(frac_bits);
         if int_bits == 0 || !(2..=64).contains(&w) {
             return Err(format!(
                 "q{int_bits}.{frac_bits}: need at least 1 integer (sign) bit and a total width of 2..=64"

@@ -22,7 +22,7 @@
 //! * E = 11 layouts share binary64's exponent range, where binary64's own subnormals lose
 //!   bits: they keep the scalar model.
 //!
-//! The target rounding of a binary64 value x ([`Narrow::round`], the lanes do the same):
+//! The target rounding of a binary64 value x, in full ([`Narrow::round`]):
 //! 1. NaN stays NaN (its payload is never read: the NaN rule is canonical, see below);
 //! 2. |x| < 2^emin (the target's subnormal range): (|x| + C) − C with C = 2^(emin − M + 52),
 //!    whose unit in the last place is the target's subnormal step 2^(emin − M): binary64's
@@ -33,6 +33,18 @@
 //!    even; a carry out of the fraction steps the exponent, as it must);
 //! 4. a result above the largest finite value becomes ±∞ (nearest-even overflow);
 //! 5. under FTZ, a result that is subnormal after rounding becomes zero of the same sign.
+//!
+//! The lanes take a faster road with a filter (CGAL's filtered-predicate pattern): each result
+//! x is rounded to p bits by Veltkamp's splitting, g = x·(2^S + 1), r = g − (g − x) (with
+//! nearest-even binary64 arithmetic, r is x rounded to 53 − S = p bits, ties to even; g − (g −
+//! x) rather than g + (x − g) keeps the sign of −0). This is the target rounding whenever x
+//! is ±0 or 2^emin ≤ |x| ≤ max (a value below 2^emin that rounds up to 2^emin does so on both
+//! grids). Any other x (a subnormal result, an overflow, an infinity) makes the lane's value a
+//! NaN, which reaches its t, u or v (every signal of the stage table feeds one of them, and
+//! u + v, which feeds only a compare, is checked too); after each block of vectors the lanes
+//! with a NaN result are recomputed by the scalar model, so a lane's bits are the model's
+//! either way. Under FTZ the operand read flushes in the lanes (a subnormal operand reads as
+//! zero of its sign) and a result that would be subnormal takes the scalar road.
 //!
 //! Eligible formats: bf16 and `eEmM` with M ≤ 24 and E ≤ 10, either subnormal mode, either
 //! division mode, and the canonical NaN rule (a NaN result is the canonical NaN, so payloads
@@ -63,6 +75,10 @@ pub struct Narrow {
     pub step: f64,
     /// 2^(M − emin), the inverse of the step (encode).
     pub inv_step: f64,
+    /// 2^S + 1, Veltkamp's splitting constant for rounding to p = 53 − S bits.
+    pub split: f64,
+    /// The binary64 just below 2^emin (the filter's subnormal threshold).
+    pub below_min: f64,
 }
 
 impl Narrow {
@@ -84,6 +100,8 @@ impl Narrow {
             max_finite: lay.max_finite(),
             step: super::layout::pow2(lay.emin() - m),
             inv_step: super::layout::pow2(m - lay.emin()),
+            split: super::layout::pow2(shift as i32) + 1.0,
+            below_min: f64::from_bits(lay.min_normal().to_bits() - 1),
         })
     }
 
