@@ -52,7 +52,18 @@ pub struct SpeedReport {
     pub peak16_gops: Option<f64>,
     /// Rows.
     pub rows: Vec<SpeedRow>,
+    /// Which formats have a SIMD batch path for RTI and which run the scalar model only.
+    pub batch_paths: Vec<String>,
 }
+
+/// The RTI batch path of each format family (the SIMD kernels of `datapath::simd`).
+pub const BATCH_PATHS: [&str; 5] = [
+    "f32, fp16: binary32 / binary16 kernels (IEEE subnormals, canonical NaN)",
+    "bf16: binary32 lanes, each op rounded to bf16 in integer lanes (IEEE or FTZ, canonical NaN)",
+    "eEmM with M <= 24, E <= 10: binary64 lanes, each op rounded to p bits behind a filter, flagged lanes on the scalar model (IEEE or FTZ, canonical NaN)",
+    "scalar model only: f32/fp16 with FTZ or the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float",
+    "scalar model only: fixed point qI.F (no batch path yet)",
+];
 
 /// Adds and multiplies on independent accumulators for about `secs`, on the widest vector
 /// unit the kernels use here: lane-ops per second.
@@ -472,6 +483,7 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         r.fraction_of_peak = r.mtests_per_s * 1e6 * r.ops / p;
     }
     SpeedReport {
+        batch_paths: BATCH_PATHS.iter().map(|s| s.to_string()).collect(),
         pairs,
         seed,
         kernels: k.map(|k| format!("{k:?}")),
@@ -522,6 +534,19 @@ pub fn render(s: &SpeedReport) -> String {
             format!("| {} | {:.1} | {} | {:.3} |", r.name, r.mtests_per_s, r.ops, r.fraction_of_peak)
         };
         out += &if with16 { format!(" {} |\n", r.peak) } else { "\n".into() };
+    }
+    // each format's RTI batch path against the binary32 kernel of the same run
+    let rate = |name: &str| s.rows.iter().find(|r| r.name == name).map(|r| r.mtests_per_s);
+    if let Some(f32k) = rate("rti f32 kernel (dispatch)").filter(|&r| r > 0.0) {
+        let ratios: Vec<String> = ["fp16", "bf16", "e8m16"]
+            .iter()
+            .filter_map(|f| rate(&format!("rti {f} kernel (dispatch)")).map(|r| format!("{f} {:.3}", r / f32k)))
+            .collect();
+        out += &format!("\nRTI batch path / f32 kernel, this run: {}\n", ratios.join(", "));
+    }
+    out += "\nRTI batch paths:\n";
+    for p in &s.batch_paths {
+        out += &format!("- {p}\n");
     }
     out
 }

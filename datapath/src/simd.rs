@@ -24,9 +24,15 @@
 //! near plane once per batch. The plain comparator `t = (x > t) ? x : t` is exactly `vmaxps(x,
 //! t)` (the second operand on NaN or equality, ±0 included), so it costs one instruction.
 //!
-//! Eligible formats: IEEE subnormals and canonical NaN (either division mode, either culling;
-//! every slab variant but the directed one); others, and machines without AVX2, run the
-//! scalar model, as does a det threshold that is negative or NaN (the RTI kernels' sign-flip
+//! RTI also has kernels for bf16 (the scalar model's binary32 arithmetic on binary32 lanes,
+//! each result rounded to bf16 in the integer lanes, FTZ flushes in the lanes) and for custom
+//! `eEmM` layouts with M ≤ 24 and E ≤ 10 (binary64 lanes behind a filter that sends a lane
+//! with a subnormal, overflowing or infinite intermediate to the scalar model; the argument is
+//! in [`crate::format::narrow`]), IEEE or FTZ, canonical NaN, either division mode.
+//!
+//! Eligible formats (binary32 / binary16): IEEE subnormals and canonical NaN (either division
+//! mode, either culling; every slab variant but the directed one); others, and machines
+//! without AVX2, run the scalar model, as does a det threshold that is negative or NaN (the RTI kernels' sign-flip
 //! side tests need det_ok to exclude det = ±0). Columns are processed a vector at a time
 //! straight from the SoA inputs; a batch's last `n mod lanes` slots run the scalar model.
 //!
@@ -266,11 +272,11 @@ fn redo_lanes<F: crate::Format>(
     }
 }
 
-/// The widest kernel of the narrow float formats (binary64 lanes: 4 on AVX2, 8 on AVX-512F).
+/// The widest kernel of bf16 and the narrow `eEmM` formats (AVX-512F: 16 binary32 / 8 binary64 lanes).
 pub const WIDEST_NARROW: Kernel = Kernel::Avx512;
 
-/// The kernel `rti_batch_bf16` / `rti_batch_soft` use for this unit on this machine: the
-/// binary64-lane path for bf16 and `eEmM` with M ≤ 24, E ≤ 10 and the canonical NaN rule.
+/// The kernel `rti_batch_bf16` / `rti_batch_soft` use for this unit on this machine: bf16 on
+/// binary32 lanes, `eEmM` with M ≤ 24, E ≤ 10 on binary64 lanes; the canonical NaN rule.
 pub fn kernel_narrow<B: IeeeBackend>(rti: &Rti<Ieee<B>>) -> Kernel {
     best_kernel(narrow_of(&rti.fmt).is_some() && rti.fmt.to_f64(rti.det_thr) >= 0.0, WIDEST_NARROW)
 }
@@ -293,7 +299,7 @@ pub fn rti_batch_bf16(
         out,
         which,
         #[cfg(target_arch = "x86_64")]
-        (kernels::v4d::rti_bf16, kernels::v8d::rti_bf16, None),
+        (kernels::b8::rti_bf16, kernels::b16::rti_bf16, None),
     )
 }
 
@@ -842,6 +848,48 @@ mod isa {
         pub unsafe fn store16(p: *mut f16, i: usize, x: __m256) {
             unsafe { _mm_storeu_si128(p.add(i) as *mut __m128i, _mm256_cvtps_ph::<_MM_FROUND_TO_NEAREST_INT>(x)) }
         }
+        /// Loads 8 bf16 encodings as binary32 (exact: bf16 is binary32's top half).
+        ///
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn load_bf16(p: *const u16, i: usize) -> __m256 {
+            let h = unsafe { _mm_loadu_si128(p.add(i) as *const __m128i) };
+            _mm256_castsi256_ps(_mm256_slli_epi32::<16>(_mm256_cvtepu16_epi32(h)))
+        }
+        /// Stores 8 lanes holding bf16 values as bf16 encodings (their top halves).
+        ///
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn store_bf16(p: *mut u16, i: usize, x: __m256) {
+            let w = _mm256_srli_epi32::<16>(_mm256_castps_si256(x));
+            // packing works per 128-bit half: take quadwords 0 and 2
+            let packed = _mm256_permute4x64_epi64::<0b1000>(_mm256_packus_epi32(w, w));
+            unsafe { _mm_storeu_si128(p.add(i) as *mut __m128i, _mm256_castsi256_si128(packed)) }
+        }
+        /// Rounds binary32 lanes to bf16, nearest-even, as the scalar model's `Bf16::round_f32`:
+        /// `(b + 0x7fff + ((b >> 16) & 1))` with the low 16 bits cleared (a carry steps the
+        /// exponent; past the largest finite value it reaches infinity).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn round_bf16(x: __m256) -> __m256 {
+            let b = _mm256_castps_si256(x);
+            let lsb = _mm256_and_si256(_mm256_srli_epi32::<16>(b), _mm256_set1_epi32(1));
+            let r = _mm256_add_epi32(_mm256_add_epi32(b, _mm256_set1_epi32(0x7fff)), lsb);
+            _mm256_castsi256_ps(_mm256_and_si256(r, _mm256_set1_epi32(0xffff_0000_u32 as i32)))
+        }
+        /// Under FTZ, lanes below binary32's (and bf16's) smallest normal become zeros of the same sign.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn flush_bf16(x: __m256, ftz: bool) -> __m256 {
+            match ftz {
+                true => blend(x, sign(x), lt(abs(x), splat(f32::MIN_POSITIVE))),
+                false => x,
+            }
+        }
         /// Rounds binary32 lanes to binary16 (nearest-even), held in binary32.
         #[inline]
         #[target_feature(enable = "avx2,f16c")]
@@ -890,6 +938,44 @@ mod isa {
             max = _mm512_max_ps, min = _mm512_min_ps, cmp = _mm512_cmp_ps_mask);
         /// vcvtps2ph: round to nearest even, exceptions suppressed (flags are not modelled).
         const NEAREST: i32 = _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC;
+        /// Loads 16 bf16 encodings as binary32 (exact: bf16 is binary32's top half).
+        ///
+        /// # Safety
+        /// `p[i..i + 16]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn load_bf16(p: *const u16, i: usize) -> __m512 {
+            let h = unsafe { _mm256_loadu_si256(p.add(i) as *const __m256i) };
+            _mm512_castsi512_ps(_mm512_slli_epi32::<16>(_mm512_cvtepu16_epi32(h)))
+        }
+        /// Stores 16 lanes holding bf16 values as bf16 encodings (their top halves).
+        ///
+        /// # Safety
+        /// `p[i..i + 16]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn store_bf16(p: *mut u16, i: usize, x: __m512) {
+            let w = _mm512_srli_epi32::<16>(_mm512_castps_si512(x));
+            unsafe { _mm256_storeu_si256(p.add(i) as *mut __m256i, _mm512_cvtepi32_epi16(w)) }
+        }
+        /// Rounds binary32 lanes to bf16, nearest-even, as the scalar model's `Bf16::round_f32`.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn round_bf16(x: __m512) -> __m512 {
+            let b = _mm512_castps_si512(x);
+            let lsb = _mm512_and_si512(_mm512_srli_epi32::<16>(b), _mm512_set1_epi32(1));
+            let r = _mm512_add_epi32(_mm512_add_epi32(b, _mm512_set1_epi32(0x7fff)), lsb);
+            _mm512_castsi512_ps(_mm512_and_si512(r, _mm512_set1_epi32(0xffff_0000_u32 as i32)))
+        }
+        /// Under FTZ, lanes below binary32's (and bf16's) smallest normal become zeros of the same sign.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn flush_bf16(x: __m512, ftz: bool) -> __m512 {
+            match ftz {
+                true => blend(x, sign(x), lt(abs(x), splat(f32::MIN_POSITIVE))),
+                false => x,
+            }
+        }
         /// Every lane x.
         #[inline]
         #[target_feature(enable = "avx512f")]
@@ -1189,27 +1275,6 @@ mod isa {
                 false => x,
             }
         }
-        /// Loads 4 bf16 encodings as binary64 (exact).
-        ///
-        /// # Safety
-        /// `p[i..i + 4]` must be in bounds.
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub unsafe fn load_bf16(p: *const u16, i: usize) -> __m256d {
-            let h = unsafe { _mm_loadl_epi64(p.add(i) as *const __m128i) };
-            _mm256_cvtps_pd(_mm_castsi128_ps(_mm_slli_epi32::<16>(_mm_cvtepu16_epi32(h))))
-        }
-        /// Stores 4 lanes holding bf16 values (or the canonical NaN) as bf16 encodings.
-        ///
-        /// # Safety
-        /// `p[i..i + 4]` must be in bounds.
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub unsafe fn store_bf16(p: *mut u16, i: usize, x: __m256d) {
-            // exact: every lane is a bf16 value; binary64's canonical NaN narrows to 0x7fc0_0000
-            let w = _mm_srli_epi32::<16>(_mm_castps_si128(_mm256_cvtpd_ps(x)));
-            unsafe { _mm_storel_epi64(p.add(i) as *mut __m128i, _mm_packus_epi32(w, w)) }
-        }
         /// Loads 4 `eEmM` encodings as binary64 (exact).
         ///
         /// # Safety
@@ -1395,29 +1460,6 @@ mod isa {
                 true => blend(x, sign(x), lt(abs(x), splat(n.min_normal))),
                 false => x,
             }
-        }
-        /// Loads 8 bf16 encodings as binary64 (exact).
-        ///
-        /// # Safety
-        /// `p[i..i + 8]` must be in bounds.
-        #[inline]
-        #[target_feature(enable = "avx512f,avx2")]
-        pub unsafe fn load_bf16(p: *const u16, i: usize) -> __m512d {
-            let h = unsafe { _mm_loadu_si128(p.add(i) as *const __m128i) };
-            _mm512_cvtps_pd(_mm256_castsi256_ps(_mm256_slli_epi32::<16>(_mm256_cvtepu16_epi32(h))))
-        }
-        /// Stores 8 lanes holding bf16 values (or the canonical NaN) as bf16 encodings.
-        ///
-        /// # Safety
-        /// `p[i..i + 8]` must be in bounds.
-        #[inline]
-        #[target_feature(enable = "avx512f,avx2")]
-        pub unsafe fn store_bf16(p: *mut u16, i: usize, x: __m512d) {
-            // exact: every lane is a bf16 value; binary64's canonical NaN narrows to 0x7fc0_0000
-            let w = _mm256_srli_epi32::<16>(_mm256_castps_si256(_mm512_cvtpd_ps(x)));
-            // packing works per 128-bit half: take quadwords 0 and 2
-            let packed = _mm256_permute4x64_epi64::<0b1000>(_mm256_packus_epi32(w, w));
-            unsafe { _mm_storeu_si128(p.add(i) as *mut __m128i, _mm256_castsi256_si128(packed)) }
         }
         /// Loads 8 `eEmM` encodings as binary64 (exact).
         ///
@@ -1732,9 +1774,7 @@ mod kernels {
                     }
                     // NaN lanes are rare: canonicalise only when one of the results is NaN
                     let canon = |x| $x::blend(x, nan, $x::unord(x, x));
-                    // (uv feeds only a compare: a NaN there marks the lane too, which the
-                    // narrow formats' filter needs; for the others it is NaN only when u or v is)
-                    let nan_lanes = $x::bits($x::or_m($x::unord(t, u), $x::unord(w, uv)));
+                    let nan_lanes = $x::bits($x::or_m($x::unord(t, u), $x::unord(w, w)));
                     nan_bits[k] = nan_lanes;
                     let (t, u, w) = if nan_lanes == 0 { (t, u, w) } else { (canon(t), canon(u), canon(w)) };
                     store(&mut out.t, i, t);
@@ -2119,7 +2159,7 @@ mod kernels {
                 use super::super::isa::$x;
                 use super::*;
                 use crate::format::narrow::Narrow;
-                use crate::format::{Bf16, Soft};
+                use crate::format::Soft;
 
                 /// One format's RTI kernel on lanes `0..full`: its column loads and stores.
                 macro_rules! narrow_rti {
@@ -2148,29 +2188,6 @@ mod kernels {
                             }
                         )
                     }};
-                }
-
-                /// The bf16 RTI kernel on lanes `0..full`.
-                #[target_feature(enable = $feat)]
-                pub fn rti_bf16(
-                    rti: &Rti<Ieee<Bf16>>,
-                    rays: &RaysSoa<u16>,
-                    tris: &TrisSoa<u16>,
-                    out: &mut HitsSoa<u16>,
-                    full: usize,
-                ) {
-                    // SAFETY (loads and stores): the caller checked that every column holds
-                    // `full` lanes; the column types are plain values.
-                    narrow_rti!(
-                        rti,
-                        rays,
-                        tris,
-                        out,
-                        full,
-                        u16,
-                        |c: &Vec<u16>, i: usize| unsafe { $x::load_bf16(c.as_ptr(), i) },
-                        |c: &mut Vec<u16>, i: usize, x| unsafe { $x::store_bf16(c.as_mut_ptr(), i, x) }
-                    );
                 }
 
                 /// The `eEmM` RTI kernel on lanes `0..full`.
@@ -2240,6 +2257,52 @@ mod kernels {
             }
         };
     }
+
+    /// The bf16 RTI kernel on binary32 lanes of one instruction set (`v8`, `v16`): the scalar
+    /// model's own arithmetic (each operation in binary32, then rounded to bf16 in the
+    /// integer lanes), the operand read and the result write flushed under FTZ.
+    macro_rules! bf16_for {
+        ($m:ident, $x:ident, $feat:literal) => {
+            pub(in crate::simd) mod $m {
+                use super::super::isa::$x;
+                use super::*;
+                use crate::format::Bf16;
+
+                /// The bf16 RTI kernel on lanes `0..full`.
+                #[target_feature(enable = $feat)]
+                pub fn rti_bf16(
+                    rti: &Rti<Ieee<Bf16>>,
+                    rays: &RaysSoa<u16>,
+                    tris: &TrisSoa<u16>,
+                    out: &mut HitsSoa<u16>,
+                    full: usize,
+                ) {
+                    let ftz = rti.fmt.opts.subnormals == Subnormals::Ftz;
+                    let thr = rti.fmt.to_f64(rti.det_thr) as f32;
+                    let thr = if ftz && thr.abs() < f32::MIN_POSITIVE { 0.0 } else { thr };
+                    // SAFETY (loads and stores): the caller checked that every column holds
+                    // `full` lanes; the column types are plain values.
+                    rti_kernel!(
+                        $x,
+                        rti,
+                        rays,
+                        tris,
+                        out,
+                        full,
+                        |c: &Vec<u16>, i: usize| $x::flush_bf16(unsafe { $x::load_bf16(c.as_ptr(), i) }, ftz),
+                        |x| $x::flush_bf16($x::round_bf16(x), ftz),
+                        |c: &mut Vec<u16>, i: usize, x| unsafe { $x::store_bf16(c.as_mut_ptr(), i, x) },
+                        thr,
+                        || {},
+                        |_: usize, _: usize, _: &[u32; 8], _: &mut HitsSoa<u16>| {}
+                    );
+                }
+            }
+        };
+    }
+
+    bf16_for!(b8, v8, "avx2");
+    bf16_for!(b16, v16, "avx512f,avx2");
 
     narrow_for!(v4d, "avx2");
     narrow_for!(v8d, "avx512f,avx2");

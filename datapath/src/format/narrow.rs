@@ -1,5 +1,6 @@
 //! Narrow IEEE-like floats held exactly in binary64 lanes: the constants of the SIMD batch
-//! path for bf16 and custom `eEmM` layouts with precision p = M + 1 ≤ 25 and E ≤ 10.
+//! path for custom `eEmM` layouts with precision p = M + 1 ≤ 25 and E ≤ 10 (bf16, whose scalar
+//! model computes in binary32, has its own kernel on binary32 lanes, `datapath::simd`).
 //!
 //! Every operation (+ − × ÷) is computed in binary64 (rounded to nearest-even) and the result
 //! rounded once more to the target, nearest-even, with [`Narrow::round`]'s rule. This equals
@@ -40,8 +41,13 @@
 //! x) rather than g + (x − g) keeps the sign of −0). This is the target rounding whenever x
 //! is ±0 or 2^emin ≤ |x| ≤ max (a value below 2^emin that rounds up to 2^emin does so on both
 //! grids). Any other x (a subnormal result, an overflow, an infinity) makes the lane's value a
-//! NaN, which reaches its t, u or v (every signal of the stage table feeds one of them, and
-//! u + v, which feeds only a compare, is checked too); after each block of vectors the lanes
+//! NaN, which reaches its t, u or v: every signal of the stage table feeds one of them, but
+//! u + v, which feeds only the compare u + v ≤ |det|. A poisoned u + v compares false, as the
+//! model's does where it overflows (±∞ > |det|); a subnormal u + v can make the compare
+//! differ only when the lane is valid otherwise, i.e. u', v' ≥ 0, and then u', v' < 2^emin
+//! (two nonnegative values of which one is ≥ 2^emin sum to ≥ 2^emin), so one of them is a
+//! nonzero subnormal (poisoned: u or v is NaN) or both are zero (u + v = 0, not poisoned).
+//! After each block of vectors the lanes
 //! with a NaN result are recomputed by the scalar model, so a lane's bits are the model's
 //! either way. Under FTZ the operand read flushes in the lanes (a subnormal operand reads as
 //! zero of its sign) and a result that would be subnormal takes the scalar road.
