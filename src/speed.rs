@@ -59,9 +59,9 @@ pub struct SpeedReport {
 /// The RTI batch path of each format family (the SIMD kernels of `datapath::simd`).
 pub const BATCH_PATHS: [&str; 5] = [
     "f32, fp16: binary32 / binary16 kernels (IEEE subnormals, canonical NaN)",
-    "bf16: binary32 lanes, each op rounded to bf16 in integer lanes (IEEE or FTZ, canonical NaN)",
+    "bf16: binary32 lanes, each op rounded to bf16 in integer lanes (IEEE or FTZ, canonical NaN; the slab kernels: IEEE)",
     "eEmM with M <= 24, E <= 10: binary64 lanes, each op rounded to p bits behind a filter, flagged lanes on the scalar model (IEEE or FTZ, canonical NaN)",
-    "scalar model only: f32/fp16 with FTZ or the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float",
+    "scalar model only: f32/fp16 with FTZ or the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float; the slab unit of every format but f32, fp16 and bf16",
     "scalar model only: fixed point qI.F (no batch path yet)",
 ];
 
@@ -324,7 +324,10 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     }));
     // the slab unit over the bounding boxes of the same triangles: pairs, and one ray against
     // every box (the shape a node's or a level's children have)
-    for (name, any) in [("f32", datapath::AnyFormat::F32(f32f)), ("fp16", datapath::AnyFormat::F16(f16f))] {
+    let bf16f: datapath::AnyFormat = "bf16".parse().expect("a built-in format name");
+    for (name, any) in
+        [("f32", datapath::AnyFormat::F32(f32f)), ("fp16", datapath::AnyFormat::F16(f16f)), ("bf16", bf16f)]
+    {
         datapath::with_format!(any, |f| {
             let s = Slab::new(f, SlabConfig::default());
             let (rs, bs) = slab_columns(&s, &cases);

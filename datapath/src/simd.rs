@@ -473,7 +473,7 @@ fn slab_dispatch<F: crate::Format>(
 
 /// A typed slab entry point: the unit's kernel choice, then [`slab_dispatch`].
 macro_rules! slab_entry {
-    ($(#[$doc:meta])* $name:ident, $fmt:ty, $v:ty, $rays:ty, $shape:ident, $which:ident, $kernel:ident, $fp16:expr) => {
+    ($(#[$doc:meta])* $name:ident, $fmt:ty, $v:ty, $rays:ty, $shape:ident, $which:ident, $m8:ident, $m16:ident, $kernel:ident, $fp16:expr) => {
         $(#[$doc])*
         ///
         /// # Panics
@@ -487,7 +487,7 @@ macro_rules! slab_entry {
                 out,
                 which,
                 #[cfg(target_arch = "x86_64")]
-                (kernels::v8::$kernel, kernels::v16::$kernel, $fp16),
+                (kernels::$m8::$kernel, kernels::$m16::$kernel, $fp16),
             )
         }
     };
@@ -495,20 +495,76 @@ macro_rules! slab_entry {
 
 slab_entry!(
     /// [`Slab::batch`] for binary32 on the fastest kernel available; the same bits.
-    slab_batch_f32, Ieee<F32Native>, f32, SlabRaysSoa<f32>, Pairs, slab_kernel_f32, slab_f32, None
+    slab_batch_f32, Ieee<F32Native>, f32, SlabRaysSoa<f32>, Pairs, slab_kernel_f32, v8, v16, slab_f32, None
 );
 slab_entry!(
     /// [`Slab::batch_ray`] (one ray, many boxes) for binary32 on the fastest kernel available; the same bits.
-    slab_ray_f32, Ieee<F32Native>, f32, SlabRay<f32>, One, slab_ray_kernel_f32, slab_f32, None
+    slab_ray_f32, Ieee<F32Native>, f32, SlabRay<f32>, One, slab_ray_kernel_f32, v8, v16, slab_f32, None
 );
 slab_entry!(
     /// [`Slab::batch`] for binary16 on the fastest kernel available; the same bits.
-    slab_batch_f16, Ieee<F16Half>, f16, SlabRaysSoa<f16>, Pairs, slab_kernel_f16, slab_f16, Some(kernels::v32h::slab_f16)
+    slab_batch_f16, Ieee<F16Half>, f16, SlabRaysSoa<f16>, Pairs, slab_kernel_f16, v8, v16, slab_f16, Some(kernels::v32h::slab_f16)
 );
 slab_entry!(
     /// [`Slab::batch_ray`] (one ray, many boxes) for binary16 on the fastest kernel available; the same bits.
-    slab_ray_f16, Ieee<F16Half>, f16, SlabRay<f16>, One, slab_ray_kernel_f16, slab_f16, Some(kernels::v32h::slab_f16)
+    slab_ray_f16, Ieee<F16Half>, f16, SlabRay<f16>, One, slab_ray_kernel_f16, v8, v16, slab_f16, Some(kernels::v32h::slab_f16)
 );
+
+/// The kernel `slab_batch_bf16` uses for this unit on this machine (IEEE subnormals and the
+/// canonical NaN rule; every variant but the directed one).
+pub fn slab_kernel_bf16(s: &Slab<Ieee<Bf16>>) -> Kernel {
+    best_kernel(eligible(&s.fmt) && !s.cfg.directed, WIDEST_NARROW)
+}
+
+/// The kernel `slab_ray_bf16` (one ray, many boxes) uses: every variant, the directed one included.
+pub fn slab_ray_kernel_bf16(s: &Slab<Ieee<Bf16>>) -> Kernel {
+    best_kernel(eligible(&s.fmt) && (!s.cfg.directed || directed_one_ok(&s.cfg)), WIDEST_NARROW)
+}
+
+slab_entry!(
+    /// [`Slab::batch`] for bf16 on the fastest kernel available; the same bits.
+    slab_batch_bf16, Ieee<Bf16>, u16, SlabRaysSoa<u16>, Pairs, slab_kernel_bf16, b8, b16, slab_bf16, None
+);
+slab_entry!(
+    /// [`Slab::batch_ray`] (one ray, many boxes) for bf16 on the fastest kernel available; the same bits.
+    slab_ray_bf16, Ieee<Bf16>, u16, SlabRay<u16>, One, slab_ray_kernel_bf16, b8, b16, slab_bf16, None
+);
+
+/// What the one-ray slab kernels read off a ray value: its sign bit and whether it is a NaN.
+trait RayValue: Copy {
+    /// The sign bit (NaN included).
+    fn sign_bit(self) -> bool;
+    /// Whether the value is a NaN.
+    fn nan(self) -> bool;
+}
+
+impl RayValue for f32 {
+    fn sign_bit(self) -> bool {
+        self.is_sign_negative()
+    }
+    fn nan(self) -> bool {
+        self.is_nan()
+    }
+}
+
+impl RayValue for f16 {
+    fn sign_bit(self) -> bool {
+        self.is_sign_negative()
+    }
+    fn nan(self) -> bool {
+        self.is_nan()
+    }
+}
+
+/// A bf16 encoding.
+impl RayValue for u16 {
+    fn sign_bit(self) -> bool {
+        self >> 15 == 1
+    }
+    fn nan(self) -> bool {
+        self & 0x7fff > 0x7f80
+    }
+}
 
 /// The body of a format-generic dispatch: calls `$f32` (or `$f16`) when the unit and its
 /// columns are the binary32 (binary16) types, the scalar model `$scalar` otherwise.
@@ -565,6 +621,30 @@ where
     by_format!(rti, rays, tris, out, rti_batch_f32, rti_batch_f16, rti.batch(rays, tris, out))
 }
 
+/// A bf16 slab entry point (pairs or one ray).
+type Bf16SlabFn<R> = fn(&Slab<Ieee<Bf16>>, &R, &BoxesSoa<u16>, &mut SlabOutSoa<u16>) -> Kernel;
+
+/// Runs `f` when the unit is bf16's (the rays `R` then hold bf16 columns), `None` otherwise.
+fn bf16_slab<F: crate::Format + 'static, R: 'static, Rb: 'static>(
+    s: &Slab<F>,
+    rays: &R,
+    boxes: &BoxesSoa<F::V>,
+    out: &mut SlabOutSoa<F::V>,
+    f: Bf16SlabFn<Rb>,
+) -> Option<Kernel>
+where
+    F::V: 'static,
+{
+    use std::any::Any;
+    let (unit, a, b) = (s as &dyn Any, rays as &dyn Any, boxes as &dyn Any);
+    match (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
+        (Some(unit), Some(a), Some(b)) => {
+            Some(f(unit, a, b, (out as &mut dyn Any).downcast_mut().expect("the output type follows the format")))
+        }
+        _ => None,
+    }
+}
+
 /// [`Slab::batch`] for any format on the fastest bit-identical implementation.
 ///
 /// # Panics
@@ -578,6 +658,9 @@ pub fn slab_batch<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
+    if let Some(k) = bf16_slab(s, rays, boxes, out, slab_batch_bf16) {
+        return k;
+    }
     by_format!(s, rays, boxes, out, slab_batch_f32, slab_batch_f16, s.batch(rays, boxes, out))
 }
 
@@ -595,6 +678,9 @@ pub fn slab_ray<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
+    if let Some(k) = bf16_slab(s, ray, boxes, out, slab_ray_bf16) {
+        return k;
+    }
     by_format!(s, ray, boxes, out, slab_ray_f32, slab_ray_f16, s.batch_ray(ray, boxes, out))
 }
 
@@ -913,6 +999,26 @@ mod isa {
             let r = _mm256_blendv_epi8(r, _mm256_set1_epi32(1), zero);
             _mm256_castsi256_ps(_mm256_blendv_epi8(r, b, keep))
         }
+        /// [`next_up`] on the bf16 grid, for lanes that hold bf16 values (a step of 2^16 in the
+        /// binary32 encoding; NaN and +inf unchanged, ±0 to the least bf16 subnormal).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn next_up_bf16(v: __m256) -> __m256 {
+            let b = _mm256_castps_si256(v);
+            let keep = _mm256_or_si256(
+                _mm256_castps_si256(_mm256_cmp_ps::<_CMP_UNORD_Q>(v, v)),
+                _mm256_cmpeq_epi32(b, _mm256_set1_epi32(0x7f80_0000)),
+            );
+            let zero = _mm256_cmpeq_epi32(_mm256_and_si256(b, _mm256_set1_epi32(0x7fff_ffff)), _mm256_setzero_si256());
+            // negative: bits - 2^16, positive: bits + 2^16
+            let step = _mm256_add_epi32(
+                _mm256_and_si256(_mm256_srai_epi32::<31>(b), _mm256_set1_epi32(-0x2_0000)),
+                _mm256_set1_epi32(0x1_0000),
+            );
+            let r = _mm256_add_epi32(b, step);
+            let r = _mm256_blendv_epi8(r, _mm256_set1_epi32(0x1_0000), zero);
+            _mm256_castsi256_ps(_mm256_blendv_epi8(r, b, keep))
+        }
         /// [`next_up`] on the binary16 grid, for lanes that hold binary16 values.
         #[inline]
         #[target_feature(enable = "avx2,f16c")]
@@ -1126,6 +1232,24 @@ mod isa {
             let step = _mm512_or_si512(_mm512_srai_epi32::<31>(b), _mm512_set1_epi32(1));
             let r = _mm512_add_epi32(b, step);
             let r = _mm512_mask_blend_epi32(zero, r, _mm512_set1_epi32(1));
+            _mm512_castsi512_ps(_mm512_mask_blend_epi32(keep, r, b))
+        }
+        /// [`next_up`] on the bf16 grid, for lanes that hold bf16 values (a step of 2^16 in the
+        /// binary32 encoding; NaN and +inf unchanged, ±0 to the least bf16 subnormal).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn next_up_bf16(v: __m512) -> __m512 {
+            let b = _mm512_castps_si512(v);
+            let keep =
+                _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(v, v) | _mm512_cmpeq_epi32_mask(b, _mm512_set1_epi32(0x7f80_0000));
+            let zero = _mm512_testn_epi32_mask(b, _mm512_set1_epi32(0x7fff_ffff));
+            // negative: bits - 2^16, positive: bits + 2^16
+            let step = _mm512_add_epi32(
+                _mm512_and_si512(_mm512_srai_epi32::<31>(b), _mm512_set1_epi32(-0x2_0000)),
+                _mm512_set1_epi32(0x1_0000),
+            );
+            let r = _mm512_add_epi32(b, step);
+            let r = _mm512_mask_blend_epi32(zero, r, _mm512_set1_epi32(0x1_0000));
             _mm512_castsi512_ps(_mm512_mask_blend_epi32(keep, r, b))
         }
         /// [`next_up`] on the binary16 grid, for lanes that hold binary16 values.
@@ -1828,13 +1952,13 @@ mod kernels {
             )
         };
         (@prep one $r:ident, $bmin:ident, $bmax:ident, $bcast:ident) => {{
-            let neg = $r.inv_d.map(|x| x.to_bits() >> (8 * std::mem::size_of_val(&x) - 1) == 1);
+            let neg = $r.inv_d.map(RayValue::sign_bit);
             (
                 std::array::from_fn::<_, 3, _>(|a| if neg[a] { $bmax[a] } else { $bmin[a] }),
                 std::array::from_fn::<_, 3, _>(|a| if neg[a] { $bmin[a] } else { $bmax[a] }),
                 ($r.o.map($bcast), $r.inv_d.map($bcast)),
                 ($bcast($r.tmin), $bcast($r.tmax)),
-                $r.tmin.is_nan() || $r.tmax.is_nan(),
+                RayValue::nan($r.tmin) || RayValue::nan($r.tmax),
             )
         }};
         // axis a of lanes i..i + L: (near-plane t, far-plane t)
@@ -2295,6 +2419,32 @@ mod kernels {
                         thr,
                         || {},
                         |_: usize, _: usize, _: &[u32; 8], _: &mut HitsSoa<u16>| {}
+                    );
+                }
+
+                /// The bf16 slab kernel on lanes `0..full` (IEEE subnormals: the dispatch checks).
+                #[target_feature(enable = $feat)]
+                pub fn slab_bf16(
+                    s: &Slab<Ieee<Bf16>>,
+                    rays: SlabRays<u16>,
+                    boxes: &BoxesSoa<u16>,
+                    out: &mut SlabOutSoa<u16>,
+                    full: usize,
+                ) {
+                    // SAFETY (loads and stores): the caller checked that every column holds
+                    // `full` lanes; the column types are plain values.
+                    slab_kernel!(
+                        $x,
+                        s,
+                        rays,
+                        boxes,
+                        out,
+                        full,
+                        |c: *const u16, i: usize| unsafe { $x::load_bf16(c, i) },
+                        |x| $x::round_bf16(x),
+                        |c: *mut u16, i: usize, x| unsafe { $x::store_bf16(c, i, x) },
+                        |v| $x::next_up_bf16(v),
+                        |x: u16| $x::splat(f32::from_bits((x as u32) << 16))
                     );
                 }
             }
