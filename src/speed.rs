@@ -276,9 +276,8 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         k[1] = rti_batch_f16(&r16, &rays16, &tris16, &mut o16)
     }));
     push(row("rti fp16 scalar model", pairs, RTI_OPS, 3, || r16.batch(&rays16, &tris16, &mut o16)));
-    // the narrow float formats' batch path (binary64 lanes, see datapath::format::narrow) beside
-    // their scalar models; wider formats (E = 11 or M > 24, the propagate NaN rule) and fixed
-    // point run the scalar model only
+    // the batch paths of bf16 (binary32 lanes) and e8m16 (binary64 lanes, see
+    // datapath::format::narrow) beside their scalar models (BATCH_PATHS says what runs where)
     for name in ["bf16", "e8m16"] {
         let any: datapath::AnyFormat = name.parse().expect("a built-in format name");
         datapath::with_format!(any, |f| {

@@ -443,13 +443,21 @@ impl<F: Format> Rti<F> {
     /// If a column is shorter than the ray batch.
     pub fn batch_from(&self, rays: &RaysSoa<F::V>, tris: &TrisSoa<F::V>, out: &mut HitsSoa<F::V>, from: usize) {
         for i in from..rays.len() {
-            let o = self.test(&rays.get(i), &tris.get(i));
-            out.hit[i] = o.hit;
-            out.valid[i] = o.valid;
-            out.t[i] = o.t;
-            out.u[i] = o.u;
-            out.v[i] = o.v;
+            self.batch_slot(rays, tris, out, i);
         }
+    }
+
+    /// [`Rti::batch`] on slot `i` alone (the SIMD kernels' tail and filter fall-through).
+    ///
+    /// # Panics
+    /// If a column is shorter than `i + 1`.
+    pub fn batch_slot(&self, rays: &RaysSoa<F::V>, tris: &TrisSoa<F::V>, out: &mut HitsSoa<F::V>, i: usize) {
+        let o = self.test(&rays.get(i), &tris.get(i));
+        out.hit[i] = o.hit;
+        out.valid[i] = o.valid;
+        out.t[i] = o.t;
+        out.u[i] = o.u;
+        out.v[i] = o.v;
     }
 }
 

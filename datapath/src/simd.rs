@@ -262,13 +262,7 @@ fn redo_lanes<F: crate::Format>(
     bad: u32,
 ) {
     for j in (0..32).filter(|&j| bad >> j & 1 == 1) {
-        let i = base + j;
-        let o = rti.test(&rays.get(i), &tris.get(i));
-        out.hit[i] = o.hit;
-        out.valid[i] = o.valid;
-        out.t[i] = o.t;
-        out.u[i] = o.u;
-        out.v[i] = o.v;
+        rti.batch_slot(rays, tris, out, base + j);
     }
 }
 
@@ -341,12 +335,12 @@ pub fn op_batch_soft(f: &Ieee<Soft>, op: crate::rti::Op, a: &[u64], b: &[u64], o
     assert!(a.len() == b.len() && b.len() == out.len(), "batch lengths differ");
     assert!(op != Op::Logic, "op_batch_soft computes arithmetic only");
     let which = op_kernel_soft(f);
-    let lanes = match which {
-        Kernel::Scalar => usize::MAX,
-        Kernel::Avx2 => 4,
-        _ => 8,
+    // binary64 lanes per vector: 4 on AVX2, 8 on AVX-512F; none on the scalar model
+    let full = match which {
+        Kernel::Scalar => 0,
+        Kernel::Avx2 => a.len() / 4 * 4,
+        _ => a.len() / 8 * 8,
     };
-    let full = if lanes == usize::MAX { 0 } else { a.len() / lanes * lanes };
     let scalar = |i: usize| match op {
         Op::Add => f.add(a[i], b[i]),
         Op::Sub => f.sub(a[i], b[i]),
@@ -566,28 +560,22 @@ impl RayValue for u16 {
     }
 }
 
-/// The body of a format-generic dispatch: calls `$f32` (or `$f16`) when the unit and its
-/// columns are the binary32 (binary16) types, the scalar model `$scalar` otherwise.
+/// The body of a format-generic dispatch: calls the first of the `typed` entry points whose
+/// unit and column types are the arguments', the scalar model `$scalar` when none is.
 macro_rules! by_format {
-    ($unit:expr, $a:expr, $b:expr, $out:expr, $f32:ident, $f16:ident, $scalar:expr) => {{
+    ($unit:expr, $a:expr, $b:expr, $out:expr, [$($typed:ident),+], $scalar:expr) => {{
         use std::any::Any;
         let (unit, a, b) = ($unit as &dyn Any, $a as &dyn Any, $b as &dyn Any);
-        if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
-            return $f32(
-                unit,
-                a,
-                b,
-                ($out as &mut dyn Any).downcast_mut().expect("the output type follows the format"),
-            );
-        }
-        if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
-            return $f16(
-                unit,
-                a,
-                b,
-                ($out as &mut dyn Any).downcast_mut().expect("the output type follows the format"),
-            );
-        }
+        $(
+            if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
+                return $typed(
+                    unit,
+                    a,
+                    b,
+                    ($out as &mut dyn Any).downcast_mut().expect("the output type follows the format"),
+                );
+            }
+        )+
         $scalar;
         Kernel::Scalar
     }};
@@ -607,42 +595,14 @@ pub fn rti_batch<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
-    {
-        use std::any::Any;
-        let (unit, a, b) = (rti as &dyn Any, rays as &dyn Any, tris as &dyn Any);
-        const O: &str = "the output type follows the format";
-        if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
-            return rti_batch_bf16(unit, a, b, (out as &mut dyn Any).downcast_mut().expect(O));
-        }
-        if let (Some(unit), Some(a), Some(b)) = (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
-            return rti_batch_soft(unit, a, b, (out as &mut dyn Any).downcast_mut().expect(O));
-        }
-    }
-    by_format!(rti, rays, tris, out, rti_batch_f32, rti_batch_f16, rti.batch(rays, tris, out))
-}
-
-/// A bf16 slab entry point (pairs or one ray).
-type Bf16SlabFn<R> = fn(&Slab<Ieee<Bf16>>, &R, &BoxesSoa<u16>, &mut SlabOutSoa<u16>) -> Kernel;
-
-/// Runs `f` when the unit is bf16's (the rays `R` then hold bf16 columns), `None` otherwise.
-fn bf16_slab<F: crate::Format + 'static, R: 'static, Rb: 'static>(
-    s: &Slab<F>,
-    rays: &R,
-    boxes: &BoxesSoa<F::V>,
-    out: &mut SlabOutSoa<F::V>,
-    f: Bf16SlabFn<Rb>,
-) -> Option<Kernel>
-where
-    F::V: 'static,
-{
-    use std::any::Any;
-    let (unit, a, b) = (s as &dyn Any, rays as &dyn Any, boxes as &dyn Any);
-    match (unit.downcast_ref(), a.downcast_ref(), b.downcast_ref()) {
-        (Some(unit), Some(a), Some(b)) => {
-            Some(f(unit, a, b, (out as &mut dyn Any).downcast_mut().expect("the output type follows the format")))
-        }
-        _ => None,
-    }
+    by_format!(
+        rti,
+        rays,
+        tris,
+        out,
+        [rti_batch_f32, rti_batch_f16, rti_batch_bf16, rti_batch_soft],
+        rti.batch(rays, tris, out)
+    )
 }
 
 /// [`Slab::batch`] for any format on the fastest bit-identical implementation.
@@ -658,10 +618,7 @@ pub fn slab_batch<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
-    if let Some(k) = bf16_slab(s, rays, boxes, out, slab_batch_bf16) {
-        return k;
-    }
-    by_format!(s, rays, boxes, out, slab_batch_f32, slab_batch_f16, s.batch(rays, boxes, out))
+    by_format!(s, rays, boxes, out, [slab_batch_f32, slab_batch_f16, slab_batch_bf16], s.batch(rays, boxes, out))
 }
 
 /// [`Slab::batch_ray`] (one ray, many boxes) for any format on the fastest bit-identical
@@ -678,10 +635,7 @@ pub fn slab_ray<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
-    if let Some(k) = bf16_slab(s, ray, boxes, out, slab_ray_bf16) {
-        return k;
-    }
-    by_format!(s, ray, boxes, out, slab_ray_f32, slab_ray_f16, s.batch_ray(ray, boxes, out))
+    by_format!(s, ray, boxes, out, [slab_ray_f32, slab_ray_f16, slab_ray_bf16], s.batch_ray(ray, boxes, out))
 }
 
 /// Pairs per chunk of [`rti_stream`]: 256 pairs × (15 input + 3 output columns) × 4 bytes plus
@@ -987,16 +941,26 @@ mod isa {
         #[inline]
         #[target_feature(enable = "avx2")]
         pub fn next_up(v: __m256) -> __m256 {
+            next_up_by(v, 1)
+        }
+        /// The step up by `unit` encodings of binary32 (1: binary32's grid, 2^16: bf16's): NaN
+        /// and +inf unchanged, ±0 to `unit`, negative values `unit` encodings toward zero.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn next_up_by(v: __m256, unit: i32) -> __m256 {
             let b = _mm256_castps_si256(v);
             let keep = _mm256_or_si256(
                 _mm256_castps_si256(_mm256_cmp_ps::<_CMP_UNORD_Q>(v, v)),
                 _mm256_cmpeq_epi32(b, _mm256_set1_epi32(0x7f80_0000)),
             );
             let zero = _mm256_cmpeq_epi32(_mm256_and_si256(b, _mm256_set1_epi32(0x7fff_ffff)), _mm256_setzero_si256());
-            // negative: bits - 1, positive: bits + 1
-            let step = _mm256_or_si256(_mm256_srai_epi32::<31>(b), _mm256_set1_epi32(1));
+            // negative: bits - unit, positive: bits + unit
+            let step = _mm256_add_epi32(
+                _mm256_and_si256(_mm256_srai_epi32::<31>(b), _mm256_set1_epi32(-2 * unit)),
+                _mm256_set1_epi32(unit),
+            );
             let r = _mm256_add_epi32(b, step);
-            let r = _mm256_blendv_epi8(r, _mm256_set1_epi32(1), zero);
+            let r = _mm256_blendv_epi8(r, _mm256_set1_epi32(unit), zero);
             _mm256_castsi256_ps(_mm256_blendv_epi8(r, b, keep))
         }
         /// [`next_up`] on the bf16 grid, for lanes that hold bf16 values (a step of 2^16 in the
@@ -1004,20 +968,7 @@ mod isa {
         #[inline]
         #[target_feature(enable = "avx2")]
         pub fn next_up_bf16(v: __m256) -> __m256 {
-            let b = _mm256_castps_si256(v);
-            let keep = _mm256_or_si256(
-                _mm256_castps_si256(_mm256_cmp_ps::<_CMP_UNORD_Q>(v, v)),
-                _mm256_cmpeq_epi32(b, _mm256_set1_epi32(0x7f80_0000)),
-            );
-            let zero = _mm256_cmpeq_epi32(_mm256_and_si256(b, _mm256_set1_epi32(0x7fff_ffff)), _mm256_setzero_si256());
-            // negative: bits - 2^16, positive: bits + 2^16
-            let step = _mm256_add_epi32(
-                _mm256_and_si256(_mm256_srai_epi32::<31>(b), _mm256_set1_epi32(-0x2_0000)),
-                _mm256_set1_epi32(0x1_0000),
-            );
-            let r = _mm256_add_epi32(b, step);
-            let r = _mm256_blendv_epi8(r, _mm256_set1_epi32(0x1_0000), zero);
-            _mm256_castsi256_ps(_mm256_blendv_epi8(r, b, keep))
+            next_up_by(v, 0x1_0000)
         }
         /// [`next_up`] on the binary16 grid, for lanes that hold binary16 values.
         #[inline]
@@ -1224,14 +1175,24 @@ mod isa {
         #[inline]
         #[target_feature(enable = "avx512f")]
         pub fn next_up(v: __m512) -> __m512 {
+            next_up_by(v, 1)
+        }
+        /// The step up by `unit` encodings of binary32 (1: binary32's grid, 2^16: bf16's): NaN
+        /// and +inf unchanged, ±0 to `unit`, negative values `unit` encodings toward zero.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn next_up_by(v: __m512, unit: i32) -> __m512 {
             let b = _mm512_castps_si512(v);
             let keep =
                 _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(v, v) | _mm512_cmpeq_epi32_mask(b, _mm512_set1_epi32(0x7f80_0000));
             let zero = _mm512_testn_epi32_mask(b, _mm512_set1_epi32(0x7fff_ffff));
-            // negative: bits - 1, positive: bits + 1
-            let step = _mm512_or_si512(_mm512_srai_epi32::<31>(b), _mm512_set1_epi32(1));
+            // negative: bits - unit, positive: bits + unit
+            let step = _mm512_add_epi32(
+                _mm512_and_si512(_mm512_srai_epi32::<31>(b), _mm512_set1_epi32(-2 * unit)),
+                _mm512_set1_epi32(unit),
+            );
             let r = _mm512_add_epi32(b, step);
-            let r = _mm512_mask_blend_epi32(zero, r, _mm512_set1_epi32(1));
+            let r = _mm512_mask_blend_epi32(zero, r, _mm512_set1_epi32(unit));
             _mm512_castsi512_ps(_mm512_mask_blend_epi32(keep, r, b))
         }
         /// [`next_up`] on the bf16 grid, for lanes that hold bf16 values (a step of 2^16 in the
@@ -1239,18 +1200,7 @@ mod isa {
         #[inline]
         #[target_feature(enable = "avx512f")]
         pub fn next_up_bf16(v: __m512) -> __m512 {
-            let b = _mm512_castps_si512(v);
-            let keep =
-                _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(v, v) | _mm512_cmpeq_epi32_mask(b, _mm512_set1_epi32(0x7f80_0000));
-            let zero = _mm512_testn_epi32_mask(b, _mm512_set1_epi32(0x7fff_ffff));
-            // negative: bits - 2^16, positive: bits + 2^16
-            let step = _mm512_add_epi32(
-                _mm512_and_si512(_mm512_srai_epi32::<31>(b), _mm512_set1_epi32(-0x2_0000)),
-                _mm512_set1_epi32(0x1_0000),
-            );
-            let r = _mm512_add_epi32(b, step);
-            let r = _mm512_mask_blend_epi32(zero, r, _mm512_set1_epi32(0x1_0000));
-            _mm512_castsi512_ps(_mm512_mask_blend_epi32(keep, r, b))
+            next_up_by(v, 0x1_0000)
         }
         /// [`next_up`] on the binary16 grid, for lanes that hold binary16 values.
         #[inline]
@@ -1274,6 +1224,41 @@ mod isa {
         let r = _mm512_add_epi16(b, step);
         let r = _mm512_mask_blend_epi16(zero, r, _mm512_set1_epi16(1));
         _mm512_mask_blend_epi16(keep, r, b)
+    }
+
+    /// The narrow formats' rounding, filter and flush, in the ops of the ISA module that
+    /// invokes it (`v4d`, `v8d`: binary64 lanes, each with its own `pred`).
+    macro_rules! narrow_ops {
+        ($feat:literal, $v:ty) => {
+            /// Every lane rounded to the format's precision p, nearest-even, by Veltkamp's
+            /// splitting (g = x·(2^S + 1), then g − (g − x)); correct for |x| in [2^emin, max]
+            /// and for zeros, which is what [`poison`] checks.
+            #[inline]
+            #[target_feature(enable = $feat)]
+            pub fn split(x: $v, n: &Narrow) -> $v {
+                let g = mul(x, splat(n.split));
+                // g − (g − x) is g + (x − g) (nearest-even rounding is symmetric) with -0 kept
+                sub(g, sub(g, x))
+            }
+            /// `r`, or a NaN where the unrounded `x` lies outside {±0} ∪ [2^emin, max] (a
+            /// subnormal, an overflow, an infinity): the NaN reaches the lane's t, u or v, and
+            /// the lane is recomputed by the scalar model.
+            #[inline]
+            #[target_feature(enable = $feat)]
+            pub fn poison(r: $v, x: $v, n: &Narrow) -> $v {
+                let out = or_m(lt(splat(n.max_finite), abs(x)), lt(pred(x), splat(n.below_min)));
+                blend(r, canonical_nan(), out)
+            }
+            /// Under FTZ, subnormal lanes read as zeros of the same sign (the operand read).
+            #[inline]
+            #[target_feature(enable = $feat)]
+            pub fn flush(x: $v, n: &Narrow) -> $v {
+                match n.ftz {
+                    true => blend(x, sign(x), lt(abs(x), splat(n.min_normal))),
+                    false => x,
+                }
+            }
+        };
     }
 
     /// AVX2, 4 binary64 lanes holding a narrow format's values exactly (see
@@ -1365,40 +1350,13 @@ mod isa {
             // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
             unsafe { (p.add(i) as *mut u32).write_unaligned(super::SPREAD[bits(m) as usize] as u32) }
         }
-        /// Every lane rounded to the format's precision p, nearest-even, by Veltkamp's
-        /// splitting (g = x·(2^S + 1), then g − (g − x)); correct for |x| in [2^emin, max]
-        /// and for zeros, which is what [`poison`] checks.
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn split(x: __m256d, n: &Narrow) -> __m256d {
-            let g = mul(x, splat(n.split));
-            // g − (g − x) is g + (x − g) (nearest-even rounding is symmetric) with -0 kept
-            sub(g, sub(g, x))
-        }
         /// The binary64 just below each lane's magnitude (a NaN for ±0).
         #[inline]
         #[target_feature(enable = "avx2")]
         fn pred(x: __m256d) -> __m256d {
             _mm256_castsi256_pd(_mm256_sub_epi64(_mm256_castpd_si256(abs(x)), int(1)))
         }
-        /// `r`, or a NaN where the unrounded `x` lies outside {±0} ∪ [2^emin, max] (a
-        /// subnormal, an overflow, an infinity): the NaN reaches the lane's t, u or v, and
-        /// the lane is recomputed by the scalar model.
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn poison(r: __m256d, x: __m256d, n: &Narrow) -> __m256d {
-            let out = or_m(lt(splat(n.max_finite), abs(x)), lt(pred(x), splat(n.below_min)));
-            blend(r, _mm256_castsi256_pd(int(0x7ff8_0000_0000_0000)), out)
-        }
-        /// Under FTZ, subnormal lanes read as zeros of the same sign (the operand read).
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn flush(x: __m256d, n: &Narrow) -> __m256d {
-            match n.ftz {
-                true => blend(x, sign(x), lt(abs(x), splat(n.min_normal))),
-                false => x,
-            }
-        }
+        narrow_ops!("avx2", __m256d);
         /// Loads 4 `eEmM` encodings as binary64 (exact).
         ///
         /// # Safety
@@ -1551,40 +1509,13 @@ mod isa {
             // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
             unsafe { (p.add(i) as *mut u64).write_unaligned(super::SPREAD[m as usize]) }
         }
-        /// Every lane rounded to the format's precision p, nearest-even, by Veltkamp's
-        /// splitting (g = x·(2^S + 1), then g − (g − x)); correct for |x| in [2^emin, max]
-        /// and for zeros, which is what [`poison`] checks.
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn split(x: __m512d, n: &Narrow) -> __m512d {
-            let g = mul(x, splat(n.split));
-            // g − (g − x) is g + (x − g) (nearest-even rounding is symmetric) with -0 kept
-            sub(g, sub(g, x))
-        }
         /// The binary64 just below each lane's magnitude (a NaN for ±0).
         #[inline]
         #[target_feature(enable = "avx512f")]
         fn pred(x: __m512d) -> __m512d {
             fb(_mm512_sub_epi64(ib(abs(x)), int(1)))
         }
-        /// `r`, or a NaN where the unrounded `x` lies outside {±0} ∪ [2^emin, max] (a
-        /// subnormal, an overflow, an infinity): the NaN reaches the lane's t, u or v, and
-        /// the lane is recomputed by the scalar model.
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn poison(r: __m512d, x: __m512d, n: &Narrow) -> __m512d {
-            let out = or_m(lt(splat(n.max_finite), abs(x)), lt(pred(x), splat(n.below_min)));
-            blend(r, fb(int(0x7ff8_0000_0000_0000)), out)
-        }
-        /// Under FTZ, subnormal lanes read as zeros of the same sign (the operand read).
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn flush(x: __m512d, n: &Narrow) -> __m512d {
-            match n.ftz {
-                true => blend(x, sign(x), lt(abs(x), splat(n.min_normal))),
-                false => x,
-            }
-        }
+        narrow_ops!("avx512f", __m512d);
         /// Loads 8 `eEmM` encodings as binary64 (exact).
         ///
         /// # Safety

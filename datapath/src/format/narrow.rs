@@ -3,8 +3,9 @@
 //! model computes in binary32, has its own kernel on binary32 lanes, `datapath::simd`).
 //!
 //! Every operation (+ − × ÷) is computed in binary64 (rounded to nearest-even) and the result
-//! rounded once more to the target, nearest-even, with [`Narrow::round`]'s rule. This equals
-//! the target's correctly rounded operation:
+//! rounded once more to the target, nearest-even (subnormals on the target's subnormal grid,
+//! overflow to ±∞, under FTZ a subnormal result flushed to zero of its sign). This equals the
+//! target's correctly rounded operation:
 //!
 //! * **Double rounding is innocuous** for + − × ÷ when the wide precision is at least 2p + 2
 //!   (Figueroa, "When is double rounding innocuous?", SIGNUM 1995): binary64 has 53 ≥ 2·25 + 2
@@ -23,19 +24,7 @@
 //! * E = 11 layouts share binary64's exponent range, where binary64's own subnormals lose
 //!   bits: they keep the scalar model.
 //!
-//! The target rounding of a binary64 value x, in full ([`Narrow::round`]):
-//! 1. NaN stays NaN (its payload is never read: the NaN rule is canonical, see below);
-//! 2. |x| < 2^emin (the target's subnormal range): (|x| + C) − C with C = 2^(emin − M + 52),
-//!    whose unit in the last place is the target's subnormal step 2^(emin − M): binary64's
-//!    nearest-even addition rounds |x| to that step, the subtraction is exact; the sign of x
-//!    is put back (a result that rounds to zero is a zero of x's sign);
-//! 3. otherwise the binary64 encoding b is rounded to M fraction bits with integer
-//!    arithmetic: b + (2^(S−1) − 1) + ((b >> S) & 1), low S = 52 − M bits cleared (ties to
-//!    even; a carry out of the fraction steps the exponent, as it must);
-//! 4. a result above the largest finite value becomes ±∞ (nearest-even overflow);
-//! 5. under FTZ, a result that is subnormal after rounding becomes zero of the same sign.
-//!
-//! The lanes take a faster road with a filter (CGAL's filtered-predicate pattern): each result
+//! The lanes round with a filter (CGAL's filtered-predicate pattern): each result
 //! x is rounded to p bits by Veltkamp's splitting, g = x·(2^S + 1), r = g − (g − x) (with
 //! nearest-even binary64 arithmetic, r is x rounded to 53 − S = p bits, ties to even; g − (g −
 //! x) rather than g + (x − g) keeps the sign of −0). This is the target rounding whenever x
@@ -65,14 +54,6 @@ pub struct Narrow {
     pub lay: FloatLayout,
     /// Under FTZ: subnormal operands read as zero, subnormal results become zero.
     pub ftz: bool,
-    /// S = 52 − M, the binary64 fraction bits the rounding drops.
-    pub shift: u32,
-    /// 2^(S−1) − 1, the rounding increment below a tie.
-    pub half: u64,
-    /// The mask that clears the low S bits.
-    pub keep: u64,
-    /// C = 2^(emin − M + 52), the subnormal rounding constant.
-    pub magic: f64,
     /// 2^emin, the smallest normal magnitude.
     pub min_normal: f64,
     /// The largest finite magnitude.
@@ -81,7 +62,7 @@ pub struct Narrow {
     pub step: f64,
     /// 2^(M − emin), the inverse of the step (encode).
     pub inv_step: f64,
-    /// 2^S + 1, Veltkamp's splitting constant for rounding to p = 53 − S bits.
+    /// 2^S + 1 with S = 52 − M, Veltkamp's splitting constant for rounding to p = 53 − S bits.
     pub split: f64,
     /// The binary64 just below 2^emin (the filter's subnormal threshold).
     pub below_min: f64,
@@ -94,66 +75,15 @@ impl Narrow {
             return None;
         }
         let m = lay.man_bits as i32;
-        let shift = 52 - lay.man_bits;
         Some(Self {
             lay,
             ftz: opts.subnormals == Subnormals::Ftz,
-            shift,
-            half: (1u64 << (shift - 1)) - 1,
-            keep: !((1u64 << shift) - 1),
-            magic: super::layout::pow2(lay.emin() - m + 52),
             min_normal: lay.min_normal(),
             max_finite: lay.max_finite(),
             step: super::layout::pow2(lay.emin() - m),
             inv_step: super::layout::pow2(m - lay.emin()),
-            split: super::layout::pow2(shift as i32) + 1.0,
+            split: super::layout::pow2(52 - m) + 1.0,
             below_min: f64::from_bits(lay.min_normal().to_bits() - 1),
         })
-    }
-
-    /// The target rounding of a binary64 value (steps 1–5 of the module documentation); the
-    /// scalar statement of what the lanes compute.
-    pub fn round(&self, x: f64) -> f64 {
-        if x.is_nan() {
-            return x;
-        }
-        let a = x.abs();
-        let r = if a < self.min_normal {
-            ((a + self.magic) - self.magic).copysign(x)
-        } else {
-            let b = x.to_bits();
-            f64::from_bits((b + self.half + ((b >> self.shift) & 1)) & self.keep)
-        };
-        let r = if r.abs() > self.max_finite { f64::INFINITY.copysign(x) } else { r };
-        if self.ftz && r.abs() < self.min_normal {
-            0.0f64.copysign(r)
-        } else {
-            r
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The rounding equals the soft-float layout's correctly rounded conversion on every
-    /// binary64 neighbour of every e5m4 value and midpoint (IEEE subnormals).
-    #[test]
-    fn round_equals_the_correctly_rounded_conversion() {
-        let lay = FloatLayout::validate(5, 4).unwrap();
-        let n = Narrow::of(lay, FpOpts::default()).unwrap();
-        for b in 0..(1u64 << lay.width()) {
-            let v = lay.to_f64(b);
-            if !v.is_finite() {
-                continue;
-            }
-            let next = lay.to_f64(b + 1);
-            let mid = if next.is_finite() && !next.is_nan() { (v + next) / 2.0 } else { v * 1.03 };
-            for x in [v, mid, f64::from_bits(mid.to_bits() + 1), f64::from_bits(mid.to_bits() - 1)] {
-                let want = lay.to_f64(lay.from_f64(x));
-                assert_eq!(n.round(x).to_bits(), want.to_bits(), "x = {x:e}");
-            }
-        }
     }
 }
