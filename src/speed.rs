@@ -62,7 +62,7 @@ pub const BATCH_PATHS: [&str; 5] = [
     "bf16: binary32 lanes, each op rounded to bf16 in integer lanes (IEEE or FTZ, canonical NaN; the slab kernels: IEEE)",
     "eEmM with M <= 24, E <= 10: binary64 lanes, each op rounded to p bits behind a filter, flagged lanes on the scalar model (IEEE or FTZ, canonical NaN)",
     "scalar model only: f32/fp16 with FTZ or the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float; the slab unit of every format but f32, fp16 and bf16",
-    "scalar model only: fixed point qI.F (no batch path yet)",
+    "fixed point qI.F with I + F <= 32: i64 lanes, every rounding, overflow and division mode (datapath::fixed_lanes); wider fixed point: scalar model only",
 ];
 
 /// Adds and multiplies on independent accumulators for about `secs`, on the widest vector
@@ -276,9 +276,10 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         k[1] = rti_batch_f16(&r16, &rays16, &tris16, &mut o16)
     }));
     push(row("rti fp16 scalar model", pairs, RTI_OPS, 3, || r16.batch(&rays16, &tris16, &mut o16)));
-    // the batch paths of bf16 (binary32 lanes) and e8m16 (binary64 lanes, see
-    // datapath::format::narrow) beside their scalar models (BATCH_PATHS says what runs where)
-    for name in ["bf16", "e8m16"] {
+    // the batch paths of bf16 (binary32 lanes), e8m16 (binary64 lanes, see
+    // datapath::format::narrow) and q16.16 (i64 lanes, datapath::fixed_lanes) beside their
+    // scalar models (BATCH_PATHS says what runs where)
+    for name in ["bf16", "e8m16", "q16.16"] {
         let any: datapath::AnyFormat = name.parse().expect("a built-in format name");
         datapath::with_format!(any, |f| {
             let rti = Rti::new(f, RtiConfig::default());
@@ -540,7 +541,7 @@ pub fn render(s: &SpeedReport) -> String {
     // each format's RTI batch path against the binary32 kernel of the same run
     let rate = |name: &str| s.rows.iter().find(|r| r.name == name).map(|r| r.mtests_per_s);
     if let Some(f32k) = rate("rti f32 kernel (dispatch)").filter(|&r| r > 0.0) {
-        let ratios: Vec<String> = ["fp16", "bf16", "e8m16"]
+        let ratios: Vec<String> = ["fp16", "bf16", "e8m16", "q16.16"]
             .iter()
             .filter_map(|f| rate(&format!("rti {f} kernel (dispatch)")).map(|r| format!("{f} {:.3}", r / f32k)))
             .collect();

@@ -41,6 +41,7 @@
 //! The AVX-512F and AVX512-FP16 kernels are tested by the same property tests as the AVX2
 //! ones, on an emulated machine with both (`emu/avx512`, Bochs 3.0) when the host has neither.
 
+pub use crate::fixed_lanes::rti_batch_fixed;
 use crate::format::narrow::Narrow;
 use crate::format::{Bf16, DivMode, F16Half, F32Native, Ieee, IeeeBackend, NanMode, Soft, Subnormals};
 use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
@@ -107,7 +108,7 @@ fn eligible<B: crate::format::IeeeBackend>(f: &Ieee<B>) -> bool {
 
 /// The widest kernel this machine has within this thread's cap and `useful` (the widest
 /// kernel the format has), if `eligible`.
-fn best_kernel(eligible: bool, useful: Kernel) -> Kernel {
+pub(crate) fn best_kernel(eligible: bool, useful: Kernel) -> Kernel {
     match eligible {
         true => widest_here().min(CAP.with(|c| c.get())).min(useful),
         false => Kernel::Scalar,
@@ -140,7 +141,7 @@ type RtiKernelFn<F> = unsafe fn(
 );
 
 /// Every column of an RTI batch holds `n` slots.
-fn rti_columns_ok<V>(rays: &RaysSoa<V>, tris: &TrisSoa<V>, out: &HitsSoa<V>, n: usize) -> bool {
+pub(crate) fn rti_columns_ok<V>(rays: &RaysSoa<V>, tris: &TrisSoa<V>, out: &HitsSoa<V>, n: usize) -> bool {
     rays.o.iter().chain(&rays.d).all(|c| c.len() == n)
         && rays.tmax.len() == n
         && tris.v.iter().flatten().all(|c| c.len() == n)
@@ -600,7 +601,7 @@ where
         rays,
         tris,
         out,
-        [rti_batch_f32, rti_batch_f16, rti_batch_bf16, rti_batch_soft],
+        [rti_batch_f32, rti_batch_f16, rti_batch_bf16, rti_batch_soft, rti_batch_fixed],
         rti.batch(rays, tris, out)
     )
 }

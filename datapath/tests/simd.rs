@@ -585,7 +585,7 @@ mod generic {
     #[test]
     fn the_generic_dispatch_picks_the_kernel_by_format() {
         let best = *kernels_here().last().unwrap();
-        for name in ["f32", "fp16", "bf16", "q8.24:divide"] {
+        for name in ["f32", "fp16", "bf16", "q8.24:divide", "q20.20"] {
             let any: AnyFormat = name.parse().unwrap();
             with_format!(any, |f| {
                 let rti = Rti::new(f, RtiConfig::default());
@@ -600,8 +600,13 @@ mod generic {
                     "fp16" => best,
                     _ => Kernel::Scalar,
                 };
-                // bf16 runs its own kernels (binary32 lanes), RTI and slab
-                let rti_expect = if name == "bf16" { best.min(datapath::simd::WIDEST_NARROW) } else { expect };
+                // bf16 runs its own kernels (binary32 lanes), RTI and slab; fixed point of at
+                // most 32 bits its RTI kernel (i64 lanes), its slab unit the scalar model
+                let slab_expect = if name == "bf16" { best.min(datapath::simd::WIDEST_NARROW) } else { expect };
+                let rti_expect = match name {
+                    "q8.24:divide" => best.min(super::widest_fixed()),
+                    _ => slab_expect,
+                };
                 assert_eq!(k, rti_expect, "{name}");
                 let s = Slab::new(f, SlabConfig::named("conservative").unwrap());
                 let (mut sr, mut sb) = (SlabRaysSoa::default(), datapath::slab::BoxesSoa::default());
@@ -616,7 +621,7 @@ mod generic {
                 s.batch(&sr, &sb, &mut x);
                 let k = slab_batch(&s, &sr, &sb, &mut y);
                 assert_eq!(x.hit, y.hit);
-                assert_eq!(k, rti_expect, "{name}");
+                assert_eq!(k, slab_expect, "{name}");
             });
         }
     }
@@ -765,5 +770,132 @@ fn narrow_ops_in_binary64_lanes_equal_the_soft_float_model_exhaustively() {
                 }
             }
         }
+    }
+}
+
+/// Fixed-point formats of every rounding, overflow and division mode, at widths that take
+/// each of the lanes' division paths (one correction step; two under wrap when a quotient can
+/// reach 2^53: q8.24, q1.31; no fraction bits: q32.0).
+const FIXED_NAMES: [&str; 8] = ["q16.16", "q8.24", "q1.31", "q4.4", "q32.0", "q12.20", "q2.6", "q20.4"];
+const FIXED_MODES: [&str; 16] = [
+    "",
+    ":ceil",
+    ":trunc",
+    ":nearest",
+    ":wrap",
+    ":ceil+wrap",
+    ":trunc+wrap",
+    ":nearest+wrap",
+    ":divide",
+    ":ceil+divide",
+    ":trunc+divide",
+    ":nearest+divide",
+    ":wrap+divide",
+    ":ceil+wrap+divide",
+    ":trunc+wrap+divide",
+    ":nearest+wrap+divide",
+];
+
+/// The widest fixed-point kernel this machine can run: the 8-lane kernel needs AVX-512DQ too.
+fn widest_fixed() -> Kernel {
+    #[cfg(target_arch = "x86_64")]
+    if !std::arch::is_x86_feature_detected!("avx512dq") {
+        return Kernel::Avx2;
+    }
+    datapath::fixed_lanes::WIDEST_FIXED
+}
+
+fn fixed(name: &str) -> datapath::format::Fixed {
+    match name.parse::<datapath::AnyFormat>().unwrap() {
+        datapath::AnyFormat::Fixed(f) => f,
+        _ => unreachable!("{name} is fixed point"),
+    }
+}
+
+/// The edge raw values of a fixed-point format: 0, ±1 step, the most positive and most
+/// negative values and their neighbours, ±1, ±1/2 and ±half the range.
+fn fixed_specials(f: &datapath::format::Fixed) -> Vec<u64> {
+    let (lo, hi) = (f.min_raw(), f.max_raw());
+    let one = f.one();
+    [0, 1, -1, hi, hi - 1, lo, lo + 1, one, -one, one / 2, -one / 2, hi / 2, lo / 2, hi / 2 + 1]
+        .map(|v| f.to_bits(v.clamp(lo, hi)))
+        .to_vec()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+    /// The fixed-point i64-lane RTI kernels return the scalar model's bits on every kernel,
+    /// every rounding, overflow and division mode, both cullings.
+    #[test]
+    fn fixed_point_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, name in 0usize..8, mode in 0usize..16, cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-3), Just(0.5)]) {
+        use datapath::fixed_lanes::{kernel_fixed, rti_batch_fixed};
+        let f = fixed(&format!("{}{}", FIXED_NAMES[name], FIXED_MODES[mode]));
+        let rti = Rti::new(f, config(cull, thr));
+        let (rays, tris) = columns(&f, n, seed, &fixed_specials(&f));
+        let mut a = HitsSoa::with_len(n);
+        rti.batch(&rays, &tris, &mut a);
+        for k in kernels_here() {
+            let mut out = HitsSoa::with_len(n);
+            let ran = with_kernel_cap(k, || rti_batch_fixed(&rti, &rays, &tris, &mut out));
+            prop_assert_eq!(ran, with_kernel_cap(k, || kernel_fixed(&f)));
+            prop_assert_eq!(ran, k.min(widest_fixed()));
+            same(&f, &a, &out)?;
+        }
+    }
+}
+
+/// Every fixed-point operation on i64 lanes equals the scalar model (exact i128 arithmetic):
+/// every operand pair of the 8-bit formats, 2^16 random and edge pairs of the wider ones (2^10
+/// of each under emu/avx512), in every rounding, overflow and division mode, on every kernel.
+#[test]
+fn fixed_point_ops_in_i64_lanes_equal_the_i128_model() {
+    use datapath::fixed_lanes::op_batch_fixed;
+    use datapath::rti::Op;
+    for name in FIXED_NAMES {
+        for mode in FIXED_MODES {
+            let full = format!("{name}{mode}");
+            let f = fixed(&full);
+            let w = f.width();
+            // on the emulated machine (emu/avx512) every format takes 2^10 random pairs
+            let emulated = std::env::var_os("RAYPIPE_EXPECT_KERNEL").is_some();
+            let (a, b): (Vec<i64>, Vec<i64>) = if w <= 8 && !emulated {
+                (0..1u64 << (2 * w)).map(|k| (f.from_bits(k >> w), f.from_bits(k & ((1 << w) - 1)))).unzip()
+            } else {
+                let sp = fixed_specials(&f);
+                let mut r = SplitMix64::new(0xf1);
+                let n = if emulated { 1 << 10 } else { 1 << 16 };
+                let pick = |r: &mut SplitMix64| match r.below(4) {
+                    0 => f.from_bits(sp[r.below(sp.len() as u64) as usize]),
+                    // small magnitudes: the products and quotients that round
+                    1 => r.below(1 << 12) as i64 - (1 << 11),
+                    _ => f.from_bits(r.next_u64()),
+                };
+                (0..n).map(|_| (pick(&mut r), pick(&mut r))).unzip()
+            };
+            for k in kernels_here() {
+                for op in [Op::Add, Op::Sub, Op::Mul, Op::Div] {
+                    let mut out = vec![0i64; a.len()];
+                    with_kernel_cap(k, || op_batch_fixed(&f, op, &a, &b, &mut out));
+                    for i in 0..a.len() {
+                        let want = match op {
+                            Op::Add => f.add(a[i], b[i]),
+                            Op::Sub => f.sub(a[i], b[i]),
+                            Op::Mul => f.mul(a[i], b[i]),
+                            _ => f.div(a[i], b[i]),
+                        };
+                        assert_eq!(out[i], want, "{full} {op:?} {} {} on {k:?}", a[i], b[i]);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Fixed-point formats wider than 32 bits keep the scalar model.
+#[test]
+fn fixed_point_formats_wider_than_32_bits_run_the_scalar_model() {
+    for name in ["q16.17", "q32.32", "q8.56", "q33.0"] {
+        assert_eq!(datapath::fixed_lanes::kernel_fixed(&fixed(name)), Kernel::Scalar, "{name}");
     }
 }

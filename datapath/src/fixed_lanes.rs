@@ -1,0 +1,736 @@
+//! The fixed-point batch path: `qI.F` formats of at most 32 bits on 64-bit integer lanes, bit
+//! for bit the scalar model of [`Fixed`] (every rounding and overflow mode, either division
+//! mode), for the RTI unit and for single operations.
+//!
+//! The scalar model forms products and quotients exactly in i128. With a total width w ≤ 32
+//! every raw value lies in [−2^31, 2^31 − 1], so the lanes need no i128:
+//!
+//! * **+ −**: the exact sum of two raw values fits i64 (|a ± b| ≤ 2^32); then the overflow mode.
+//! * **×**: the exact product of two raw values fits i64 (|a·b| ≤ 2^62; it is formed as a
+//!   signed 32 × 32 → 64-bit multiply); `p / 2^F` rounded by the mode from the arithmetic
+//!   shift `q = p >> F` (floor, i.e. toward −∞) and the dropped bits `r = p & (2^F − 1)`
+//!   (0 ≤ r < 2^F): toward +∞ adds 1 when r ≠ 0, toward zero adds 1 when r ≠ 0 and p < 0, to
+//!   nearest-even adds 1 when r > 2^(F−1) or r = 2^(F−1) and q is odd; then the overflow mode.
+//! * **÷** (`a / b`, b ≠ 0): the numerator `n = a·2^F` (|n| ≤ 2^62, and exact in binary64:
+//!   it has the ≤ 32 significant bits of a) and the denominator `d = |b|` (sign moved to n)
+//!   are converted to binary64 exactly; `q0 = ⌊RN(n / d)⌋`. While |n / d| < 2^53 the
+//!   binary64 quotient's error is below one unit and `q0` is ⌊n / d⌋ or ⌊n / d⌋ + 1, so the
+//!   remainder `r = n − q0·d` (computed modulo 2^64, exact because the true value is small)
+//!   lies in [−d, d): one step (`r < 0`: q0 − 1, r + d) gives the floor and 0 ≤ r < d, from
+//!   which the rounding mode decides as for ×. A quotient reaches 2^53 only when w − 1 + F
+//!   ≥ 53; such formats take a second correction step (q0 + ⌊RN(r / d)⌋, |r / d| ≤ 2^10)
+//!   before the final one. Under saturation a quotient that large saturates whatever its
+//!   low bits. `b = 0` gives the most positive value for a > 0, the most negative for a < 0,
+//!   0 for 0 / 0, as in the model. The reciprocal mode is `a × (1 / b)`, both rounded.
+//! * **Overflow**: saturate clamps to [−2^(w−1), 2^(w−1) − 1]; wrap keeps the low w bits,
+//!   sign-extended (`(x << (64 − w)) >> (64 − w)`).
+//! * **Compares** are integer compares; |x| is `fit(|x|)` (the most negative value saturates
+//!   or wraps, as in the model).
+//!
+//! One formulation of the RTI stage table, `rti_vec`, runs on a lane type of the `Ops`
+//! trait: AVX-512F + DQ registers of 8 lanes (`zmm::Z`: vpmuldq, vpsraq, vpminsq/vpmaxsq,
+//! vcvtqq2pd, vdivpd, vcvtpd2qq toward −∞, vpmullq) and, for AVX2, arrays of 4 lanes on
+//! which each operation is the branch-free scalar function of this module (the compiler
+//! vectorises the copies). Every mode is a const parameter, so no lane decides a mode; the
+//! slots after the last full vector run the scalar model.
+
+use crate::format::{DivMode, Fixed, FxOverflow, FxRound};
+use crate::rti::{Cull, HitsSoa, Op, RaysSoa, Rti, TrisSoa};
+use crate::simd::Kernel;
+use crate::Format as _;
+
+/// The widest kernel of the fixed-point batch path (AVX-512F with AVX-512DQ: 8 i64 lanes).
+pub const WIDEST_FIXED: Kernel = Kernel::Avx512;
+
+/// The constants of one fixed-point format's lane arithmetic.
+#[derive(Clone, Copy, Debug)]
+struct Lanes {
+    /// Fraction bits F.
+    f: u32,
+    /// 64 − w: the wrap shift.
+    sh: u32,
+    /// Most negative raw value.
+    min: i64,
+    /// Most positive raw value.
+    max: i64,
+    /// 2^F − 1: the bits a product's shift drops.
+    low: i64,
+    /// 2^(F−1) (the tie), or i64::MAX when F = 0 (no bits dropped, never a tie).
+    half: i64,
+    /// The format's 1 (rounded into range), the reciprocal's numerator.
+    one: i64,
+}
+
+impl Lanes {
+    /// The constants of `f`, when it has a batch path (width ≤ 32).
+    fn of(f: &Fixed) -> Option<Self> {
+        let w = f.int_bits + f.frac_bits;
+        (w <= 32).then(|| Self {
+            f: f.frac_bits,
+            sh: 64 - w,
+            min: f.min_raw(),
+            max: f.max_raw(),
+            low: (1i64 << f.frac_bits) - 1,
+            half: if f.frac_bits == 0 { i64::MAX } else { 1i64 << (f.frac_bits - 1) },
+            one: f.one(),
+        })
+    }
+}
+
+/// Rounding modes as const parameters.
+const FLOOR: u8 = 0;
+const CEIL: u8 = 1;
+const TRUNC: u8 = 2;
+const NEAREST: u8 = 3;
+
+const fn round_code(r: FxRound) -> u8 {
+    match r {
+        FxRound::Floor => FLOOR,
+        FxRound::Ceil => CEIL,
+        FxRound::Trunc => TRUNC,
+        FxRound::NearestEven => NEAREST,
+    }
+}
+
+/// `x` if `c`, else `y` (a select, never a branch).
+#[inline(always)]
+fn sel(c: bool, x: i64, y: i64) -> i64 {
+    let m = -(c as i64);
+    (x & m) | (y & !m)
+}
+
+/// The overflow mode applied to an exact result that fits i64.
+#[inline(always)]
+fn fit<const WRAP: bool>(c: &Lanes, x: i64) -> i64 {
+    if WRAP {
+        (x << c.sh) >> c.sh
+    } else {
+        x.max(c.min).min(c.max)
+    }
+}
+
+/// The rounding increment of a quotient whose floor is `q` with remainder 0 ≤ r < d, for an
+/// exact value of sign `neg`: 0 or 1.
+#[inline(always)]
+fn bump<const R: u8>(q: i64, r: i64, d: i64, neg: bool) -> i64 {
+    let inexact = r != 0;
+    (match R {
+        FLOOR => false,
+        CEIL => inexact,
+        TRUNC => inexact & neg,
+        _ => {
+            let twice = r << 1;
+            (twice > d) | ((twice == d) & (q & 1 == 1))
+        }
+    }) as i64
+}
+
+/// `a + b`, then the overflow mode.
+#[inline(always)]
+fn add<const WRAP: bool>(c: &Lanes, a: i64, b: i64) -> i64 {
+    fit::<WRAP>(c, a + b)
+}
+
+/// `a − b`, then the overflow mode.
+#[inline(always)]
+fn sub<const WRAP: bool>(c: &Lanes, a: i64, b: i64) -> i64 {
+    fit::<WRAP>(c, a - b)
+}
+
+/// `a × b / 2^F` rounded by the mode, then the overflow mode.
+#[inline(always)]
+fn mul<const R: u8, const WRAP: bool>(c: &Lanes, a: i64, b: i64) -> i64 {
+    // raw values are 32-bit: a signed 32 x 32 -> 64-bit multiply, exact
+    let p = (a as i32 as i64) * (b as i32 as i64);
+    let q = p >> c.f;
+    let r = p & c.low;
+    let up = match R {
+        NEAREST => ((r > c.half) | ((r == c.half) & (q & 1 == 1))) as i64,
+        _ => bump::<R>(q, r, 1, p < 0),
+    };
+    fit::<WRAP>(c, q + up)
+}
+
+/// `a / b` rounded once (see the module documentation).
+#[inline(always)]
+fn div<const R: u8, const WRAP: bool, const TWO: bool>(c: &Lanes, a: i64, b: i64) -> i64 {
+    let n0 = a << c.f;
+    let neg_b = b < 0;
+    let n = sel(neg_b, n0.wrapping_neg(), n0);
+    let d0 = sel(neg_b, b.wrapping_neg(), b);
+    let zero = d0 == 0;
+    let d = sel(zero, 1, d0);
+    let (nf, df) = (n as f64, d as f64);
+    // SAFETY: |n / d| <= 2^62 (d >= 1), finite, so its floor fits i64
+    let mut q: i64 = unsafe { (nf / df).floor().to_int_unchecked() };
+    let mut r = n.wrapping_sub(q.wrapping_mul(d));
+    if TWO {
+        // SAFETY: |r / d| <= 2^11 here (see the module documentation)
+        q += unsafe { (r as f64 / df).floor().to_int_unchecked::<i64>() };
+        r = n.wrapping_sub(q.wrapping_mul(d));
+    }
+    let low = r < 0;
+    q -= low as i64;
+    r += sel(low, d, 0);
+    let res = fit::<WRAP>(c, q + bump::<R>(q, r, d, n < 0));
+    let by_zero = sel(a > 0, c.max, sel(a < 0, c.min, 0));
+    sel(zero, by_zero, res)
+}
+
+/// The format's division (its mode).
+#[inline(always)]
+fn divide<const R: u8, const WRAP: bool, const TWO: bool, const RECIP: bool>(c: &Lanes, a: i64, b: i64) -> i64 {
+    if RECIP {
+        mul::<R, WRAP>(c, a, div::<R, WRAP, TWO>(c, c.one, b))
+    } else {
+        div::<R, WRAP, TWO>(c, a, b)
+    }
+}
+
+/// The lane operations of the RTI and operation loops: `V` holds `L` raw values, a mask is
+/// a `u8` (bit j: lane j). Every operation is the scalar function of the same name above,
+/// lane by lane.
+trait Ops: Copy {
+    /// Lanes per vector.
+    const L: usize;
+    /// A vector of raw values.
+    type V: Copy;
+    /// The format's constants.
+    fn c(&self) -> &Lanes;
+    /// `col[i..i + L]`.
+    fn load(&self, col: &[i64], i: usize) -> Self::V;
+    /// `col[i..i + L] = v`.
+    fn store(&self, col: &mut [i64], i: usize, v: Self::V);
+    /// Every lane `x`.
+    fn splat(&self, x: i64) -> Self::V;
+    /// [`add`].
+    fn add<const WRAP: bool>(&self, a: Self::V, b: Self::V) -> Self::V;
+    /// [`sub`].
+    fn sub<const WRAP: bool>(&self, a: Self::V, b: Self::V) -> Self::V;
+    /// [`mul`].
+    fn mul<const R: u8, const WRAP: bool>(&self, a: Self::V, b: Self::V) -> Self::V;
+    /// [`div`].
+    fn div<const R: u8, const WRAP: bool, const TWO: bool>(&self, a: Self::V, b: Self::V) -> Self::V;
+    /// `fit(|a|)`.
+    fn abs<const WRAP: bool>(&self, a: Self::V) -> Self::V;
+    /// `a < b` per lane.
+    fn lt(&self, a: Self::V, b: Self::V) -> u8;
+    /// `a <= b` per lane.
+    fn le(&self, a: Self::V, b: Self::V) -> u8;
+    /// The format's division (its mode).
+    #[inline(always)]
+    fn divide<const R: u8, const WRAP: bool, const TWO: bool, const RECIP: bool>(
+        &self,
+        a: Self::V,
+        b: Self::V,
+    ) -> Self::V {
+        if RECIP {
+            let one = self.splat(self.c().one);
+            self.mul::<R, WRAP>(a, self.div::<R, WRAP, TWO>(one, b))
+        } else {
+            self.div::<R, WRAP, TWO>(a, b)
+        }
+    }
+}
+
+/// Writes the 8 bits of `m` (lanes `0..l`) as bools at `out[i..i + l]`.
+#[inline(always)]
+fn store_flags(out: &mut [bool], i: usize, l: usize, m: u8) {
+    for (j, o) in out[i..i + l].iter_mut().enumerate() {
+        *o = m >> j & 1 == 1;
+    }
+}
+
+/// Portable lanes: `L` raw values in an array, each operation the scalar function lane by
+/// lane (the compiler vectorises the copies).
+#[derive(Clone, Copy)]
+struct Port<const L: usize>(Lanes);
+
+impl<const L: usize> Port<L> {
+    #[inline(always)]
+    fn map2(a: [i64; L], b: [i64; L], f: impl Fn(i64, i64) -> i64) -> [i64; L] {
+        std::array::from_fn(|i| f(a[i], b[i]))
+    }
+    #[inline(always)]
+    fn bits(a: [i64; L], b: [i64; L], f: impl Fn(i64, i64) -> bool) -> u8 {
+        (0..L).fold(0, |m, i| m | (f(a[i], b[i]) as u8) << i)
+    }
+}
+
+impl<const L: usize> Ops for Port<L> {
+    const L: usize = L;
+    type V = [i64; L];
+    #[inline(always)]
+    fn c(&self) -> &Lanes {
+        &self.0
+    }
+    #[inline(always)]
+    fn load(&self, col: &[i64], i: usize) -> [i64; L] {
+        col[i..i + L].try_into().expect("L lanes")
+    }
+    #[inline(always)]
+    fn store(&self, col: &mut [i64], i: usize, v: [i64; L]) {
+        col[i..i + L].copy_from_slice(&v)
+    }
+    #[inline(always)]
+    fn splat(&self, x: i64) -> [i64; L] {
+        [x; L]
+    }
+    #[inline(always)]
+    fn add<const WRAP: bool>(&self, a: [i64; L], b: [i64; L]) -> [i64; L] {
+        Self::map2(a, b, |a, b| add::<WRAP>(&self.0, a, b))
+    }
+    #[inline(always)]
+    fn sub<const WRAP: bool>(&self, a: [i64; L], b: [i64; L]) -> [i64; L] {
+        Self::map2(a, b, |a, b| sub::<WRAP>(&self.0, a, b))
+    }
+    #[inline(always)]
+    fn mul<const R: u8, const WRAP: bool>(&self, a: [i64; L], b: [i64; L]) -> [i64; L] {
+        Self::map2(a, b, |a, b| mul::<R, WRAP>(&self.0, a, b))
+    }
+    #[inline(always)]
+    fn div<const R: u8, const WRAP: bool, const TWO: bool>(&self, a: [i64; L], b: [i64; L]) -> [i64; L] {
+        Self::map2(a, b, |a, b| div::<R, WRAP, TWO>(&self.0, a, b))
+    }
+    #[inline(always)]
+    fn abs<const WRAP: bool>(&self, a: [i64; L]) -> [i64; L] {
+        a.map(|a| fit::<WRAP>(&self.0, a.abs()))
+    }
+    #[inline(always)]
+    fn lt(&self, a: [i64; L], b: [i64; L]) -> u8 {
+        Self::bits(a, b, |a, b| a < b)
+    }
+    #[inline(always)]
+    fn le(&self, a: [i64; L], b: [i64; L]) -> u8 {
+        Self::bits(a, b, |a, b| a <= b)
+    }
+}
+
+/// One vector of RTI tests in the stage table's order of operations, branch-free.
+#[inline(always)]
+fn rti_vec<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP: bool>(
+    x: &X,
+    thr: X::V,
+    backface: bool,
+    i: &[X::V; 17],
+) -> (u8, u8, X::V, X::V, X::V) {
+    let sub = |a, b| x.sub::<WRAP>(a, b);
+    let add = |a, b| x.add::<WRAP>(a, b);
+    let mul = |a, b| x.mul::<R, WRAP>(a, b);
+    let div = |a, b| x.div::<R, WRAP, TWO>(a, b);
+    let [ox, oy, oz, dx, dy, dz, tmin, tmax, v0x, v0y, v0z, v1x, v1y, v1z, v2x, v2y, v2z] = *i;
+    let (e1x, e1y, e1z) = (sub(v1x, v0x), sub(v1y, v0y), sub(v1z, v0z));
+    let (e2x, e2y, e2z) = (sub(v2x, v0x), sub(v2y, v0y), sub(v2z, v0z));
+    let (sx, sy, sz) = (sub(ox, v0x), sub(oy, v0y), sub(oz, v0z));
+    let px = sub(mul(dy, e2z), mul(dz, e2y));
+    let py = sub(mul(dz, e2x), mul(dx, e2z));
+    let pz = sub(mul(dx, e2y), mul(dy, e2x));
+    let qx = sub(mul(sy, e1z), mul(sz, e1y));
+    let qy = sub(mul(sz, e1x), mul(sx, e1z));
+    let qz = sub(mul(sx, e1y), mul(sy, e1x));
+    let det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
+    let up = add(add(mul(sx, px), mul(sy, py)), mul(sz, pz));
+    let vp = add(add(mul(dx, qx), mul(dy, qy)), mul(dz, qz));
+    let tp = add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz));
+    let uv = add(up, vp);
+    let zero = x.splat(0);
+    let det_ok = x.lt(thr, if backface { det } else { x.abs::<WRAP>(det) });
+    let pos = x.lt(zero, det);
+    // det > 0 ? 0 <= y : y <= 0, and det > 0 ? uv <= det : det <= uv
+    let ok = |y| (pos & x.le(zero, y)) | (!pos & x.le(y, zero));
+    let uv_ok = (pos & x.le(uv, det)) | (!pos & x.le(det, uv));
+    let valid = det_ok & ok(up) & ok(vp) & uv_ok & ok(tp);
+    let (t, u, v) = if RECIP {
+        // the model's inv_det is its division one / det, itself one x (1 / det) in this mode
+        let inv = x.divide::<R, WRAP, TWO, RECIP>(x.splat(x.c().one), det);
+        (mul(tp, inv), mul(up, inv), mul(vp, inv))
+    } else {
+        (div(tp, det), div(up, det), div(vp, det))
+    };
+    let hit = valid & x.le(tmin, t) & x.le(t, tmax);
+    (valid, hit, t, u, v)
+}
+
+/// The RTI loop over slots `0..n / L * L`; returns that count.
+#[inline(always)]
+fn rti_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP: bool>(
+    x: &X,
+    thr: i64,
+    backface: bool,
+    rays: &RaysSoa<i64>,
+    tris: &TrisSoa<i64>,
+    out: &mut HitsSoa<i64>,
+    n: usize,
+) -> usize {
+    let [o, d] = [&rays.o, &rays.d];
+    let [v0, v1, v2] = &tris.v;
+    let cols: [&[i64]; 17] = [
+        &o[0], &o[1], &o[2], &d[0], &d[1], &d[2], &rays.tmin, &rays.tmax, &v0[0], &v0[1], &v0[2], &v1[0], &v1[1],
+        &v1[2], &v2[0], &v2[1], &v2[2],
+    ];
+    let thr = x.splat(thr);
+    let full = n / X::L * X::L;
+    for i in (0..full).step_by(X::L) {
+        let inp: [X::V; 17] = std::array::from_fn(|k| x.load(cols[k], i));
+        let (valid, hit, t, u, v) = rti_vec::<X, R, WRAP, TWO, RECIP>(x, thr, backface, &inp);
+        store_flags(&mut out.valid, i, X::L, valid);
+        store_flags(&mut out.hit, i, X::L, hit);
+        x.store(&mut out.t, i, t);
+        x.store(&mut out.u, i, u);
+        x.store(&mut out.v, i, v);
+    }
+    full
+}
+
+/// One operation over columns, `L` lanes at a time (the tail on the scalar functions).
+#[inline(always)]
+fn op_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP: bool>(
+    x: &X,
+    op: Op,
+    a: &[i64],
+    b: &[i64],
+    out: &mut [i64],
+) {
+    let full = out.len() / X::L * X::L;
+    for i in (0..full).step_by(X::L) {
+        let (p, q) = (x.load(a, i), x.load(b, i));
+        let r = match op {
+            Op::Add => x.add::<WRAP>(p, q),
+            Op::Sub => x.sub::<WRAP>(p, q),
+            Op::Mul => x.mul::<R, WRAP>(p, q),
+            _ => x.divide::<R, WRAP, TWO, RECIP>(p, q),
+        };
+        x.store(out, i, r);
+    }
+    let c = x.c();
+    for i in full..out.len() {
+        out[i] = match op {
+            Op::Add => add::<WRAP>(c, a[i], b[i]),
+            Op::Sub => sub::<WRAP>(c, a[i], b[i]),
+            Op::Mul => mul::<R, WRAP>(c, a[i], b[i]),
+            _ => divide::<R, WRAP, TWO, RECIP>(c, a[i], b[i]),
+        };
+    }
+}
+
+/// Calls `$f::<$x, R, WRAP, TWO, RECIP>($args)` for the format's modes.
+macro_rules! by_modes {
+    ($fmt:expr, $f:ident, $x:ty, $($arg:expr),*) => {{
+        let fmt: &Fixed = $fmt;
+        let wrap = fmt.overflow == FxOverflow::Wrap;
+        // a quotient can reach 2^53 only when w - 1 + F >= 53; under saturation it saturates
+        let two = wrap && fmt.int_bits + 2 * fmt.frac_bits > 53;
+        let recip = fmt.div == DivMode::RecipMul;
+        macro_rules! go {
+            ($r:expr) => {
+                match (wrap, two, recip) {
+                    (false, _, false) => $f::<$x, { $r }, false, false, false>($($arg),*),
+                    (false, _, true) => $f::<$x, { $r }, false, false, true>($($arg),*),
+                    (true, false, false) => $f::<$x, { $r }, true, false, false>($($arg),*),
+                    (true, false, true) => $f::<$x, { $r }, true, false, true>($($arg),*),
+                    (true, true, false) => $f::<$x, { $r }, true, true, false>($($arg),*),
+                    (true, true, true) => $f::<$x, { $r }, true, true, true>($($arg),*),
+                }
+            };
+        }
+        match round_code(fmt.round) {
+            FLOOR => go!(FLOOR),
+            CEIL => go!(CEIL),
+            TRUNC => go!(TRUNC),
+            _ => go!(NEAREST),
+        }
+    }};
+}
+
+/// AVX-512F + DQ lanes: 8 raw values in a zmm register, masks in `__mmask8`.
+#[cfg(target_arch = "x86_64")]
+mod zmm {
+    use super::*;
+    use std::arch::x86_64::*;
+
+    /// The format's constants, broadcast. A value of this type exists only where AVX-512F
+    /// and AVX-512DQ were detected ([`Z::new`] is unsafe), which is what makes the
+    /// intrinsics in its methods sound.
+    #[derive(Clone, Copy)]
+    pub(super) struct Z {
+        c: Lanes,
+        min: __m512i,
+        max: __m512i,
+        low: __m512i,
+        unit: __m512i,
+        one: __m512i,
+        f: __m128i,
+        sh: __m128i,
+    }
+
+    /// `_mm512_cvt_roundpd_epi64` toward −∞: the floor of each lane as an integer.
+    const FLOOR_CVT: i32 = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC;
+
+    impl Z {
+        /// The broadcast constants of `c`.
+        ///
+        /// # Safety
+        /// The CPU has AVX-512F and AVX-512DQ.
+        #[inline(always)]
+        pub(super) unsafe fn new(c: Lanes) -> Self {
+            // SAFETY: the caller's promise
+            unsafe {
+                Self {
+                    c,
+                    min: _mm512_set1_epi64(c.min),
+                    max: _mm512_set1_epi64(c.max),
+                    low: _mm512_set1_epi64(c.low),
+                    unit: _mm512_set1_epi64(c.low + 1),
+                    one: _mm512_set1_epi64(1),
+                    f: _mm_cvtsi64_si128(c.f as i64),
+                    sh: _mm_cvtsi64_si128(c.sh as i64),
+                }
+            }
+        }
+        /// [`fit`].
+        #[inline(always)]
+        fn fit<const WRAP: bool>(&self, x: __m512i) -> __m512i {
+            // SAFETY (every method): `self` exists, so the features do (see the type)
+            unsafe {
+                if WRAP {
+                    _mm512_sra_epi64(_mm512_sll_epi64(x, self.sh), self.sh)
+                } else {
+                    _mm512_min_epi64(_mm512_max_epi64(x, self.min), self.max)
+                }
+            }
+        }
+        /// `q` + [`bump`] (remainder `r` of `d`, exact value negative in `neg`).
+        #[inline(always)]
+        fn bump<const R: u8>(&self, q: __m512i, r: __m512i, d: __m512i, neg: __mmask8) -> __m512i {
+            unsafe {
+                let inexact = _mm512_test_epi64_mask(r, r);
+                let m = match R {
+                    FLOOR => 0,
+                    CEIL => inexact,
+                    TRUNC => inexact & neg,
+                    _ => {
+                        let twice = _mm512_add_epi64(r, r);
+                        _mm512_cmpgt_epi64_mask(twice, d)
+                            | (_mm512_cmpeq_epi64_mask(twice, d) & _mm512_test_epi64_mask(q, self.one))
+                    }
+                };
+                _mm512_mask_add_epi64(q, m, q, self.one)
+            }
+        }
+    }
+
+    impl Ops for Z {
+        const L: usize = 8;
+        type V = __m512i;
+        #[inline(always)]
+        fn c(&self) -> &Lanes {
+            &self.c
+        }
+        #[inline(always)]
+        fn load(&self, col: &[i64], i: usize) -> __m512i {
+            let s = &col[i..i + 8];
+            unsafe { _mm512_loadu_si512(s.as_ptr().cast()) }
+        }
+        #[inline(always)]
+        fn store(&self, col: &mut [i64], i: usize, v: __m512i) {
+            let s = &mut col[i..i + 8];
+            unsafe { _mm512_storeu_si512(s.as_mut_ptr().cast(), v) }
+        }
+        #[inline(always)]
+        fn splat(&self, x: i64) -> __m512i {
+            unsafe { _mm512_set1_epi64(x) }
+        }
+        #[inline(always)]
+        fn add<const WRAP: bool>(&self, a: __m512i, b: __m512i) -> __m512i {
+            self.fit::<WRAP>(unsafe { _mm512_add_epi64(a, b) })
+        }
+        #[inline(always)]
+        fn sub<const WRAP: bool>(&self, a: __m512i, b: __m512i) -> __m512i {
+            self.fit::<WRAP>(unsafe { _mm512_sub_epi64(a, b) })
+        }
+        #[inline(always)]
+        fn mul<const R: u8, const WRAP: bool>(&self, a: __m512i, b: __m512i) -> __m512i {
+            unsafe {
+                // the raw values are 32-bit: vpmuldq is the exact product
+                let p = _mm512_mul_epi32(a, b);
+                let q = _mm512_sra_epi64(p, self.f);
+                let r = _mm512_and_si512(p, self.low);
+                // to nearest: 2r against 2^F is r against 2^(F-1)
+                self.fit::<WRAP>(self.bump::<R>(q, r, self.unit, _mm512_movepi64_mask(p)))
+            }
+        }
+        #[inline(always)]
+        fn div<const R: u8, const WRAP: bool, const TWO: bool>(&self, a: __m512i, b: __m512i) -> __m512i {
+            unsafe {
+                let zero = _mm512_setzero_si512();
+                let n0 = _mm512_sll_epi64(a, self.f);
+                let n = _mm512_mask_sub_epi64(n0, _mm512_movepi64_mask(b), zero, n0);
+                let d0 = _mm512_abs_epi64(b);
+                let by0 = _mm512_testn_epi64_mask(d0, d0);
+                let d = _mm512_mask_mov_epi64(d0, by0, self.one);
+                let df = _mm512_cvtepi64_pd(d);
+                let mut q = _mm512_cvt_roundpd_epi64::<FLOOR_CVT>(_mm512_div_pd(_mm512_cvtepi64_pd(n), df));
+                let mut r = _mm512_sub_epi64(n, _mm512_mullo_epi64(q, d));
+                if TWO {
+                    let step = _mm512_cvt_roundpd_epi64::<FLOOR_CVT>(_mm512_div_pd(_mm512_cvtepi64_pd(r), df));
+                    q = _mm512_add_epi64(q, step);
+                    r = _mm512_sub_epi64(n, _mm512_mullo_epi64(q, d));
+                }
+                let below = _mm512_movepi64_mask(r);
+                q = _mm512_mask_sub_epi64(q, below, q, self.one);
+                r = _mm512_mask_add_epi64(r, below, r, d);
+                let res = self.fit::<WRAP>(self.bump::<R>(q, r, d, _mm512_movepi64_mask(n)));
+                let pos = _mm512_mask_mov_epi64(zero, _mm512_cmpgt_epi64_mask(a, zero), self.max);
+                let by_zero = _mm512_mask_mov_epi64(pos, _mm512_movepi64_mask(a), self.min);
+                _mm512_mask_mov_epi64(res, by0, by_zero)
+            }
+        }
+        #[inline(always)]
+        fn abs<const WRAP: bool>(&self, a: __m512i) -> __m512i {
+            self.fit::<WRAP>(unsafe { _mm512_abs_epi64(a) })
+        }
+        #[inline(always)]
+        fn lt(&self, a: __m512i, b: __m512i) -> u8 {
+            unsafe { _mm512_cmplt_epi64_mask(a, b) }
+        }
+        #[inline(always)]
+        fn le(&self, a: __m512i, b: __m512i) -> u8 {
+            unsafe { _mm512_cmple_epi64_mask(a, b) }
+        }
+    }
+}
+
+/// The per-instruction-set entry points: AVX2 on portable 4-lane arrays, AVX-512F + DQ on
+/// [`zmm::Z`].
+#[cfg(target_arch = "x86_64")]
+mod isa {
+    use super::*;
+
+    /// The RTI loop on lanes `x` for `rti`'s modes; returns the slots done.
+    #[inline(always)]
+    fn rti_any<X: Ops>(
+        x: &X,
+        rti: &Rti<Fixed>,
+        rays: &RaysSoa<i64>,
+        tris: &TrisSoa<i64>,
+        out: &mut HitsSoa<i64>,
+        n: usize,
+    ) -> usize {
+        let backface = rti.cull == Cull::Backface;
+        by_modes!(&rti.fmt, rti_loop, X, x, rti.det_thr, backface, rays, tris, out, n)
+    }
+
+    /// AVX2 (4 lanes).
+    #[target_feature(enable = "avx2")]
+    pub(super) fn rti_avx2(
+        rti: &Rti<Fixed>,
+        c: &Lanes,
+        rays: &RaysSoa<i64>,
+        tris: &TrisSoa<i64>,
+        out: &mut HitsSoa<i64>,
+        n: usize,
+    ) -> usize {
+        rti_any(&Port::<4>(*c), rti, rays, tris, out, n)
+    }
+
+    /// AVX-512F + DQ (8 lanes).
+    #[target_feature(enable = "avx512f,avx512dq")]
+    pub(super) fn rti_avx512(
+        rti: &Rti<Fixed>,
+        c: &Lanes,
+        rays: &RaysSoa<i64>,
+        tris: &TrisSoa<i64>,
+        out: &mut HitsSoa<i64>,
+        n: usize,
+    ) -> usize {
+        // SAFETY: this function's features
+        let z = unsafe { zmm::Z::new(*c) };
+        rti_any(&z, rti, rays, tris, out, n)
+    }
+
+    /// AVX2 (4 lanes).
+    #[target_feature(enable = "avx2")]
+    pub(super) fn op_avx2(f: &Fixed, c: &Lanes, op: Op, a: &[i64], b: &[i64], out: &mut [i64]) {
+        let x = Port::<4>(*c);
+        by_modes!(f, op_loop, Port<4>, &x, op, a, b, out)
+    }
+
+    /// AVX-512F + DQ (8 lanes).
+    #[target_feature(enable = "avx512f,avx512dq")]
+    pub(super) fn op_avx512(f: &Fixed, c: &Lanes, op: Op, a: &[i64], b: &[i64], out: &mut [i64]) {
+        // SAFETY: this function's features
+        let z = unsafe { zmm::Z::new(*c) };
+        by_modes!(f, op_loop, zmm::Z, &z, op, a, b, out)
+    }
+}
+
+/// The kernel `rti_batch_fixed` / `op_batch_fixed` use for this format on this machine:
+/// formats of at most 32 bits on i64 lanes, the scalar model otherwise.
+pub fn kernel_fixed(f: &Fixed) -> Kernel {
+    let k = crate::simd::best_kernel(Lanes::of(f).is_some(), WIDEST_FIXED);
+    // the 8-lane kernel also needs AVX-512DQ (64-bit multiplies and conversions)
+    #[cfg(target_arch = "x86_64")]
+    if k == Kernel::Avx512 && !std::arch::is_x86_feature_detected!("avx512dq") {
+        return Kernel::Avx2;
+    }
+    k
+}
+
+/// [`Rti::batch`] for a fixed-point format on the fastest kernel available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn rti_batch_fixed(rti: &Rti<Fixed>, rays: &RaysSoa<i64>, tris: &TrisSoa<i64>, out: &mut HitsSoa<i64>) -> Kernel {
+    let n = rays.len();
+    assert!(tris.len() == n && out.len() == n, "batch lengths differ");
+    let which = kernel_fixed(&rti.fmt);
+    #[cfg(target_arch = "x86_64")]
+    if let Some(c) = Lanes::of(&rti.fmt).filter(|_| crate::simd::rti_columns_ok(rays, tris, out, n)) {
+        // SAFETY: `which` names a kernel only after run-time feature detection.
+        let full = match which {
+            Kernel::Avx2 => unsafe { isa::rti_avx2(rti, &c, rays, tris, out, n) },
+            Kernel::Scalar => 0,
+            _ => unsafe { isa::rti_avx512(rti, &c, rays, tris, out, n) },
+        };
+        if which != Kernel::Scalar {
+            rti.batch_from(rays, tris, out, full);
+            return which;
+        }
+    }
+    let _ = which;
+    rti.batch(rays, tris, out);
+    Kernel::Scalar
+}
+
+/// `Add`, `Sub`, `Mul` or `Div` (in the format's division mode) of a fixed-point format on
+/// whole columns, `out[i] = a[i] op b[i]`, on the fastest kernel available; the model's bits.
+///
+/// # Panics
+/// If the slice lengths differ or `op` is `Logic`.
+pub fn op_batch_fixed(f: &Fixed, op: Op, a: &[i64], b: &[i64], out: &mut [i64]) -> Kernel {
+    assert!(a.len() == b.len() && b.len() == out.len(), "batch lengths differ");
+    assert!(op != Op::Logic, "op_batch_fixed computes arithmetic only");
+    let which = kernel_fixed(f);
+    #[cfg(target_arch = "x86_64")]
+    if let Some(c) = Lanes::of(f) {
+        match which {
+            // SAFETY: as above.
+            Kernel::Avx2 => unsafe { isa::op_avx2(f, &c, op, a, b, out) },
+            Kernel::Scalar => {}
+            _ => unsafe { isa::op_avx512(f, &c, op, a, b, out) },
+        }
+        if which != Kernel::Scalar {
+            return which;
+        }
+    }
+    let _ = which;
+    for i in 0..out.len() {
+        out[i] = match op {
+            Op::Add => f.add(a[i], b[i]),
+            Op::Sub => f.sub(a[i], b[i]),
+            Op::Mul => f.mul(a[i], b[i]),
+            _ => f.div(a[i], b[i]),
+        };
+    }
+    Kernel::Scalar
+}
