@@ -1250,6 +1250,23 @@ mod isa {
                 let out = or_m(lt(splat(n.max_finite), abs(x)), lt(pred(x), splat(n.below_min)));
                 blend(r, canonical_nan(), out)
             }
+            /// The range filter (see [`crate::format::narrow`]): true when on every lane the
+            /// nonzero magnitudes among `v` (the stage-1 results and the direction) are at
+            /// least `n.fast_lo` and all magnitudes at most `n.fast_hi`, so that no result of
+            /// stages 2-6 leaves {±0} ∪ [2^emin, max]. A NaN may pass: it reaches t, u or v.
+            #[inline]
+            #[target_feature(enable = $feat)]
+            pub fn fast_ok(v: &[$v; 12], n: &Narrow) -> bool {
+                let (zero, inf) = (splat(0.0), splat(f64::INFINITY));
+                let (mut hi, mut lo) = (zero, inf);
+                for &x in v {
+                    let a = abs(x);
+                    hi = max(a, hi);
+                    lo = min_where(lo, a, lt(zero, a));
+                }
+                let good = and_m(le(splat(n.fast_lo), lo), le(hi, splat(n.fast_hi)));
+                bits(good) == (1 << LANES) - 1
+            }
             /// Under FTZ, subnormal lanes read as zeros of the same sign (the operand read).
             #[inline]
             #[target_feature(enable = $feat)]
@@ -1323,6 +1340,12 @@ mod isa {
         pub fn blend(a: __m256d, b: __m256d, m: M) -> __m256d {
             _mm256_blendv_pd(a, b, m)
         }
+        /// `m ? min(lo, a) : lo` per lane.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn min_where(lo: __m256d, a: __m256d, m: M) -> __m256d {
+            _mm256_blendv_pd(lo, _mm256_min_pd(lo, a), m)
+        }
         /// The sign bits of x (everything else cleared).
         #[inline]
         #[target_feature(enable = "avx2")]
@@ -1367,6 +1390,9 @@ mod isa {
         pub unsafe fn load_soft(p: *const u64, i: usize, n: &Narrow) -> __m256d {
             let (l, m) = (n.lay, n.lay.man_bits);
             let b = unsafe { _mm256_loadu_si256(p.add(i) as *const __m256i) };
+            if n.e8 {
+                return unsafe { load_e8(p, i, n) };
+            }
             let emax = (1u64 << l.exp_bits) - 1;
             let e = _mm256_and_si256(_mm256_srl_epi64(b, count(m)), int(emax));
             let f = _mm256_and_si256(b, int((1u64 << m) - 1));
@@ -1382,6 +1408,28 @@ mod isa {
             let r = blend(_mm256_castsi256_pd(normal), sub, _mm256_castsi256_pd(_mm256_cmpeq_epi64(e, int(0))));
             blend(r, _mm256_castsi256_pd(special), _mm256_castsi256_pd(_mm256_cmpeq_epi64(e, int(emax))))
         }
+        /// [`load_soft`] for `e8mM` with M ≤ 23 (`n.e8`), as `v8d::load_e8`.
+        ///
+        /// # Safety
+        /// `p[i..i + 4]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn load_e8(p: *const u64, i: usize, n: &Narrow) -> __m256d {
+            let b = unsafe { _mm256_loadu_si256(p.add(i) as *const __m256i) };
+            // the low 32 bits of each lane
+            let lo = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(b, _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6)));
+            _mm256_cvtps_pd(_mm_castsi128_ps(_mm_sll_epi32(lo, count(n.e8_shift))))
+        }
+        /// [`store_soft`] for `e8mM` with M ≤ 23 (`n.e8`), as `v8d::store_e8`.
+        ///
+        /// # Safety
+        /// `p[i..i + 4]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub unsafe fn store_e8(p: *mut u64, i: usize, x: __m256d, n: &Narrow) {
+            let b32 = _mm_srl_epi32(_mm_castps_si128(_mm256_cvtpd_ps(x)), count(n.e8_shift));
+            unsafe { _mm256_storeu_si256(p.add(i) as *mut __m256i, _mm256_cvtepu32_epi64(b32)) }
+        }
         /// Stores 4 lanes holding `eEmM` values (or a NaN, stored as the canonical NaN) as
         /// encodings.
         ///
@@ -1391,6 +1439,9 @@ mod isa {
         #[target_feature(enable = "avx2")]
         pub unsafe fn store_soft(p: *mut u64, i: usize, x: __m256d, n: &Narrow) {
             let (l, m) = (n.lay, n.lay.man_bits);
+            if n.e8 {
+                return unsafe { store_e8(p, i, blend(x, canonical_nan(), unord(x, x)), n) };
+            }
             let b = _mm256_castpd_si256(x);
             let s = _mm256_sll_epi64(_mm256_srli_epi64::<63>(b), count(l.width() - 1));
             let a = abs(x);
@@ -1482,6 +1533,12 @@ mod isa {
         pub fn blend(a: __m512d, b: __m512d, m: M) -> __m512d {
             _mm512_mask_blend_pd(m, a, b)
         }
+        /// `m ? min(lo, a) : lo` per lane.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn min_where(lo: __m512d, a: __m512d, m: M) -> __m512d {
+            _mm512_mask_min_pd(lo, m, lo, a)
+        }
         /// The sign bits of x (everything else cleared).
         #[inline]
         #[target_feature(enable = "avx512f")]
@@ -1526,6 +1583,9 @@ mod isa {
         pub unsafe fn load_soft(p: *const u64, i: usize, n: &Narrow) -> __m512d {
             let (l, m) = (n.lay, n.lay.man_bits);
             let b = unsafe { _mm512_loadu_si512(p.add(i) as *const __m512i) };
+            if n.e8 {
+                return unsafe { load_e8(p, i, n) };
+            }
             let emax = (1u64 << l.exp_bits) - 1;
             let e = _mm512_and_si512(_mm512_srl_epi64(b, count(m)), int(emax));
             let f = _mm512_and_si512(b, int((1u64 << m) - 1));
@@ -1541,6 +1601,31 @@ mod isa {
             let r = blend(normal, sub, _mm512_cmpeq_epi64_mask(e, int(0)));
             blend(r, special, _mm512_cmpeq_epi64_mask(e, int(emax)))
         }
+        /// [`load_soft`] for `e8mM` with M ≤ 23 (`n.e8`): binary32's exponent, so the
+        /// encoding shifted to binary32's fraction width is the same value in binary32
+        /// (subnormals, infinities and NaNs included), widened exactly to binary64.
+        ///
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn load_e8(p: *const u64, i: usize, n: &Narrow) -> __m512d {
+            let b = unsafe { _mm512_loadu_si512(p.add(i) as *const __m512i) };
+            _mm512_cvtps_pd(_mm256_castsi256_ps(_mm256_sll_epi32(_mm512_cvtepi64_epi32(b), count(n.e8_shift))))
+        }
+        /// [`store_soft`] for `e8mM` with M ≤ 23 (`n.e8`): the lanes hold target values, which
+        /// binary32 holds exactly, so narrowing is exact and the binary32 encoding shifted
+        /// right is the target's. A NaN lane must be binary64's canonical NaN, which narrows
+        /// to binary32's, whose shift is the target's canonical NaN.
+        ///
+        /// # Safety
+        /// `p[i..i + 8]` must be in bounds.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub unsafe fn store_e8(p: *mut u64, i: usize, x: __m512d, n: &Narrow) {
+            let b32 = _mm256_srl_epi32(_mm256_castps_si256(_mm512_cvtpd_ps(x)), count(n.e8_shift));
+            unsafe { _mm512_storeu_si512(p.add(i) as *mut __m512i, _mm512_cvtepu32_epi64(b32)) }
+        }
         /// Stores 8 lanes holding `eEmM` values (or a NaN, stored as the canonical NaN) as
         /// encodings.
         ///
@@ -1550,6 +1635,9 @@ mod isa {
         #[target_feature(enable = "avx512f")]
         pub unsafe fn store_soft(p: *mut u64, i: usize, x: __m512d, n: &Narrow) {
             let (l, m) = (n.lay, n.lay.man_bits);
+            if n.e8 {
+                return unsafe { store_e8(p, i, blend(x, canonical_nan(), unord(x, x)), n) };
+            }
             let b = ib(x);
             let s = _mm512_sll_epi64(_mm512_srli_epi64::<63>(b), count(l.width() - 1));
             let a = abs(x);
@@ -1734,19 +1822,56 @@ mod kernels {
     /// the format, `$store(column, i, x)` writes results, `$thr` is the det threshold as binary32.
     macro_rules! rti_kernel {
         ($x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $start:expr, $end:expr) => {{
+            let round = $round;
+            rti_kernel!($x, $rti, $rays, $tris, $out, $full, $load, round, round, |_: &[_; 12]| true, $store, $thr, $start, $end)
+        }};
+        // `$fast` rounds without the filter; `$ok(v)` (v: the stage-1 results and the
+        // direction) says that `$fast` gives `$round`'s results at stages 2-6 on every lane
+        ($x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $fast:expr, $ok:expr, $store:expr, $thr:expr, $start:expr, $end:expr) => {{
             // one loop per (culling, division mode), so that neither is decided per vector
             let backface = $rti.cull == Cull::Backface;
             match ($rti.fmt.opts.div, backface) {
-                (DivMode::RecipMul, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $start, $end, false, true),
-                (DivMode::RecipMul, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $start, $end, true, true),
-                (DivMode::Divide, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $start, $end, false, false),
-                (DivMode::Divide, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $store, $thr, $start, $end, true, false),
+                (DivMode::RecipMul, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $ok, $store, $thr, $start, $end, false, true),
+                (DivMode::RecipMul, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $ok, $store, $thr, $start, $end, true, true),
+                (DivMode::Divide, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $ok, $store, $thr, $start, $end, false, false),
+                (DivMode::Divide, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $ok, $store, $thr, $start, $end, true, false),
             }
         }};
-        (@loop $x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $start:expr, $end:expr, $backface:expr, $recip:expr) => {{
+        // stage 1 in `$sub`: (e1, e2, s)
+        (@stage1 $sub:ident, $v:ident, $ox:ident, $oy:ident, $oz:ident) => {{
+            let (v0x, v0y, v0z) = ($v(0, 0), $v(0, 1), $v(0, 2));
+            (
+                ($sub($v(1, 0), v0x), $sub($v(1, 1), v0y), $sub($v(1, 2), v0z)),
+                ($sub($v(2, 0), v0x), $sub($v(2, 1), v0y), $sub($v(2, 2), v0z)),
+                ($sub($ox, v0x), $sub($oy, v0y), $sub($oz, v0z)),
+            )
+        }};
+        // stages 2-6 in `$sub`, `$add`, `$mul`: [det, u', v', t']
+        (@stages26 $sub:ident, $add:ident, $mul:ident, $e1:expr, $e2:expr, $s:expr, $d:expr) => {{
+            let ((e1x, e1y, e1z), (e2x, e2y, e2z), (sx, sy, sz), (dx, dy, dz)) = ($e1, $e2, $s, $d);
+            // stages 2, 3: p = d x e2, q = s x e1
+            let px = $sub($mul(dy, e2z), $mul(dz, e2y));
+            let py = $sub($mul(dz, e2x), $mul(dx, e2z));
+            let pz = $sub($mul(dx, e2y), $mul(dy, e2x));
+            let qx = $sub($mul(sy, e1z), $mul(sz, e1y));
+            let qy = $sub($mul(sz, e1x), $mul(sx, e1z));
+            let qz = $sub($mul(sx, e1y), $mul(sy, e1x));
+            // stages 4-6: (x + y) + z
+            let det = $add($add($mul(e1x, px), $mul(e1y, py)), $mul(e1z, pz));
+            let up = $add($add($mul(sx, px), $mul(sy, py)), $mul(sz, pz));
+            let vp = $add($add($mul(dx, qx), $mul(dy, qy)), $mul(dz, qz));
+            let tp = $add($add($mul(e2x, qx), $mul(e2y, qy)), $mul(e2z, qz));
+            [det, up, vp, tp]
+        }};
+        (@loop $x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $fast:expr, $ok:expr, $store:expr, $thr:expr, $start:expr, $end:expr, $backface:expr, $recip:expr) => {{
             let (rays, tris, out) = ($rays, $tris, $out);
             let load = $load;
             let rd = $round;
+            let fast = $fast;
+            let ok = $ok;
+            let fsub = |a, b| fast($x::sub(a, b));
+            let fadd = |a, b| fast($x::add(a, b));
+            let fmul = |a, b| fast($x::mul(a, b));
             let store = $store;
             // called before and after each block of vectors (the narrow formats' filter)
             let (start, end) = ($start, $end);
@@ -1767,6 +1892,8 @@ mod kernels {
             // filling the scheduler with instructions that wait for it.
             const BLOCK: usize = 8;
             let mut keep = [[zero; 4]; BLOCK];
+            // which vectors of the block took the unfiltered stages 2-6 (and so stage 7's u + v)
+            let mut unfiltered = [false; BLOCK];
             // the NaN lanes of each vector of the block (bit j: lane j), for `end`
             let mut nan_bits = [0u32; BLOCK];
             let mut base = 0;
@@ -1775,32 +1902,27 @@ mod kernels {
                 start();
                 for (k, slot) in keep.iter_mut().enumerate().take(nv) {
                     let i = base + L * k;
-                    let [ox, oy, oz] = [0, 1, 2].map(|a| load(&rays.o[a], i));
-                    let [dx, dy, dz] = [0, 1, 2].map(|a| load(&rays.d[a], i));
+                    // (direct calls: a closure mapped over an array may stay out of line)
+                    let (ox, oy, oz) = (load(&rays.o[0], i), load(&rays.o[1], i), load(&rays.o[2], i));
+                    let (dx, dy, dz) = (load(&rays.d[0], i), load(&rays.d[1], i), load(&rays.d[2], i));
                     let v = |k: usize, a: usize| load(&tris.v[k][a], i);
-                    let (v0x, v0y, v0z) = (v(0, 0), v(0, 1), v(0, 2));
-                    // stage 1
-                    let (e1x, e1y, e1z) = (sub(v(1, 0), v0x), sub(v(1, 1), v0y), sub(v(1, 2), v0z));
-                    let (e2x, e2y, e2z) = (sub(v(2, 0), v0x), sub(v(2, 1), v0y), sub(v(2, 2), v0z));
-                    let (sx, sy, sz) = (sub(ox, v0x), sub(oy, v0y), sub(oz, v0z));
-                    // stages 2, 3: p = d x e2, q = s x e1
-                    let px = sub(mul(dy, e2z), mul(dz, e2y));
-                    let py = sub(mul(dz, e2x), mul(dx, e2z));
-                    let pz = sub(mul(dx, e2y), mul(dy, e2x));
-                    let qx = sub(mul(sy, e1z), mul(sz, e1y));
-                    let qy = sub(mul(sz, e1x), mul(sx, e1z));
-                    let qz = sub(mul(sx, e1y), mul(sy, e1x));
-                    // stages 4-6: (x + y) + z
-                    let det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
-                    let up = add(add(mul(sx, px), mul(sy, py)), mul(sz, pz));
-                    let vp = add(add(mul(dx, qx), mul(dy, qy)), mul(dz, qz));
-                    let tp = add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz));
-                    *slot = [det, up, vp, tp];
+                    let d = (dx, dy, dz);
+                    // stage 1 unfiltered; when `ok` clears every lane, stages 2-6 unfiltered
+                    // too, else all of stages 1-6 again behind the filter
+                    let (e1, e2, s) = rti_kernel!(@stage1 fsub, v, ox, oy, oz);
+                    let all = [e1.0, e1.1, e1.2, e2.0, e2.1, e2.2, s.0, s.1, s.2, dx, dy, dz];
+                    unfiltered[k] = ok(&all);
+                    *slot = if unfiltered[k] {
+                        rti_kernel!(@stages26 fsub, fadd, fmul, e1, e2, s, d)
+                    } else {
+                        let (e1, e2, s) = rti_kernel!(@stage1 sub, v, ox, oy, oz);
+                        rti_kernel!(@stages26 sub, add, mul, e1, e2, s, d)
+                    };
                 }
                 for (k, &[det, up, vp, tp]) in keep.iter().enumerate().take(nv) {
                     let i = base + L * k;
                     // stage 7
-                    let uv = add(up, vp);
+                    let uv = if unfiltered[k] { fadd(up, vp) } else { add(up, vp) };
                     // The compares of stage 7, with the det-sign select done by a sign flip:
                     // when `det_ok` holds, det is neither ±0 nor NaN (threshold >= 0, checked
                     // by the dispatch), so `det > 0 ? a <= b : b <= a` equals `a^s <= b^s`
@@ -2232,6 +2354,8 @@ mod kernels {
                             $full,
                             |c: &Vec<$v>, i: usize| $x::flush(load(c, i), n),
                             |x| $x::poison($x::split(x, n), x, n),
+                            |x| $x::split(x, n),
+                            |v: &[_; 12]| $x::fast_ok(v, n),
                             $store,
                             super::super::narrow_thr(rti, n),
                             || {},
@@ -2256,17 +2380,31 @@ mod kernels {
                     full: usize,
                 ) {
                     let n: &Narrow = &super::super::narrow_of(&rti.fmt).expect("the dispatch checked the format");
-                    // SAFETY (loads and stores): as above.
-                    narrow_rti!(
-                        rti,
-                        rays,
-                        tris,
-                        out,
-                        full,
-                        u64,
-                        |c: &Vec<u64>, i: usize| unsafe { $x::load_soft(c.as_ptr(), i, n) },
-                        |c: &mut Vec<u64>, i: usize, x| unsafe { $x::store_soft(c.as_mut_ptr(), i, x, n) }
-                    );
+                    // SAFETY (loads and stores): as above. One loop per encoding shape, so that
+                    // neither is decided per load.
+                    if n.e8 {
+                        narrow_rti!(
+                            rti,
+                            rays,
+                            tris,
+                            out,
+                            full,
+                            u64,
+                            |c: &Vec<u64>, i: usize| unsafe { $x::load_e8(c.as_ptr(), i, n) },
+                            |c: &mut Vec<u64>, i: usize, x| unsafe { $x::store_e8(c.as_mut_ptr(), i, x, n) }
+                        );
+                    } else {
+                        narrow_rti!(
+                            rti,
+                            rays,
+                            tris,
+                            out,
+                            full,
+                            u64,
+                            |c: &Vec<u64>, i: usize| unsafe { $x::load_soft(c.as_ptr(), i, n) },
+                            |c: &mut Vec<u64>, i: usize, x| unsafe { $x::store_soft(c.as_mut_ptr(), i, x, n) }
+                        );
+                    }
                 }
 
                 /// One operation of an `eEmM` format on lanes `0..full`: `out[i] = a[i] op b[i]`,

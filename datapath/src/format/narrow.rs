@@ -41,6 +41,30 @@
 //! either way. Under FTZ the operand read flushes in the lanes (a subnormal operand reads as
 //! zero of its sign) and a result that would be subnormal takes the scalar road.
 //!
+//! **The range filter** (a cheaper filter first, CGAL-style, per vector of lanes): the RTI
+//! kernel rounds stage 1 without the per-result check and then looks at the twelve values
+//! every product of stages 2 and 4 takes an operand from (e1, e2, s and d). Let L be the
+//! smallest nonzero magnitude among them and H the largest, and ℓ = 2^⌊log2 L⌋. Every target
+//! value x ≠ 0 is a multiple of its quantum q(x) = 2^(max(⌊log2 |x|⌋, emin) − M), so a
+//! nonzero exact sum or difference of two target values is at least the smaller quantum, and
+//! a value ≥ 2^j has quantum ≥ 2^(j − M) when 2^j ≥ 2^emin. Hence the nonzero results are
+//! at least: stage 2 (d × e2, s × e1) ℓ²; stage 3 (differences) ℓ²·2^−M; stage 4 (products
+//! with one of the twelve) ℓ³·2^−M; stages 5, 6 and u + v (sums) ℓ³·2^−2M, ℓ³·2^−3M,
+//! ℓ³·2^−4M; and, with u = 2^−p the unit roundoff, at most H², 2H²(1+u)², 2H³(1+u)³, 4H³(1+u)⁴,
+//! 6H³(1+u)⁵ and 12H³(1+u)⁶ ≤ 64H³ (u ≤ 1/4). If every lane has L ≥ `fast_lo` =
+//! 2^⌈max((emin + 4M)/3, (emin + M)/2)⌉ and H ≤ `fast_hi` = 2^⌊(emax − 6)/3⌋, every result of
+//! stages 2–7 is ±0 or in [2^emin, max], where the split is the target rounding: the vector
+//! computes stages 2–7 without the check (for e8m16: nonzero stage-1 results and direction
+//! components in [2^−20, 2^40]). Otherwise stages 1–6 are recomputed behind the per-result
+//! check. A NaN among the twelve passes the filter and reaches t, u or v (the fall-through
+//! above); an infinity fails it (H = ∞). The reciprocal or division and the three final
+//! multiplies keep the per-result check.
+//!
+//! **e8mM loads** (E = 8, M ≤ 23, binary32's exponent field and bias): an encoding shifted
+//! left by 23 − M is the binary32 encoding of the same value (subnormals, ±∞ and NaNs
+//! included), which widens to binary64 exactly; a stored lane (a target value, or binary64's
+//! canonical NaN) narrows to binary32 exactly and shifts back.
+//!
 //! Eligible formats: bf16 and `eEmM` with M ≤ 24 and E ≤ 10, either subnormal mode, either
 //! division mode, and the canonical NaN rule (a NaN result is the canonical NaN, so payloads
 //! never matter); the propagate NaN rule keeps the scalar model.
@@ -66,6 +90,14 @@ pub struct Narrow {
     pub split: f64,
     /// The binary64 just below 2^emin (the filter's subnormal threshold).
     pub below_min: f64,
+    /// The range filter's lower limit: a power of two ℓ_min (see "The range filter").
+    pub fast_lo: f64,
+    /// The range filter's upper limit: a power of two h_max (see "The range filter").
+    pub fast_hi: f64,
+    /// E = 8 and M ≤ 23: the encodings convert through binary32 (shifted by 23 − M).
+    pub e8: bool,
+    /// 23 − M, the shift between the encoding and binary32's (meaningful when `e8`).
+    pub e8_shift: u32,
 }
 
 impl Narrow {
@@ -84,6 +116,12 @@ impl Narrow {
             inv_step: super::layout::pow2(m - lay.emin()),
             split: super::layout::pow2(52 - m) + 1.0,
             below_min: f64::from_bits(lay.min_normal().to_bits() - 1),
+            fast_lo: super::layout::pow2(
+                (((lay.emin() + 4 * m) as f64 / 3.0).ceil() as i32).max(((lay.emin() + m) as f64 / 2.0).ceil() as i32),
+            ),
+            fast_hi: super::layout::pow2((lay.emax() - 6).div_euclid(3)),
+            e8: lay.exp_bits == 8 && m <= 23,
+            e8_shift: (23 - m).max(0) as u32,
         })
     }
 }
