@@ -61,8 +61,8 @@ pub const BATCH_PATHS: [&str; 5] = [
     "f32, fp16: binary32 / binary16 kernels (IEEE subnormals, canonical NaN)",
     "bf16: binary32 lanes, each op rounded to bf16 in integer lanes (IEEE or FTZ, canonical NaN; the slab kernels: IEEE)",
     "eEmM with M <= 24, E <= 10: binary64 lanes, each op rounded to p bits behind a filter, flagged lanes on the scalar model (IEEE or FTZ, canonical NaN)",
-    "scalar model only: f32/fp16 with FTZ or the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float; the slab unit of every format but f32, fp16 and bf16",
-    "fixed point qI.F with I + F <= 32: i64 lanes, every rounding, overflow and division mode (datapath::fixed_lanes); wider fixed point: scalar model only",
+    "scalar model only: f32/fp16 with FTZ or the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float; the slab unit of eEmM formats",
+    "fixed point qI.F with I + F <= 32: i64 lanes for RTI and slab (every variant), every rounding, overflow and division mode (datapath::fixed_lanes); wider fixed point: scalar model only",
 ];
 
 /// Adds and multiplies on independent accumulators for about `secs`, on the widest vector
@@ -325,9 +325,13 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     // the slab unit over the bounding boxes of the same triangles: pairs, and one ray against
     // every box (the shape a node's or a level's children have)
     let bf16f: datapath::AnyFormat = "bf16".parse().expect("a built-in format name");
-    for (name, any) in
-        [("f32", datapath::AnyFormat::F32(f32f)), ("fp16", datapath::AnyFormat::F16(f16f)), ("bf16", bf16f)]
-    {
+    let q16f: datapath::AnyFormat = "q16.16".parse().expect("a built-in format name");
+    for (name, any) in [
+        ("f32", datapath::AnyFormat::F32(f32f)),
+        ("fp16", datapath::AnyFormat::F16(f16f)),
+        ("bf16", bf16f),
+        ("q16.16", q16f),
+    ] {
         datapath::with_format!(any, |f| {
             let s = Slab::new(f, SlabConfig::default());
             let (rs, bs) = slab_columns(&s, &cases);

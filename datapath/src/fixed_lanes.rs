@@ -37,6 +37,7 @@
 use crate::format::{DivMode, Fixed, FxOverflow, FxRound};
 use crate::rti::{Cull, HitsSoa, Op, RaysSoa, Rti, TrisSoa};
 use crate::simd::Kernel;
+use crate::slab::{BoxesSoa, Slab, SlabOutSoa, SlabRay, SlabRaysSoa};
 use crate::Format as _;
 
 /// The widest kernel of the fixed-point batch path (AVX-512F with AVX-512DQ: 8 i64 lanes).
@@ -217,6 +218,20 @@ trait Ops: Copy {
     fn lt(&self, a: Self::V, b: Self::V) -> u8;
     /// `a <= b` per lane.
     fn le(&self, a: Self::V, b: Self::V) -> u8;
+    /// `a == b` per lane.
+    fn eq(&self, a: Self::V, b: Self::V) -> u8;
+    /// `m ? a : b` per lane.
+    fn sel(&self, m: u8, a: Self::V, b: Self::V) -> Self::V;
+    /// The larger of `a` and `b`.
+    fn max(&self, a: Self::V, b: Self::V) -> Self::V;
+    /// The smaller of `a` and `b`.
+    fn min(&self, a: Self::V, b: Self::V) -> Self::V;
+    /// `a + k` without the overflow mode (|k| small, `a` a raw value: no i64 overflow).
+    fn step(&self, a: Self::V, k: i64) -> Self::V;
+    /// `col[i..i + L]` of a flag column as a mask.
+    fn load_flags(&self, col: &[bool], i: usize) -> u8 {
+        (0..Self::L).fold(0, |m, j| m | (col[i + j] as u8) << j)
+    }
     /// The format's division (its mode).
     #[inline(always)]
     fn divide<const R: u8, const WRAP: bool, const TWO: bool, const RECIP: bool>(
@@ -303,6 +318,26 @@ impl<const L: usize> Ops for Port<L> {
     #[inline(always)]
     fn le(&self, a: [i64; L], b: [i64; L]) -> u8 {
         Self::bits(a, b, |a, b| a <= b)
+    }
+    #[inline(always)]
+    fn eq(&self, a: [i64; L], b: [i64; L]) -> u8 {
+        Self::bits(a, b, |a, b| a == b)
+    }
+    #[inline(always)]
+    fn sel(&self, m: u8, a: [i64; L], b: [i64; L]) -> [i64; L] {
+        std::array::from_fn(|i| sel(m >> i & 1 == 1, a[i], b[i]))
+    }
+    #[inline(always)]
+    fn max(&self, a: [i64; L], b: [i64; L]) -> [i64; L] {
+        Self::map2(a, b, i64::max)
+    }
+    #[inline(always)]
+    fn min(&self, a: [i64; L], b: [i64; L]) -> [i64; L] {
+        Self::map2(a, b, i64::min)
+    }
+    #[inline(always)]
+    fn step(&self, a: [i64; L], k: i64) -> [i64; L] {
+        a.map(|a| a + k)
     }
 }
 
@@ -411,6 +446,142 @@ fn op_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP: 
             _ => divide::<R, WRAP, TWO, RECIP>(c, a[i], b[i]),
         };
     }
+}
+
+/// The ray of a slab vector: every value per lane (pairs) or broadcast (one ray).
+#[derive(Clone, Copy)]
+struct SlabRayV<V> {
+    o: [V; 3],
+    inv_d: [V; 3],
+    inv_lo: [V; 3],
+    inv_hi: [V; 3],
+    /// Lanes whose axis is parallel (directed variant).
+    parallel: [u8; 3],
+    tmin: V,
+    tmax: V,
+}
+
+/// One vector of slab tests (stage table of [`crate::slab`]), branch-free: (hit, t_near,
+/// t_far). Fixed point has no NaN, so both comparators of the compare unit are max (near) and
+/// min (far); `next_up` / `next_down` are ±1 step saturating at the range's ends; the guard is
+/// off (the conservative variant refuses fixed point).
+#[inline(always)]
+fn slab_vec<X: Ops, const R: u8, const WRAP: bool>(
+    x: &X,
+    s: &crate::slab::SlabConfig,
+    r: &SlabRayV<X::V>,
+    bmin: [X::V; 3],
+    bmax: [X::V; 3],
+) -> (u8, X::V, X::V) {
+    let c = x.c();
+    let (top, bottom) = (x.splat(c.max), x.splat(c.min));
+    let up = |v| x.min(x.step(v, 1), top);
+    let down = |v| x.max(x.step(v, -1), bottom);
+    let zero = x.splat(0);
+    let neg = |v| x.lt(v, zero);
+    if s.directed {
+        let (mut near, mut far, mut outside) = (r.tmin, r.tmax, 0u8);
+        for a in 0..3 {
+            let o = r.o[a];
+            let par = r.parallel[a];
+            let inside = x.le(bmin[a], o) & x.le(o, bmax[a]);
+            outside |= par & !inside;
+            let ng = neg(r.inv_d[a]);
+            let (pe, px) = (x.sel(ng, bmax[a], bmin[a]), x.sel(ng, bmin[a], bmax[a]));
+            let (de, dx) = (x.sub::<WRAP>(pe, o), x.sub::<WRAP>(px, o));
+            let (de_lo, de_hi, dx_lo, dx_hi) = (down(de), up(de), down(dx), up(dx));
+            let (up_inf, lo_inf) = (|v| x.eq(v, top), |v| x.eq(v, bottom));
+            let x_e = x.sel(ng, de_hi, de_lo);
+            let x_e_inf = (ng & up_inf(de_hi)) | (!ng & lo_inf(de_lo));
+            let se = neg(x_e);
+            let inv_e = x.sel(se, r.inv_hi[a], r.inv_lo[a]);
+            let inv_e_inf = (se & up_inf(r.inv_hi[a])) | (!se & lo_inf(r.inv_lo[a]));
+            let x_x = x.sel(ng, dx_lo, dx_hi);
+            let x_x_inf = (ng & lo_inf(dx_lo)) | (!ng & up_inf(dx_hi));
+            let sx = neg(x_x);
+            let inv_x = x.sel(sx, r.inv_lo[a], r.inv_hi[a]);
+            let inv_x_inf = (sx & lo_inf(r.inv_lo[a])) | (!sx & up_inf(r.inv_hi[a]));
+            let entry = x.sel(x_e_inf | inv_e_inf, bottom, down(x.mul::<R, WRAP>(x_e, inv_e)));
+            let exit = x.sel(x_x_inf | inv_x_inf, top, up(x.mul::<R, WRAP>(x_x, inv_x)));
+            // a parallel axis adds no constraint
+            near = x.sel(par, near, x.max(near, entry));
+            far = x.sel(par, far, x.min(far, exit));
+        }
+        return (!outside & x.le(near, far), near, far);
+    }
+    let (mut near, mut far) = (r.tmin, r.tmax);
+    for a in 0..3 {
+        let (lo, hi) = (x.sub::<WRAP>(bmin[a], r.o[a]), x.sub::<WRAP>(bmax[a], r.o[a]));
+        let (tlo, thi) = (x.mul::<R, WRAP>(lo, r.inv_d[a]), x.mul::<R, WRAP>(hi, r.inv_d[a]));
+        let ng = neg(r.inv_d[a]);
+        near = x.max(near, x.sel(ng, thi, tlo));
+        far = x.min(far, x.sel(ng, tlo, thi));
+    }
+    // stage 5: widening by |widen_ulps| steps (saturating)
+    let w = s.widen_ulps.unsigned_abs() as i64;
+    if s.widen_ulps > 0 {
+        near = x.max(x.step(near, -w), bottom);
+        far = x.min(x.step(far, w), top);
+    } else if s.widen_ulps < 0 {
+        near = x.min(x.step(near, w), top);
+        far = x.max(x.step(far, -w), bottom);
+    }
+    (x.le(near, far), near, far)
+}
+
+/// The slab loop over slots `0..n / L * L` (pairs, or one ray against every box); returns
+/// that count.
+#[inline(always)]
+fn slab_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP: bool>(
+    x: &X,
+    s: &crate::slab::SlabConfig,
+    rays: SlabShape<'_>,
+    boxes: &BoxesSoa<i64>,
+    out: &mut SlabOutSoa<i64>,
+) -> usize {
+    let n = out.hit.len();
+    let full = n / X::L * X::L;
+    let one = match rays {
+        SlabShape::One(r) => Some(SlabRayV {
+            o: r.o.map(|v| x.splat(v)),
+            inv_d: r.inv_d.map(|v| x.splat(v)),
+            inv_lo: r.inv_lo.map(|v| x.splat(v)),
+            inv_hi: r.inv_hi.map(|v| x.splat(v)),
+            parallel: r.parallel.map(|p| if p { u8::MAX } else { 0 }),
+            tmin: x.splat(r.tmin),
+            tmax: x.splat(r.tmax),
+        }),
+        SlabShape::Pairs(_) => None,
+    };
+    for i in (0..full).step_by(X::L) {
+        let ray = match (one, rays) {
+            (Some(r), _) => r,
+            (None, SlabShape::Pairs(r)) => SlabRayV {
+                o: [0, 1, 2].map(|a| x.load(&r.o[a], i)),
+                inv_d: [0, 1, 2].map(|a| x.load(&r.inv_d[a], i)),
+                inv_lo: [0, 1, 2].map(|a| x.load(&r.inv_lo[a], i)),
+                inv_hi: [0, 1, 2].map(|a| x.load(&r.inv_hi[a], i)),
+                parallel: [0, 1, 2].map(|a| x.load_flags(&r.parallel[a], i)),
+                tmin: x.load(&r.tmin, i),
+                tmax: x.load(&r.tmax, i),
+            },
+            (None, SlabShape::One(_)) => unreachable!("the one-ray shape is broadcast above"),
+        };
+        let bmin = [0, 1, 2].map(|a| x.load(&boxes.min[a], i));
+        let bmax = [0, 1, 2].map(|a| x.load(&boxes.max[a], i));
+        let (hit, near, far) = slab_vec::<X, R, WRAP>(x, s, &ray, bmin, bmax);
+        store_flags(&mut out.hit, i, X::L, hit);
+        x.store(&mut out.t_near, i, near);
+        x.store(&mut out.t_far, i, far);
+    }
+    full
+}
+
+/// What a slab batch tests: ray i against box i, or one ray against every box.
+#[derive(Clone, Copy)]
+enum SlabShape<'a> {
+    Pairs(&'a SlabRaysSoa<i64>),
+    One(&'a SlabRay<i64>),
 }
 
 /// Calls `$f::<$x, R, WRAP, TWO, RECIP>($args)` for the format's modes.
@@ -597,6 +768,26 @@ mod zmm {
         fn le(&self, a: __m512i, b: __m512i) -> u8 {
             unsafe { _mm512_cmple_epi64_mask(a, b) }
         }
+        #[inline(always)]
+        fn eq(&self, a: __m512i, b: __m512i) -> u8 {
+            unsafe { _mm512_cmpeq_epi64_mask(a, b) }
+        }
+        #[inline(always)]
+        fn sel(&self, m: u8, a: __m512i, b: __m512i) -> __m512i {
+            unsafe { _mm512_mask_blend_epi64(m, b, a) }
+        }
+        #[inline(always)]
+        fn max(&self, a: __m512i, b: __m512i) -> __m512i {
+            unsafe { _mm512_max_epi64(a, b) }
+        }
+        #[inline(always)]
+        fn min(&self, a: __m512i, b: __m512i) -> __m512i {
+            unsafe { _mm512_min_epi64(a, b) }
+        }
+        #[inline(always)]
+        fn step(&self, a: __m512i, k: i64) -> __m512i {
+            unsafe { _mm512_add_epi64(a, _mm512_set1_epi64(k)) }
+        }
     }
 }
 
@@ -646,6 +837,44 @@ mod isa {
         // SAFETY: this function's features
         let z = unsafe { zmm::Z::new(*c) };
         rti_any(&z, rti, rays, tris, out, n)
+    }
+
+    /// The slab loop on lanes `x` for the unit's modes; returns the slots done.
+    #[inline(always)]
+    fn slab_any<X: Ops>(
+        x: &X,
+        s: &Slab<Fixed>,
+        rays: SlabShape<'_>,
+        boxes: &BoxesSoa<i64>,
+        out: &mut SlabOutSoa<i64>,
+    ) -> usize {
+        by_modes!(&s.fmt, slab_loop, X, x, &s.cfg, rays, boxes, out)
+    }
+
+    /// AVX2 (4 lanes).
+    #[target_feature(enable = "avx2")]
+    pub(super) fn slab_avx2(
+        s: &Slab<Fixed>,
+        c: &Lanes,
+        rays: SlabShape<'_>,
+        boxes: &BoxesSoa<i64>,
+        out: &mut SlabOutSoa<i64>,
+    ) -> usize {
+        slab_any(&Port::<4>(*c), s, rays, boxes, out)
+    }
+
+    /// AVX-512F + DQ (8 lanes).
+    #[target_feature(enable = "avx512f,avx512dq")]
+    pub(super) fn slab_avx512(
+        s: &Slab<Fixed>,
+        c: &Lanes,
+        rays: SlabShape<'_>,
+        boxes: &BoxesSoa<i64>,
+        out: &mut SlabOutSoa<i64>,
+    ) -> usize {
+        // SAFETY: this function's features
+        let z = unsafe { zmm::Z::new(*c) };
+        slab_any(&z, s, rays, boxes, out)
     }
 
     /// AVX2 (4 lanes).
@@ -733,4 +962,74 @@ pub fn op_batch_fixed(f: &Fixed, op: Op, a: &[i64], b: &[i64], out: &mut [i64]) 
         };
     }
     Kernel::Scalar
+}
+
+/// The kernel `slab_batch_fixed` / `slab_ray_fixed` use for this unit: as [`kernel_fixed`],
+/// every variant.
+pub fn slab_kernel_fixed(s: &Slab<Fixed>) -> Kernel {
+    kernel_fixed(&s.fmt)
+}
+
+/// Runs the slab kernel `which` names on the full vectors, the scalar model on the rest.
+fn slab_fixed(s: &Slab<Fixed>, rays: SlabShape<'_>, boxes: &BoxesSoa<i64>, out: &mut SlabOutSoa<i64>) -> Kernel {
+    let n = out.hit.len();
+    let cols_ok = boxes.min.iter().chain(&boxes.max).all(|c| c.len() == n)
+        && [&out.t_near, &out.t_far].iter().all(|c| c.len() == n);
+    let rays_ok = match rays {
+        SlabShape::Pairs(r) => {
+            assert!(r.tmin.len() == n && boxes.min[0].len() == n, "batch lengths differ");
+            [&r.o, &r.inv_d, &r.inv_lo, &r.inv_hi].iter().all(|c| c.iter().all(|c| c.len() == n))
+                && r.parallel.iter().all(|c| c.len() == n)
+                && r.tmax.len() == n
+        }
+        SlabShape::One(_) => {
+            assert!(boxes.min[0].len() == n, "batch lengths differ");
+            true
+        }
+    };
+    let which = slab_kernel_fixed(s);
+    #[cfg(target_arch = "x86_64")]
+    if let Some(c) = Lanes::of(&s.fmt).filter(|_| cols_ok && rays_ok) {
+        // SAFETY: `which` names a kernel only after run-time feature detection.
+        let full = match which {
+            Kernel::Avx2 => unsafe { isa::slab_avx2(s, &c, rays, boxes, out) },
+            Kernel::Scalar => 0,
+            _ => unsafe { isa::slab_avx512(s, &c, rays, boxes, out) },
+        };
+        if which != Kernel::Scalar {
+            match rays {
+                SlabShape::Pairs(r) => s.batch_from(r, boxes, out, full),
+                SlabShape::One(r) => s.batch_ray_from(r, boxes, out, full),
+            }
+            return which;
+        }
+    }
+    let _ = (which, cols_ok, rays_ok);
+    match rays {
+        SlabShape::Pairs(r) => s.batch(r, boxes, out),
+        SlabShape::One(r) => s.batch_ray(r, boxes, out),
+    }
+    Kernel::Scalar
+}
+
+/// [`Slab::batch`] for a fixed-point format on the fastest kernel available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn slab_batch_fixed(
+    s: &Slab<Fixed>,
+    rays: &SlabRaysSoa<i64>,
+    boxes: &BoxesSoa<i64>,
+    out: &mut SlabOutSoa<i64>,
+) -> Kernel {
+    slab_fixed(s, SlabShape::Pairs(rays), boxes, out)
+}
+
+/// [`Slab::batch_ray`] (one ray, many boxes) for a fixed-point format on the fastest kernel
+/// available; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn slab_ray_fixed(s: &Slab<Fixed>, ray: &SlabRay<i64>, boxes: &BoxesSoa<i64>, out: &mut SlabOutSoa<i64>) -> Kernel {
+    slab_fixed(s, SlabShape::One(ray), boxes, out)
 }

@@ -41,7 +41,7 @@
 //! The AVX-512F and AVX512-FP16 kernels are tested by the same property tests as the AVX2
 //! ones, on an emulated machine with both (`emu/avx512`, Bochs 3.0) when the host has neither.
 
-pub use crate::fixed_lanes::rti_batch_fixed;
+pub use crate::fixed_lanes::{rti_batch_fixed, slab_batch_fixed, slab_ray_fixed};
 use crate::format::narrow::Narrow;
 use crate::format::{Bf16, DivMode, F16Half, F32Native, Ieee, IeeeBackend, NanMode, Soft, Subnormals};
 use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
@@ -619,7 +619,14 @@ pub fn slab_batch<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
-    by_format!(s, rays, boxes, out, [slab_batch_f32, slab_batch_f16, slab_batch_bf16], s.batch(rays, boxes, out))
+    by_format!(
+        s,
+        rays,
+        boxes,
+        out,
+        [slab_batch_f32, slab_batch_f16, slab_batch_bf16, slab_batch_fixed],
+        s.batch(rays, boxes, out)
+    )
 }
 
 /// [`Slab::batch_ray`] (one ray, many boxes) for any format on the fastest bit-identical
@@ -636,7 +643,14 @@ pub fn slab_ray<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
-    by_format!(s, ray, boxes, out, [slab_ray_f32, slab_ray_f16, slab_ray_bf16], s.batch_ray(ray, boxes, out))
+    by_format!(
+        s,
+        ray,
+        boxes,
+        out,
+        [slab_ray_f32, slab_ray_f16, slab_ray_bf16, slab_ray_fixed],
+        s.batch_ray(ray, boxes, out)
+    )
 }
 
 /// Pairs per chunk of [`rti_stream`]: 256 pairs × (15 input + 3 output columns) × 4 bytes plus
