@@ -1,5 +1,14 @@
-//! Judging one model result: the model's bits against the golden f64 reference on the same
+//! Judging one model result: the model's bits against the reference decision on the same
 //! (format-quantised) inputs, and against the error bound of the datapath.
+//!
+//! The **reference decision** is the exact hit/miss of the quantised test, found by a filter
+//! first (CGAL's filtered predicates): the det-scaled quantities the decision reads (det,
+//! u', v', det − (u' + v'), t' and t against the interval's finite ends), evaluated in f64 in
+//! the datapath's order, each clear of zero by more than the bound on their f64 evaluation
+//! ([`datapath::bound::RtiBound`] with the zero error model [`EXACT_F64`], i.e. its
+//! `F64_SLACK` term alone), give the exact signs; a test the filter cannot decide (or whose
+//! f64 evaluation overflows) *falls through* to exact rational arithmetic
+//! ([`golden::intersect_exact`]). The golden f64 Möller–Trumbore (textbook order) gives t.
 
 use datapath::bound::RtiBound;
 use datapath::rti::{Cull, Rti};
@@ -13,8 +22,12 @@ pub struct Judged {
     pub hit: bool,
     /// Model t as f64.
     pub t: f64,
-    /// Golden result on the quantised inputs.
+    /// Golden result on the quantised inputs (its t is the reference t).
     pub golden: MtResult,
+    /// The reference (exact) hit decision: the f64 filter's, or exact rational arithmetic's.
+    pub reference_hit: bool,
+    /// The f64 filter could not decide: exact rational arithmetic did.
+    pub fell_through: bool,
     /// The error bound says the model must reproduce the exact decision.
     pub decisive: bool,
     /// The bound's exact decision.
@@ -26,14 +39,15 @@ pub struct Judged {
 }
 
 impl Judged {
-    /// A property failure: a decisive case whose hit/miss differs from the golden (or from the
-    /// bound's exact decision), or a shared hit whose t error exceeds the bound.
+    /// A property failure: a decisive case whose hit/miss differs from the reference decision
+    /// (which, in a decisive case, is the bound's exact decision), or a shared hit whose t
+    /// error exceeds the bound.
     pub fn violation(&self) -> Option<String> {
         if !self.decisive {
             return None;
         }
-        if self.hit != self.golden.hit || self.golden.hit != self.exact_hit {
-            return Some(format!("hit/miss: model {} golden {} exact {}", self.hit, self.golden.hit, self.exact_hit));
+        if self.hit != self.reference_hit || self.reference_hit != self.exact_hit {
+            return Some(format!("hit/miss: model {} exact {}", self.hit, self.reference_hit));
         }
         if self.hit && self.t_error() > self.t_err + self.golden.t.abs() * 1e-12 {
             return Some(format!("t error {:e} exceeds bound {:e}", self.t_error(), self.t_err));
@@ -61,6 +75,24 @@ pub fn quantise<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> (Ray64, Tr
     )
 }
 
+/// The error model of an exact evaluation: no rounding error, only the bound's f64
+/// evaluation slack (the f64 filter of the reference decision).
+pub const EXACT_F64: datapath::format::ErrorModel =
+    datapath::format::ErrorModel { u: 0.0, eta: 0.0, add_eta: 0.0, max: f64::MAX };
+
+/// The reference decision of a quantised test and whether it fell through the f64 filter to
+/// exact rational arithmetic (see the module documentation); `golden_hit` stands in where the
+/// exact arithmetic has no answer (a non-finite input).
+pub fn reference<F: Format>(rti: &Rti<F>, rq: &Ray64, tq: &Tri64, golden_hit: bool) -> (bool, bool) {
+    let b = RtiBound::new(EXACT_F64, datapath::format::DivMode::Divide, rq.o, rq.d, tq.v);
+    let v = b.verdict(rti.cull, rti.fmt.to_f64(rti.det_thr), rq.tmin, rq.tmax);
+    if v.decisive {
+        (v.hit, false)
+    } else {
+        (golden::intersect_exact(rq, tq, faces(rti)).unwrap_or(golden_hit), true)
+    }
+}
+
 /// Runs the model on one test and judges it.
 pub fn judge<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> Judged {
     let f = &rti.fmt;
@@ -69,13 +101,70 @@ pub fn judge<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> Judged {
     let golden = golden::intersect(&rq, &tq, faces(rti));
     let b = RtiBound::new(f.error_model(), f.div_mode(), rq.o, rq.d, tq.v);
     let v = b.verdict(rti.cull, f.to_f64(rti.det_thr), rq.tmin, rq.tmax);
+    // a decisive case is also decided by the f64 filter (the model's bounds include its slack)
+    let (reference_hit, fell_through) = if v.decisive { (v.hit, false) } else { reference(rti, &rq, &tq, golden.hit) };
     Judged {
         hit: out.hit,
         t: f.to_f64(out.t),
         golden,
+        reference_hit,
+        fell_through,
         decisive: v.decisive,
         exact_hit: v.hit,
         t_err: b.t_err,
         ulp: f.ulp(golden.t),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use datapath::format::{F32Native, FpOpts, Ieee};
+    use datapath::rti::RtiConfig;
+
+    fn rti() -> Rti<Ieee<F32Native>> {
+        Rti::new(Ieee::new(F32Native, FpOpts::default()), RtiConfig::default())
+    }
+
+    const TRI: Tri64 = Tri64 { v: [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] };
+
+    fn down(x: f64, y: f64) -> Ray64 {
+        Ray64 { o: [x, y, 1.0], d: [0.0, 0.0, -1.0], tmin: 0.0, tmax: f64::INFINITY }
+    }
+
+    /// A test clear of every threshold is decided by the f64 filter; one exactly on an edge or
+    /// a vertex (u' = 0, or u' + v' = det) cannot be, falls through, and gets the exact
+    /// answer (the closed triangle: a hit); one a hair outside an edge, far from the origin
+    /// (cancellation), falls through and misses.
+    #[test]
+    fn the_reference_filters_first_and_falls_through_to_exact_arithmetic() {
+        let r = rti();
+        assert_eq!(reference(&r, &down(0.25, 0.25), &TRI, false), (true, false));
+        assert_eq!(reference(&r, &down(2.0, 2.0), &TRI, true), (false, false));
+        for (x, y) in [(0.0, 0.5), (0.5, 0.0), (0.5, 0.5), (0.0, 0.0), (1.0, 0.0)] {
+            assert_eq!(reference(&r, &down(x, y), &TRI, false), (true, true), "({x}, {y})");
+        }
+        // tiny margins the f64 evaluation resolves exactly: still the filter's
+        let e = 2f64.powi(-60);
+        assert_eq!(reference(&r, &down(-e, 0.5), &TRI, true), (false, false));
+        // the same triangle far from the origin (x + 2^30): u' = -2^-20 against monomials of
+        // 2^31, which the f64 filter cannot certify; exact arithmetic says outside
+        let far = Tri64 { v: TRI.v.map(|p| [p[0] + 2f64.powi(30), p[1], p[2]]) };
+        let x = 2f64.powi(30) - 2f64.powi(-20);
+        assert_eq!(reference(&r, &down(x, 0.5), &far, true), (false, true));
+        assert_eq!(reference(&r, &down(x + 2f64.powi(-19), 0.5), &far, false), (true, true));
+        // a NaN input has no exact answer: the golden's stands
+        assert_eq!(reference(&r, &down(f64::NAN, 0.5), &TRI, true), (true, true));
+    }
+
+    /// The judge uses the reference: an on-edge test's reference hit is the exact one, and
+    /// fell_through says so.
+    #[test]
+    fn the_judge_reports_the_fall_through() {
+        let r = rti();
+        let j = judge(&r, &down(0.0, 0.5), &TRI);
+        assert!(j.reference_hit && j.fell_through && !j.decisive);
+        let j = judge(&r, &down(0.25, 0.25), &TRI);
+        assert!(j.reference_hit && !j.fell_through && j.decisive);
     }
 }

@@ -52,14 +52,17 @@ pub struct FormatReport {
     pub tests: u64,
     /// Tests whose error bound makes the decision certain.
     pub decisive: u64,
-    /// Golden hits.
+    /// Reference hits: the exact decision on the quantised inputs (f64 filter, then exact
+    /// rational arithmetic; see `crate::judge`).
     pub golden_hits: u64,
     /// Model hits.
     pub model_hits: u64,
-    /// Model miss where the golden hits.
+    /// Model miss where the reference hits.
     pub false_misses: u64,
-    /// Model hit where the golden misses.
+    /// Model hit where the reference misses.
     pub false_hits: u64,
+    /// Tests the f64 filter could not decide, decided by exact rational arithmetic.
+    pub exact: u64,
     /// Property failures (must be 0).
     pub violations: u64,
     /// Tests where both hit.
@@ -162,10 +165,11 @@ pub fn render(r: &VerifyReport) -> String {
         r.scene, r.triangles, r.scale, r.rays, r.seed, r.tests_per_ray
     );
     s += &format!(
-        "{:<16} {:>9} {:>9} {:>8} {:>8} {:>7} {:>7} {:>6} {:>10} {:>10} {:>9} {:>9} {:>8} {:>9}\n",
+        "{:<16} {:>9} {:>9} {:>7} {:>8} {:>8} {:>7} {:>7} {:>6} {:>10} {:>10} {:>9} {:>9} {:>8} {:>9}\n",
         "format",
         "tests",
         "decisive",
+        "exact",
         "g-hits",
         "m-hits",
         "f-miss",
@@ -180,10 +184,11 @@ pub fn render(r: &VerifyReport) -> String {
     );
     for f in &r.formats {
         s += &format!(
-            "{:<16} {:>9} {:>9} {:>8} {:>8} {:>7} {:>7} {:>6} {:>10.3} {:>10.3} {:>9.2e} {:>9.2e} {:>8} {:>9.2}\n",
+            "{:<16} {:>9} {:>9} {:>7} {:>8} {:>8} {:>7} {:>7} {:>6} {:>10.3} {:>10.3} {:>9.2e} {:>9.2e} {:>8} {:>9.2}\n",
             f.format,
             f.tests,
             f.decisive,
+            f.exact,
             f.golden_hits,
             f.model_hits,
             f.false_misses,
@@ -197,7 +202,7 @@ pub fn render(r: &VerifyReport) -> String {
             f.mtests_per_s
         );
     }
-    s += "\nf-miss/f-hit: model vs golden f64 on the same quantised inputs; viol: decisive tests (error bound clear of every threshold) where hit/miss differs or the t error exceeds its bound.\n";
+    s += "\ng-hits, f-miss, f-hit: against the exact decision on the same quantised inputs (an f64 filter; exact: the tests it could not decide, decided in exact rational arithmetic); t errors against the golden f64 t; viol: decisive tests (error bound clear of every threshold) where hit/miss differs or the t error exceeds its bound.\n";
     s += "skipped work: tests whose valid bit clears at stage 7, so a valid-gated divide stage skips them: ";
     s += &r
         .formats
