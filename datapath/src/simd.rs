@@ -251,22 +251,6 @@ fn narrow_thr<B: IeeeBackend>(rti: &Rti<Ieee<B>>, n: &Narrow) -> f64 {
     }
 }
 
-/// The scalar model on the lanes `bad` (bit j: slot `base + j`): the narrow kernels' filter
-/// fall-through.
-#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-fn redo_lanes<F: crate::Format>(
-    rti: &Rti<F>,
-    rays: &RaysSoa<F::V>,
-    tris: &TrisSoa<F::V>,
-    out: &mut HitsSoa<F::V>,
-    base: usize,
-    bad: u32,
-) {
-    for j in (0..32).filter(|&j| bad >> j & 1 == 1) {
-        rti.batch_slot(rays, tris, out, base + j);
-    }
-}
-
 /// The widest kernel of bf16 and the narrow `eEmM` formats (AVX-512F: 16 binary32 / 8 binary64 lanes).
 pub const WIDEST_NARROW: Kernel = Kernel::Avx512;
 
@@ -348,19 +332,13 @@ pub fn op_batch_soft(f: &Ieee<Soft>, op: crate::rti::Op, a: &[u64], b: &[u64], o
         Op::Mul => f.mul(a[i], b[i]),
         _ => f.div(a[i], b[i]),
     };
-    let mut redo = Vec::new();
     #[cfg(target_arch = "x86_64")]
     match which {
         // SAFETY: `which` names a kernel only after run-time feature detection; every slice
         // holds the same n >= full slots (checked above).
-        Kernel::Avx2 => unsafe { kernels::v4d::op_soft(f, op, a, b, out, full, &mut redo) },
+        Kernel::Avx2 => unsafe { kernels::v4d::op_soft(f, op, a, b, out, full) },
         Kernel::Scalar => {}
-        _ => unsafe { kernels::v8d::op_soft(f, op, a, b, out, full, &mut redo) },
-    }
-    for (i, mask) in redo {
-        for k in (0..32).filter(|k| mask >> k & 1 == 1) {
-            out[i + k] = scalar(i + k);
-        }
+        _ => unsafe { kernels::v8d::op_soft(f, op, a, b, out, full) },
     }
     for (i, o) in out.iter_mut().enumerate().skip(full) {
         *o = scalar(i);
@@ -1242,12 +1220,12 @@ mod isa {
     }
 
     /// The narrow formats' rounding, filter and flush, in the ops of the ISA module that
-    /// invokes it (`v4d`, `v8d`: binary64 lanes, each with its own `pred`).
+    /// invokes it (`v4d`, `v8d`: binary64 lanes).
     macro_rules! narrow_ops {
         ($feat:literal, $v:ty) => {
             /// Every lane rounded to the format's precision p, nearest-even, by Veltkamp's
             /// splitting (g = x·(2^S + 1), then g − (g − x)); correct for |x| in [2^emin, max]
-            /// and for zeros, which is what [`poison`] checks.
+            /// and for zeros ([`round_full`] handles the rest of the range).
             #[inline]
             #[target_feature(enable = $feat)]
             pub fn split(x: $v, n: &Narrow) -> $v {
@@ -1255,31 +1233,41 @@ mod isa {
                 // g − (g − x) is g + (x − g) (nearest-even rounding is symmetric) with -0 kept
                 sub(g, sub(g, x))
             }
-            /// `r`, or a NaN where the unrounded `x` lies outside {±0} ∪ [2^emin, max] (a
-            /// subnormal, an overflow, an infinity): the NaN reaches the lane's t, u or v, and
-            /// the lane is recomputed by the scalar model.
+            /// Every lane rounded to the format, nearest-even, with its range (see "Rounding in
+            /// the lanes" in [`crate::format::narrow`]): [`split`] where |x| ≥ 2^emin; the
+            /// subnormal grid where |x| < 2^emin (`(|x| + C) − C`, C = 2^(emin − M + 52), sign
+            /// restored), then under FTZ a subnormal result flushed to zero of its sign; ±∞ where
+            /// |x| ≥ max + ulp(max)/2 (infinities included). A NaN stays a NaN.
             #[inline]
             #[target_feature(enable = $feat)]
-            pub fn poison(r: $v, x: $v, n: &Narrow) -> $v {
-                let out = or_m(lt(splat(n.max_finite), abs(x)), lt(pred(x), splat(n.below_min)));
-                blend(r, canonical_nan(), out)
+            pub fn round_full(x: $v, n: &Narrow) -> $v {
+                let a = abs(x);
+                let sgn = sign(x);
+                let mut tiny = sub(add(a, splat(n.sub_grid)), splat(n.sub_grid));
+                if n.ftz {
+                    tiny = blend(tiny, splat(0.0), lt(tiny, splat(n.min_normal)));
+                }
+                let r = blend(split(x, n), xor(tiny, sgn), lt(a, splat(n.min_normal)));
+                blend(r, xor(splat(f64::INFINITY), sgn), le(splat(n.overflow_at), a))
             }
             /// The range filter (see [`crate::format::narrow`]): true when on every lane the
             /// nonzero magnitudes among `v` (the stage-1 results and the direction) are at
             /// least `n.fast_lo` and all magnitudes at most `n.fast_hi`, so that no result of
-            /// stages 2-6 leaves {±0} ∪ [2^emin, max]. A NaN may pass: it reaches t, u or v.
+            /// stages 2-6 leaves {±0} ∪ [2^emin, max]. A NaN fails (the unfiltered stage 1
+            /// turns an infinite difference into a NaN, which must take the filtered road).
             #[inline]
             #[target_feature(enable = $feat)]
             pub fn fast_ok(v: &[$v; 12], n: &Narrow) -> bool {
-                let (zero, inf) = (splat(0.0), splat(f64::INFINITY));
-                let (mut hi, mut lo) = (zero, inf);
+                let (zero, inf, top) = (splat(0.0), splat(f64::INFINITY), splat(n.fast_hi));
+                let mut lo = inf;
+                // all lanes, then cleared where a magnitude is above fast_hi or NaN
+                let mut good = le(zero, zero);
                 for &x in v {
                     let a = abs(x);
-                    hi = max(a, hi);
+                    good = and_m(good, le(a, top));
                     lo = min_where(lo, a, lt(zero, a));
                 }
-                let good = and_m(le(splat(n.fast_lo), lo), le(hi, splat(n.fast_hi)));
-                bits(good) == (1 << LANES) - 1
+                bits(and_m(good, le(splat(n.fast_lo), lo))) == (1 << LANES) - 1
             }
             /// Under FTZ, subnormal lanes read as zeros of the same sign (the operand read).
             #[inline]
@@ -1387,12 +1375,6 @@ mod isa {
         pub unsafe fn flags(p: *mut bool, i: usize, m: M) {
             // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
             unsafe { (p.add(i) as *mut u32).write_unaligned(super::SPREAD[bits(m) as usize] as u32) }
-        }
-        /// The binary64 just below each lane's magnitude (a NaN for ±0).
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        fn pred(x: __m256d) -> __m256d {
-            _mm256_castsi256_pd(_mm256_sub_epi64(_mm256_castpd_si256(abs(x)), int(1)))
         }
         narrow_ops!("avx2", __m256d);
         /// Loads 4 `eEmM` encodings as binary64 (exact).
@@ -1580,12 +1562,6 @@ mod isa {
         pub unsafe fn flags(p: *mut bool, i: usize, m: M) {
             // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
             unsafe { (p.add(i) as *mut u64).write_unaligned(super::SPREAD[m as usize]) }
-        }
-        /// The binary64 just below each lane's magnitude (a NaN for ±0).
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        fn pred(x: __m512d) -> __m512d {
-            fb(_mm512_sub_epi64(ib(abs(x)), int(1)))
         }
         narrow_ops!("avx512f", __m512d);
         /// Loads 8 `eEmM` encodings as binary64 (exact).
@@ -2338,13 +2314,11 @@ mod kernels {
     kernels_for!(v16, "avx512f", "avx512f,avx2");
     kernels_for!(v32h, binary16 "avx512fp16,avx512bw,avx512f");
 
-    /// The RTI kernels of the narrow float formats (bf16, `eEmM` with M ≤ 24 and E ≤ 10) on
-    /// the binary64 lanes of one instruction set (`v4d`, `v8d`): the same stage table, every
-    /// operation in binary64 then rounded to the format's precision by [`isa::v4d::split`],
-    /// behind a filter ([`crate::format::narrow`]): each lane tracks the largest magnitude and
-    /// the smallest nonzero magnitude of every unrounded result (and, under FTZ, of every
-    /// operand read); a lane where either left [2^emin, max] at any step (a subnormal, an
-    /// overflow, an infinity) is recomputed by the scalar model after its block.
+    /// The RTI kernels of the narrow `eEmM` formats (M ≤ 24 and E ≤ 10) on the binary64 lanes
+    /// of one instruction set (`v4d`, `v8d`): the same stage table, every operation in
+    /// binary64 then rounded to the format in the lanes, its whole range included
+    /// ([`isa::v4d::round_full`]), and stages 2-7 by the split alone when the range filter
+    /// ([`isa::v4d::fast_ok`]) proves them in range (see [`crate::format::narrow`]).
     macro_rules! narrow_for {
         ($x:ident, $feat:literal) => {
             pub(in crate::simd) mod $x {
@@ -2367,19 +2341,13 @@ mod kernels {
                             $out,
                             $full,
                             |c: &Vec<$v>, i: usize| $x::flush(load(c, i), n),
-                            |x| $x::poison($x::split(x, n), x, n),
+                            |x| $x::round_full(x, n),
                             |x| $x::split(x, n),
                             |v: &[_; 12]| $x::fast_ok(v, n),
                             $store,
                             super::super::narrow_thr(rti, n),
                             || {},
-                            |base: usize, nv: usize, nan: &[u32; 8], out: &mut HitsSoa<$v>| {
-                                for (k, &bad) in nan.iter().enumerate().take(nv) {
-                                    if bad != 0 {
-                                        super::super::redo_lanes(rti, rays, tris, out, base + $x::LANES * k, bad);
-                                    }
-                                }
-                            }
+                            |_: usize, _: usize, _: &[u32; 8], _: &mut HitsSoa<$v>| {}
                         )
                     }};
                 }
@@ -2422,18 +2390,9 @@ mod kernels {
                 }
 
                 /// One operation of an `eEmM` format on lanes `0..full`: `out[i] = a[i] op b[i]`,
-                /// behind the same filter; returns the lanes (bit k: lane k of the vector at
-                /// `i`) the caller must recompute, as `(i, mask)` pairs in `redo`.
+                /// each result rounded by [`isa::v4d::round_full`] (the RTI kernel's rounding).
                 #[target_feature(enable = $feat)]
-                pub fn op_soft(
-                    f: &Ieee<Soft>,
-                    op: crate::rti::Op,
-                    a: &[u64],
-                    b: &[u64],
-                    out: &mut [u64],
-                    full: usize,
-                    redo: &mut Vec<(usize, u32)>,
-                ) {
+                pub fn op_soft(f: &Ieee<Soft>, op: crate::rti::Op, a: &[u64], b: &[u64], out: &mut [u64], full: usize) {
                     use crate::rti::Op;
                     let n = &super::super::narrow_of(f).expect("the dispatch checked the format");
                     let mut i = 0;
@@ -2441,7 +2400,7 @@ mod kernels {
                         // SAFETY: the caller checked that every slice holds `full` lanes.
                         let (x, y) = unsafe { ($x::load_soft(a.as_ptr(), i, n), $x::load_soft(b.as_ptr(), i, n)) };
                         let (x, y) = ($x::flush(x, n), $x::flush(y, n));
-                        let rd = |v| $x::poison($x::split(v, n), v, n);
+                        let rd = |v| $x::round_full(v, n);
                         let r = match (op, f.opts.div) {
                             (Op::Add, _) => rd($x::add(x, y)),
                             (Op::Sub, _) => rd($x::sub(x, y)),
@@ -2455,10 +2414,6 @@ mod kernels {
                         };
                         // SAFETY: as above; a NaN lane is stored as the canonical NaN.
                         unsafe { $x::store_soft(out.as_mut_ptr(), i, r, n) };
-                        let bad = $x::bits($x::unord(r, r));
-                        if bad != 0 {
-                            redo.push((i, bad));
-                        }
                         i += $x::LANES;
                     }
                 }

@@ -24,22 +24,26 @@
 //! * E = 11 layouts share binary64's exponent range, where binary64's own subnormals lose
 //!   bits: they keep the scalar model.
 //!
-//! The lanes round with a filter (CGAL's filtered-predicate pattern): each result
-//! x is rounded to p bits by Veltkamp's splitting, g = x·(2^S + 1), r = g − (g − x) (with
-//! nearest-even binary64 arithmetic, r is x rounded to 53 − S = p bits, ties to even; g − (g −
-//! x) rather than g + (x − g) keeps the sign of −0). This is the target rounding whenever x
-//! is ±0 or 2^emin ≤ |x| ≤ max (a value below 2^emin that rounds up to 2^emin does so on both
-//! grids). Any other x (a subnormal result, an overflow, an infinity) makes the lane's value a
-//! NaN, which reaches its t, u or v: every signal of the stage table feeds one of them, but
-//! u + v, which feeds only the compare u + v ≤ |det|. A poisoned u + v compares false, as the
-//! model's does where it overflows (±∞ > |det|); a subnormal u + v can make the compare
-//! differ only when the lane is valid otherwise, i.e. u', v' ≥ 0, and then u', v' < 2^emin
-//! (two nonnegative values of which one is ≥ 2^emin sum to ≥ 2^emin), so one of them is a
-//! nonzero subnormal (poisoned: u or v is NaN) or both are zero (u + v = 0, not poisoned).
-//! After each block of vectors the lanes
-//! with a NaN result are recomputed by the scalar model, so a lane's bits are the model's
-//! either way. Under FTZ the operand read flushes in the lanes (a subnormal operand reads as
-//! zero of its sign) and a result that would be subnormal takes the scalar road.
+//! **Rounding in the lanes** (`round_full` in `datapath::simd`): each binary64 result x is
+//! rounded to the target, nearest-even, with its whole range:
+//! * 2^emin ≤ |x| < max + ulp(max)/2: Veltkamp's splitting, g = x·(2^S + 1), r = g − (g − x)
+//!   (with nearest-even binary64 arithmetic, r is x rounded to 53 − S = p bits, ties to even;
+//!   g − (g − x) rather than g + (x − g) keeps the sign of −0). Below the overflow threshold
+//!   the p-bit rounding never exceeds max (a value in [max, max + ulp/2) rounds to max);
+//! * |x| < 2^emin: the subnormal grid, `(|x| + C) − C` with C = 2^(emin − M + 52) (the sum lies
+//!   in [C, 2C), where binary64's spacing is the target's subnormal step 2^(emin − M), so
+//!   binary64's nearest-even addition is the target's rounding, 2^emin included; the
+//!   subtraction is exact), then the sign of x; under FTZ a result below 2^emin (subnormal
+//!   after rounding) becomes zero of x's sign, the model's rule;
+//! * |x| ≥ max + ulp(max)/2 (= 2^(emax+1)·(1 − 2^−(p+1)), exact in binary64; infinities
+//!   included): ±∞ (the tie rounds to even, i.e. up);
+//! * a NaN stays a NaN and is stored as the canonical NaN (the canonical rule: a NaN result is
+//!   the canonical NaN whatever its operands).
+//!
+//! Under FTZ the operand read flushes in the lanes too (a subnormal operand reads as zero of
+//! its sign). No lane falls back to the scalar model. `narrow_ops_in_binary64_lanes_equal_the_
+//! soft_float_model_exhaustively` checks every operand pair of e5m4, e4m3, e3m2 and e2m1 (each
+//! subnormal and division mode), where subnormals, overflow and ties are dense.
 //!
 //! **The range filter** (a cheaper filter first, CGAL-style, per vector of lanes): the RTI
 //! kernel rounds stage 1 without the per-result check and then looks at the twelve values
@@ -55,10 +59,10 @@
 //! 2^⌈max((emin + 4M)/3, (emin + M)/2)⌉ and H ≤ `fast_hi` = 2^⌊(emax − 6)/3⌋, every result of
 //! stages 2–7 is ±0 or in [2^emin, max], where the split is the target rounding: the vector
 //! computes stages 2–7 without the check (for e8m16: nonzero stage-1 results and direction
-//! components in [2^−20, 2^40]). Otherwise stages 1–6 are recomputed behind the per-result
-//! check. A NaN among the twelve passes the filter and reaches t, u or v (the fall-through
-//! above); an infinity fails it (H = ∞). The reciprocal or division and the three final
-//! multiplies keep the per-result check.
+//! components in [2^−20, 2^40]). Otherwise stages 1–6 are recomputed with the full
+//! rounding. A NaN or an infinity among the twelve fails the filter (the unfiltered stage 1
+//! turns an infinite difference into a NaN, so both must take the full road). The reciprocal
+//! or division and the three final multiplies always round in full.
 //!
 //! **e8mM loads** (E = 8, M ≤ 23, binary32's exponent field and bias): an encoding shifted
 //! left by 23 − M is the binary32 encoding of the same value (subnormals, ±∞ and NaNs
@@ -88,8 +92,10 @@ pub struct Narrow {
     pub inv_step: f64,
     /// 2^S + 1 with S = 52 − M, Veltkamp's splitting constant for rounding to p = 53 − S bits.
     pub split: f64,
-    /// The binary64 just below 2^emin (the filter's subnormal threshold).
-    pub below_min: f64,
+    /// C = 2^(emin − M + 52): `(|x| + C) − C` is |x| < 2^emin rounded to the subnormal grid.
+    pub sub_grid: f64,
+    /// max + ulp(max)/2: the magnitude from which a result rounds to ±∞.
+    pub overflow_at: f64,
     /// The range filter's lower limit: a power of two ℓ_min (see "The range filter").
     pub fast_lo: f64,
     /// The range filter's upper limit: a power of two h_max (see "The range filter").
@@ -115,7 +121,8 @@ impl Narrow {
             step: super::layout::pow2(lay.emin() - m),
             inv_step: super::layout::pow2(m - lay.emin()),
             split: super::layout::pow2(52 - m) + 1.0,
-            below_min: f64::from_bits(lay.min_normal().to_bits() - 1),
+            sub_grid: super::layout::pow2(lay.emin() - m + 52),
+            overflow_at: lay.max_finite() + super::layout::pow2(lay.emax() - m - 1),
             fast_lo: super::layout::pow2(
                 (((lay.emin() + 4 * m) as f64 / 3.0).ceil() as i32).max(((lay.emin() + m) as f64 / 2.0).ceil() as i32),
             ),
