@@ -60,8 +60,8 @@ pub struct SpeedReport {
 pub const BATCH_PATHS: [&str; 5] = [
     "f32, fp16: binary32 / binary16 kernels (IEEE subnormals, canonical NaN)",
     "bf16: binary32 lanes, each op rounded to bf16 in integer lanes (IEEE or FTZ, canonical NaN; the slab kernels: IEEE)",
-    "eEmM with M <= 24, E <= 10: binary64 lanes, each op rounded to p bits behind a filter, flagged lanes on the scalar model (IEEE or FTZ, canonical NaN)",
-    "scalar model only: f32/fp16 with FTZ or the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float; the slab unit of eEmM formats",
+    "eEmM with M <= 24, E <= 10: binary64 lanes, each op rounded to the format in the lanes (subnormals, FTZ, overflow), a range filter skipping that work where the stage-1 values prove it unneeded (IEEE or FTZ, canonical NaN); the slab kernels: IEEE subnormals, every variant for e8mM (M <= 23), plain / take-on-false / embree for the other layouts",
+    "scalar model only: f32/fp16 with FTZ or the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float; the eEmM slab unit under FTZ, and its conservative and directed variants for layouts other than e8mM",
     "fixed point qI.F with I + F <= 32: i64 lanes for RTI and slab (every variant), every rounding, overflow and division mode (datapath::fixed_lanes); wider fixed point: scalar model only",
 ];
 
@@ -326,10 +326,12 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     // every box (the shape a node's or a level's children have)
     let bf16f: datapath::AnyFormat = "bf16".parse().expect("a built-in format name");
     let q16f: datapath::AnyFormat = "q16.16".parse().expect("a built-in format name");
+    let e8f: datapath::AnyFormat = "e8m16".parse().expect("a built-in format name");
     for (name, any) in [
         ("f32", datapath::AnyFormat::F32(f32f)),
         ("fp16", datapath::AnyFormat::F16(f16f)),
         ("bf16", bf16f),
+        ("e8m16", e8f),
         ("q16.16", q16f),
     ] {
         datapath::with_format!(any, |f| {

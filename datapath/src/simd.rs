@@ -494,6 +494,38 @@ pub fn slab_ray_kernel_bf16(s: &Slab<Ieee<Bf16>>) -> Kernel {
     best_kernel(eligible(&s.fmt) && (!s.cfg.directed || directed_one_ok(&s.cfg)), WIDEST_NARROW)
 }
 
+/// Whether the `eEmM` slab kernels take this unit (pairs, or one ray when `one`): M ≤ 24,
+/// E ≤ 10, IEEE subnormals, the canonical NaN rule; `e8mM` (M ≤ 23) in every variant but
+/// the directed one on pairs, the others in the variants without widening, guard or directed
+/// arithmetic (plain, take-on-false, embree).
+fn soft_slab_ok(s: &Slab<Ieee<Soft>>, one: bool) -> bool {
+    let c = &s.cfg;
+    match narrow_of(&s.fmt) {
+        Some(n) if !n.ftz && n.e8 => !c.directed || (one && directed_one_ok(c)),
+        Some(n) if !n.ftz => !c.directed && c.widen_ulps == 0 && !c.guard,
+        _ => false,
+    }
+}
+
+/// The kernel `slab_batch_soft` uses for this unit on this machine (see `soft_slab_ok`).
+pub fn slab_kernel_soft(s: &Slab<Ieee<Soft>>) -> Kernel {
+    best_kernel(soft_slab_ok(s, false), WIDEST_NARROW)
+}
+
+/// The kernel `slab_ray_soft` (one ray, many boxes) uses for this unit on this machine.
+pub fn slab_ray_kernel_soft(s: &Slab<Ieee<Soft>>) -> Kernel {
+    best_kernel(soft_slab_ok(s, true), WIDEST_NARROW)
+}
+
+slab_entry!(
+    /// [`Slab::batch`] for an `eEmM` format on the fastest kernel available; the same bits.
+    slab_batch_soft, Ieee<Soft>, u64, SlabRaysSoa<u64>, Pairs, slab_kernel_soft, v4d, v8d, slab_soft, None
+);
+slab_entry!(
+    /// [`Slab::batch_ray`] (one ray, many boxes) for an `eEmM` format on the fastest kernel available; the same bits.
+    slab_ray_soft, Ieee<Soft>, u64, SlabRay<u64>, One, slab_ray_kernel_soft, v4d, v8d, slab_soft, None
+);
+
 slab_entry!(
     /// [`Slab::batch`] for bf16 on the fastest kernel available; the same bits.
     slab_batch_bf16, Ieee<Bf16>, u16, SlabRaysSoa<u16>, Pairs, slab_kernel_bf16, b8, b16, slab_bf16, None
@@ -502,42 +534,6 @@ slab_entry!(
     /// [`Slab::batch_ray`] (one ray, many boxes) for bf16 on the fastest kernel available; the same bits.
     slab_ray_bf16, Ieee<Bf16>, u16, SlabRay<u16>, One, slab_ray_kernel_bf16, b8, b16, slab_bf16, None
 );
-
-/// What the one-ray slab kernels read off a ray value: its sign bit and whether it is a NaN.
-trait RayValue: Copy {
-    /// The sign bit (NaN included).
-    fn sign_bit(self) -> bool;
-    /// Whether the value is a NaN.
-    fn nan(self) -> bool;
-}
-
-impl RayValue for f32 {
-    fn sign_bit(self) -> bool {
-        self.is_sign_negative()
-    }
-    fn nan(self) -> bool {
-        self.is_nan()
-    }
-}
-
-impl RayValue for f16 {
-    fn sign_bit(self) -> bool {
-        self.is_sign_negative()
-    }
-    fn nan(self) -> bool {
-        self.is_nan()
-    }
-}
-
-/// A bf16 encoding.
-impl RayValue for u16 {
-    fn sign_bit(self) -> bool {
-        self >> 15 == 1
-    }
-    fn nan(self) -> bool {
-        self & 0x7fff > 0x7f80
-    }
-}
 
 /// The body of a format-generic dispatch: calls the first of the `typed` entry points whose
 /// unit and column types are the arguments', the scalar model `$scalar` when none is.
@@ -602,7 +598,7 @@ where
         rays,
         boxes,
         out,
-        [slab_batch_f32, slab_batch_f16, slab_batch_bf16, slab_batch_fixed],
+        [slab_batch_f32, slab_batch_f16, slab_batch_bf16, slab_batch_soft, slab_batch_fixed],
         s.batch(rays, boxes, out)
     )
 }
@@ -626,7 +622,7 @@ where
         ray,
         boxes,
         out,
-        [slab_ray_f32, slab_ray_f16, slab_ray_bf16, slab_ray_fixed],
+        [slab_ray_f32, slab_ray_f16, slab_ray_bf16, slab_ray_soft, slab_ray_fixed],
         s.batch_ray(ray, boxes, out)
     )
 }
@@ -940,7 +936,7 @@ mod isa {
         /// and +inf unchanged, ±0 to `unit`, negative values `unit` encodings toward zero.
         #[inline]
         #[target_feature(enable = "avx2")]
-        fn next_up_by(v: __m256, unit: i32) -> __m256 {
+        pub(in crate::simd) fn next_up_by(v: __m256, unit: i32) -> __m256 {
             let b = _mm256_castps_si256(v);
             let keep = _mm256_or_si256(
                 _mm256_castps_si256(_mm256_cmp_ps::<_CMP_UNORD_Q>(v, v)),
@@ -1348,6 +1344,40 @@ mod isa {
         pub fn min_where(lo: __m256d, a: __m256d, m: M) -> __m256d {
             _mm256_blendv_pd(lo, _mm256_min_pd(lo, a), m)
         }
+        /// `sign(x) ? b : a` per lane.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn blend_sign(a: __m256d, b: __m256d, x: __m256d) -> __m256d {
+            _mm256_blendv_pd(a, b, x)
+        }
+        /// The mask's complement.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn not_m(a: M) -> M {
+            _mm256_xor_pd(a, _mm256_castsi256_pd(int(u64::MAX)))
+        }
+        /// `sel ? b : a` per lane, on masks.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn blend_m(a: M, b: M, sel: M) -> M {
+            _mm256_blendv_pd(a, b, sel)
+        }
+        /// Lanes whose sign bit is set.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn sign_m(x: __m256d) -> M {
+            _mm256_castsi256_pd(_mm256_cmpgt_epi64(_mm256_setzero_si256(), _mm256_castpd_si256(x)))
+        }
+        /// The next value above each lane on the grid of an `e8mM` format with M ≤ 23 (`n.e8`;
+        /// lanes holding its values): binary32 holds them exactly, and the target's encoding is
+        /// binary32's shifted by 23 − M, so the step is 2^(23 − M) binary32 encodings
+        /// (`v8::next_up_by`: NaN and +∞ unchanged, ±0 to the least subnormal).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn next_up_e8(v: __m256d, n: &Narrow) -> __m256d {
+            let f = _mm256_castps128_ps256(_mm256_cvtpd_ps(v));
+            _mm256_cvtps_pd(_mm256_castps256_ps128(super::v8::next_up_by(f, 1 << n.e8_shift)))
+        }
         /// The sign bits of x (everything else cleared).
         #[inline]
         #[target_feature(enable = "avx2")]
@@ -1534,6 +1564,36 @@ mod isa {
         #[target_feature(enable = "avx512f")]
         pub fn min_where(lo: __m512d, a: __m512d, m: M) -> __m512d {
             _mm512_mask_min_pd(lo, m, lo, a)
+        }
+        /// `sign(x) ? b : a` per lane.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn blend_sign(a: __m512d, b: __m512d, x: __m512d) -> __m512d {
+            _mm512_mask_blend_pd(sign_m(x), a, b)
+        }
+        /// The mask's complement.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn not_m(a: M) -> M {
+            !a
+        }
+        /// `sel ? b : a` per lane, on masks.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn blend_m(a: M, b: M, sel: M) -> M {
+            (a & !sel) | (b & sel)
+        }
+        /// Lanes whose sign bit is set.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn sign_m(x: __m512d) -> M {
+            _mm512_test_epi64_mask(ib(x), int(1 << 63))
+        }
+        /// [`super::v4d::next_up_e8`] on 8 lanes.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn next_up_e8(v: __m512d, n: &Narrow) -> __m512d {
+            _mm512_cvtps_pd(super::v8::next_up_by(_mm512_cvtpd_ps(v), 1 << n.e8_shift))
         }
         /// The sign bits of x (everything else cleared).
         #[inline]
@@ -1986,7 +2046,7 @@ mod kernels {
         // per-batch preparation, hoisted out of the loop: column pointers; for one ray, each
         // axis's near and far plane columns (picked by the sign bit of 1/d) and the broadcast
         // origin, 1/d and t interval
-        (@prep pairs $r:ident, $bmin:ident, $bmax:ident, $bcast:ident) => {
+        (@prep $x:ident, pairs $r:ident, $bmin:ident, $bmax:ident, $bcast:ident) => {
             (
                 $r.o.each_ref().map(|c| c.as_ptr()),
                 $r.inv_d.each_ref().map(|c| c.as_ptr()),
@@ -1995,14 +2055,15 @@ mod kernels {
                 true, // a lane's t interval may be NaN
             )
         };
-        (@prep one $r:ident, $bmin:ident, $bmax:ident, $bcast:ident) => {{
-            let neg = $r.inv_d.map(RayValue::sign_bit);
+        (@prep $x:ident, one $r:ident, $bmin:ident, $bmax:ident, $bcast:ident) => {{
+            let neg = $r.inv_d.map(|v| $x::bits($x::sign_m($bcast(v))) != 0);
+            let is_nan = |v| { let b = $bcast(v); $x::bits($x::unord(b, b)) != 0 };
             (
                 std::array::from_fn::<_, 3, _>(|a| if neg[a] { $bmax[a] } else { $bmin[a] }),
                 std::array::from_fn::<_, 3, _>(|a| if neg[a] { $bmin[a] } else { $bmax[a] }),
                 ($r.o.map($bcast), $r.inv_d.map($bcast)),
                 ($bcast($r.tmin), $bcast($r.tmax)),
-                RayValue::nan($r.tmin) || RayValue::nan($r.tmax),
+                is_nan($r.tmin) || is_nan($r.tmax),
             )
         }};
         // axis a of lanes i..i + L: (near-plane t, far-plane t)
@@ -2051,7 +2112,7 @@ mod kernels {
             let r = $r;
             use crate::Format as _;
             let f = &s.fmt;
-            let prep = slab_kernel!(@prep one r, bmin, bmax, bcast);
+            let prep = slab_kernel!(@prep $x, one r, bmin, bmax, bcast);
             let (top, bottom) = (f.from_f64(f64::INFINITY), f.from_f64(f64::NEG_INFINITY));
             let (vtop, vbottom) = (bcast(top), bcast(bottom));
             let is_top = |v| f.to_bits(v) == f.to_bits(top);
@@ -2134,7 +2195,7 @@ mod kernels {
             let down = |v| neg(up(neg(v)));
             let bmin = boxes.min.each_ref().map(|c| c.as_ptr());
             let bmax = boxes.max.each_ref().map(|c| c.as_ptr());
-            let prep = slab_kernel!(@prep $shape $r, bmin, bmax, bcast);
+            let prep = slab_kernel!(@prep $x, $shape $r, bmin, bmax, bcast);
             let _ = bcast; // the pairs shape broadcasts nothing
             let (o_hit, o_near, o_far) = (out.hit.as_mut_ptr(), out.t_near.as_mut_ptr(), out.t_far.as_mut_ptr());
             let widen = s.cfg.widen_ulps;
@@ -2387,6 +2448,39 @@ mod kernels {
                             |c: &mut Vec<u64>, i: usize, x| unsafe { $x::store_soft(c.as_mut_ptr(), i, x, n) }
                         );
                     }
+                }
+
+                /// The `eEmM` slab kernel (pairs, or one ray against every box) on lanes
+                /// `0..full`, IEEE subnormals: every variant for `e8mM` (M ≤ 23), the variants
+                /// without widening, guard or directed arithmetic for the others
+                /// (`slab_kernel_soft`, `slab_ray_kernel_soft`).
+                #[target_feature(enable = $feat)]
+                pub fn slab_soft(
+                    s: &Slab<Ieee<Soft>>,
+                    rays: SlabRays<u64>,
+                    boxes: &BoxesSoa<u64>,
+                    out: &mut SlabOutSoa<u64>,
+                    full: usize,
+                ) {
+                    let n: &Narrow = &super::super::narrow_of(&s.fmt).expect("the dispatch checked the format");
+                    let f = s.fmt;
+                    // SAFETY (loads and stores): the caller checked that every column holds
+                    // `full` lanes.
+                    slab_kernel!(
+                        $x,
+                        s,
+                        rays,
+                        boxes,
+                        out,
+                        full,
+                        |c: *const u64, i: usize| unsafe { $x::load_soft(c, i, n) },
+                        |x| $x::round_full(x, n),
+                        |c: *mut u64, i: usize, x| unsafe { $x::store_soft(c, i, x, n) },
+                        // the grid step of e8mM formats; other formats never call it (the
+                        // dispatch refuses widening and the directed variant for them)
+                        |v| if n.e8 { $x::next_up_e8(v, n) } else { v },
+                        |v: u64| $x::splat(f.to_f64(v))
+                    );
                 }
 
                 /// One operation of an `eEmM` format on lanes `0..full`: `out[i] = a[i] op b[i]`,

@@ -509,6 +509,41 @@ mod slab {
         }
     }
 
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+
+        /// The `eEmM` slab kernels (binary64 lanes, each result rounded in the lanes), pairs and
+        /// one ray against every box: the scalar model's bits; e8mM in every variant (grid
+        /// steps through binary32), other layouts without widening, guard or directed
+        /// arithmetic, FTZ formats on the scalar model.
+        #[test]
+        fn soft_float_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..5, fmt in 0usize..7) {
+            use datapath::simd::{slab_batch_soft, slab_kernel_soft, slab_ray_kernel_soft, slab_ray_soft, WIDEST_NARROW};
+            let names = ["e8m16", "e5m4", "e10m24:divide", "e8m7", "e6m9:divide", "e8m16:ftz", "e8m23:divide"];
+            let datapath::AnyFormat::Soft(f) = names[fmt].parse().unwrap() else { unreachable!() };
+            let s = Slab::new(f, SlabConfig::named(VARIANTS[v]).unwrap());
+            // e8mM (binary32's exponent): every variant (the directed one on one-ray batches);
+            // the others: the variants without widening, guard or directed arithmetic
+            let (e8, ftz) = (names[fmt].starts_with("e8"), names[fmt].contains("ftz"));
+            let plainish = VARIANTS[v] != "conservative" && VARIANTS[v] != "directed";
+            let best = |ok: bool| if ok && !ftz { WIDEST_NARROW } else { Kernel::Scalar };
+            let (pairs_widest, one_widest) = (best(plainish || (e8 && VARIANTS[v] != "directed")), best(plainish || e8));
+            let here = *kernels_here().last().unwrap();
+            prop_assert_eq!(slab_kernel_soft(&s), here.min(pairs_widest));
+            prop_assert_eq!(slab_ray_kernel_soft(&s), here.min(one_widest));
+            let (rays, boxes) = batch(&s, seed, n);
+            let mut a = SlabOutSoa::with_len(n);
+            s.batch(&rays, &boxes, &mut a);
+            let fresh = || SlabOutSoa::with_len(n);
+            on_every_kernel(pairs_widest, &a, |b| slab_batch_soft(&s, &rays, &boxes, b), fresh, |a, b| same(&f, a, b))?;
+            for k in [0, 1, 7].into_iter().filter(|&k| k < n) {
+                let ray = rays.get((seed as usize + k) % n);
+                s.batch_ray(&ray, &boxes, &mut a);
+                on_every_kernel(one_widest, &a, |b| slab_ray_soft(&s, &ray, &boxes, b), fresh, |a, b| same(&f, a, b))?;
+            }
+        }
+    }
+
     /// A seeded fixed-point slab batch within the format's range: origins, directions (some
     /// axis components 0: parallel axes, some tiny: saturated 1/d) and boxes scaled to a
     /// quarter of the range, a quarter of the boxes raw bits (possibly inverted), t intervals
