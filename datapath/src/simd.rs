@@ -1238,6 +1238,13 @@ mod isa {
             #[target_feature(enable = $feat)]
             pub fn round_full(x: $v, n: &Narrow) -> $v {
                 let a = abs(x);
+                // the common vector: every lane ±0 or normal-range (the binary64 just below
+                // |x| is below 2^emin only for a nonzero |x| < 2^emin; for ±0 it is a NaN),
+                // where the split is the rounding
+                let odd = or_m(le(splat(n.overflow_at), a), lt(pred(a), splat(n.min_normal)));
+                if bits(odd) == 0 {
+                    return split(x, n);
+                }
                 let sgn = sign(x);
                 let mut tiny = sub(add(a, splat(n.sub_grid)), splat(n.sub_grid));
                 if n.ftz {
@@ -1405,6 +1412,12 @@ mod isa {
         pub unsafe fn flags(p: *mut bool, i: usize, m: M) {
             // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
             unsafe { (p.add(i) as *mut u32).write_unaligned(super::SPREAD[bits(m) as usize] as u32) }
+        }
+        /// The binary64 just below each lane of a magnitude `a` (a NaN for +0).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn pred(a: __m256d) -> __m256d {
+            _mm256_castsi256_pd(_mm256_sub_epi64(_mm256_castpd_si256(a), int(1)))
         }
         narrow_ops!("avx2", __m256d);
         /// Loads 4 `eEmM` encodings as binary64 (exact).
@@ -1622,6 +1635,12 @@ mod isa {
         pub unsafe fn flags(p: *mut bool, i: usize, m: M) {
             // SAFETY: in bounds (the caller); every byte written is 0 or 1, a valid bool.
             unsafe { (p.add(i) as *mut u64).write_unaligned(super::SPREAD[m as usize]) }
+        }
+        /// The binary64 just below each lane of a magnitude `a` (a NaN for +0).
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn pred(a: __m512d) -> __m512d {
+            fb(_mm512_sub_epi64(ib(a), int(1)))
         }
         narrow_ops!("avx512f", __m512d);
         /// Loads 8 `eEmM` encodings as binary64 (exact).
