@@ -1253,25 +1253,6 @@ mod isa {
                 let r = blend(split(x, n), xor(tiny, sgn), lt(a, splat(n.min_normal)));
                 blend(r, xor(splat(f64::INFINITY), sgn), le(splat(n.overflow_at), a))
             }
-            /// The range filter (see [`crate::format::narrow`]): true when on every lane the
-            /// nonzero magnitudes among `v` (the stage-1 results and the direction) are at
-            /// least `n.fast_lo` and all magnitudes at most `n.fast_hi`, so that no result of
-            /// stages 2-6 leaves {±0} ∪ [2^emin, max]. A NaN fails (the unfiltered stage 1
-            /// turns an infinite difference into a NaN, which must take the filtered road).
-            #[inline]
-            #[target_feature(enable = $feat)]
-            pub fn fast_ok(v: &[$v; 12], n: &Narrow) -> bool {
-                let (zero, inf, top) = (splat(0.0), splat(f64::INFINITY), splat(n.fast_hi));
-                let mut lo = inf;
-                // all lanes, then cleared where a magnitude is above fast_hi or NaN
-                let mut good = le(zero, zero);
-                for &x in v {
-                    let a = abs(x);
-                    good = and_m(good, le(a, top));
-                    lo = min_where(lo, a, lt(zero, a));
-                }
-                bits(and_m(good, le(splat(n.fast_lo), lo))) == (1 << LANES) - 1
-            }
             /// Under FTZ, subnormal lanes read as zeros of the same sign (the operand read).
             #[inline]
             #[target_feature(enable = $feat)]
@@ -1418,6 +1399,25 @@ mod isa {
         #[target_feature(enable = "avx2")]
         fn pred(a: __m256d) -> __m256d {
             _mm256_castsi256_pd(_mm256_sub_epi64(_mm256_castpd_si256(a), int(1)))
+        }
+        /// The range filter (see [`crate::format::narrow`]): true when on every lane the
+        /// nonzero magnitudes among `v` (the stage-1 results and the direction) are at least
+        /// `n.fast_lo` and all magnitudes at most `n.fast_hi`, so that no result of stages 2-7
+        /// leaves {±0} ∪ [2^emin, max]. A NaN fails (the unfiltered stage 1 turns an infinite
+        /// difference into a NaN, which must take the filtered road).
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        pub fn fast_ok(v: &[__m256d; 12], n: &Narrow) -> bool {
+            let (zero, inf, top) = (splat(0.0), splat(f64::INFINITY), splat(n.fast_hi));
+            let mut lo = inf;
+            // all lanes, then cleared where a magnitude is above fast_hi or NaN
+            let mut good = le(zero, zero);
+            for &x in v {
+                let a = abs(x);
+                good = and_m(good, le(a, top));
+                lo = min_where(lo, a, lt(zero, a));
+            }
+            bits(and_m(good, le(splat(n.fast_lo), lo))) == (1 << LANES) - 1
         }
         narrow_ops!("avx2", __m256d);
         /// Loads 4 `eEmM` encodings as binary64 (exact).
@@ -1641,6 +1641,24 @@ mod isa {
         #[target_feature(enable = "avx512f")]
         fn pred(a: __m512d) -> __m512d {
             fb(_mm512_sub_epi64(ib(a), int(1)))
+        }
+        /// [`super::v4d::fast_ok`] on 8 lanes, in integer lanes: u = the encoding shifted left
+        /// by one (the sign dropped; for magnitudes, the order of u is the order of the values,
+        /// and a NaN's u is above +∞'s), the largest u and the smallest u − 1 (a zero's u − 1
+        /// wraps to the largest value, so zeros drop out) against the limits' encodings.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        pub fn fast_ok(v: &[__m512d; 12], n: &Narrow) -> bool {
+            let one = int(1);
+            let (mut hi, mut lo) = (_mm512_setzero_si512(), int(u64::MAX));
+            for &x in v {
+                let u = _mm512_add_epi64(ib(x), ib(x));
+                hi = _mm512_max_epu64(hi, u);
+                lo = _mm512_min_epu64(lo, _mm512_sub_epi64(u, one));
+            }
+            let top = int(n.fast_hi.to_bits() << 1);
+            let bottom = int((n.fast_lo.to_bits() << 1) - 1);
+            _mm512_cmple_epu64_mask(hi, top) & _mm512_cmpge_epu64_mask(lo, bottom) == u8::MAX
         }
         narrow_ops!("avx512f", __m512d);
         /// Loads 8 `eEmM` encodings as binary64 (exact).
