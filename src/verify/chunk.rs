@@ -151,6 +151,8 @@ struct Scratch<V> {
     shit: Vec<bool>,
     snear: Vec<f64>,
     sfar: Vec<f64>,
+    /// Lanes whose golden f64 interval is within 1e-9 (relative) of empty: exact decides.
+    sclose: Vec<bool>,
     exact: Vec<u8>,
     prepared: Vec<datapath::slab::SlabRay<V>>,
     boxes: BoxesSoa<V>,
@@ -176,6 +178,7 @@ impl<V: Copy + Default> Scratch<V> {
             shit: b(),
             snear: f(),
             sfar: f(),
+            sclose: b(),
             exact: vec![0; BLOCK],
             prepared: Vec::new(),
             boxes: BoxesSoa::default(),
@@ -369,8 +372,14 @@ where
                 s.boxes.max[a][k] = b.max[a];
             }
         }
-        // the exact decision of each lane, computed at most once for all variants (0: not yet)
+        // the exact decision of each lane, computed at most once for all variants (0: not yet);
+        // whether the golden interval is too close to empty to trust, once for all variants
         s.exact[..n].fill(0);
+        for k in 0..n {
+            let (near, far) = (s.snear[k], s.sfar[k]);
+            let scale = 1.0f64.max(near.abs()).max(if far.is_finite() { far.abs() } else { 0.0 });
+            s.sclose[k] = (far - near).abs() <= 1e-9 * scale;
+        }
         for ((v, sr), acc) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()) {
             s.sout.hit.resize(n, false);
             s.sout.t_near.resize(n, F::V::default());
@@ -380,11 +389,8 @@ where
             acc.model_ns += t0.elapsed().as_nanos() as u64;
             let c = &mut acc.c.0;
             for k in 0..n {
-                let hit = s.sout.hit[k];
-                let (g, near, far) = (s.shit[k], s.snear[k], s.sfar[k]);
-                let scale = 1.0f64.max(near.abs()).max(if far.is_finite() { far.abs() } else { 0.0 });
-                let close = (far - near).abs() <= 1e-9 * scale;
-                let exact = if close || g != hit {
+                let (hit, g) = (s.sout.hit[k], s.shit[k]);
+                let exact = if s.sclose[k] || g != hit {
                     c[4] += 1;
                     if s.exact[k] == 0 {
                         let b = &self.boxes[blk[k] as usize];
