@@ -1572,12 +1572,6 @@ mod isa {
         pub fn blend(a: __m512d, b: __m512d, m: M) -> __m512d {
             _mm512_mask_blend_pd(m, a, b)
         }
-        /// `m ? min(lo, a) : lo` per lane.
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn min_where(lo: __m512d, a: __m512d, m: M) -> __m512d {
-            _mm512_mask_min_pd(lo, m, lo, a)
-        }
         /// `sign(x) ? b : a` per lane.
         #[inline]
         #[target_feature(enable = "avx512f")]

@@ -391,16 +391,37 @@ mod slab {
     {
         let s = Slab::new(f, SlabConfig::named(variant).unwrap());
         let (rays, boxes) = batch(&s, seed, n);
-        let mut a = SlabOutSoa::with_len(n);
-        s.batch(&rays, &boxes, &mut a);
-        let fresh = || SlabOutSoa::with_len(n);
         // the directed variant's pairs run the scalar model (its kernel takes one-ray batches)
         let pairs_widest = if s.cfg.directed { Kernel::Scalar } else { widest };
-        on_every_kernel(pairs_widest, &a, |b| pairs(&s, &rays, &boxes, b), fresh, |a, b| same(&f, a, b))?;
-        if n > 0 {
-            let ray = rays.get(seed as usize % n);
-            s.batch_ray(&ray, &boxes, &mut a);
-            on_every_kernel(widest, &a, |b| one(&s, &ray, &boxes, b), fresh, |a, b| same(&f, a, b))?;
+        check_shapes(&s, &rays, &boxes, (pairs_widest, widest), pairs, one, seed, &[0])
+    }
+
+    /// `pairs` on the whole batch, then `one` for the rays `(seed + k) % n` (k in `offsets`)
+    /// against every box, on every kernel (`widest`: the pairs' and the one-ray batches'),
+    /// against the scalar model's bits.
+    #[allow(clippy::too_many_arguments)]
+    fn check_shapes<F: Format + Copy>(
+        s: &Slab<F>,
+        rays: &SlabRaysSoa<F::V>,
+        boxes: &BoxesSoa<F::V>,
+        widest: (Kernel, Kernel),
+        pairs: PairsFn<F>,
+        one: RayFn<F>,
+        seed: u64,
+        offsets: &[usize],
+    ) -> Result<(), TestCaseError>
+    where
+        F::V: Default,
+    {
+        let n = rays.tmin.len();
+        let mut a = SlabOutSoa::with_len(n);
+        s.batch(rays, boxes, &mut a);
+        let fresh = || SlabOutSoa::with_len(n);
+        on_every_kernel(widest.0, &a, |b| pairs(s, rays, boxes, b), fresh, |a, b| same(&s.fmt, a, b))?;
+        for &k in offsets.iter().filter(|&&k| k < n) {
+            let ray = rays.get((seed as usize + k) % n);
+            s.batch_ray(&ray, boxes, &mut a);
+            on_every_kernel(widest.1, &a, |b| one(s, &ray, boxes, b), fresh, |a, b| same(&s.fmt, a, b))?;
         }
         Ok(())
     }
@@ -532,15 +553,7 @@ mod slab {
             prop_assert_eq!(slab_kernel_soft(&s), here.min(pairs_widest));
             prop_assert_eq!(slab_ray_kernel_soft(&s), here.min(one_widest));
             let (rays, boxes) = batch(&s, seed, n);
-            let mut a = SlabOutSoa::with_len(n);
-            s.batch(&rays, &boxes, &mut a);
-            let fresh = || SlabOutSoa::with_len(n);
-            on_every_kernel(pairs_widest, &a, |b| slab_batch_soft(&s, &rays, &boxes, b), fresh, |a, b| same(&f, a, b))?;
-            for k in [0, 1, 7].into_iter().filter(|&k| k < n) {
-                let ray = rays.get((seed as usize + k) % n);
-                s.batch_ray(&ray, &boxes, &mut a);
-                on_every_kernel(one_widest, &a, |b| slab_ray_soft(&s, &ray, &boxes, b), fresh, |a, b| same(&f, a, b))?;
-            }
+            check_shapes(&s, &rays, &boxes, (pairs_widest, one_widest), slab_batch_soft, slab_ray_soft, seed, &[0, 1, 7])?;
         }
     }
 
@@ -592,16 +605,8 @@ mod slab {
             let f = super::fixed(&format!("{}{}", super::FIXED_NAMES[name], super::FIXED_MODES[mode]));
             let s = Slab::new(f, SlabConfig::named(VARIANTS[v]).unwrap());
             let (rays, boxes) = fixed_slab_batch(&s, seed, n);
-            let mut a = SlabOutSoa::with_len(n);
-            s.batch(&rays, &boxes, &mut a);
-            let fresh = || SlabOutSoa::with_len(n);
             let widest = super::widest_fixed();
-            on_every_kernel(widest, &a, |b| slab_batch_fixed(&s, &rays, &boxes, b), fresh, |a, b| same(&f, a, b))?;
-            for k in [0, 1, 7].into_iter().filter(|&k| k < n) {
-                let ray = rays.get((seed as usize + k) % n);
-                s.batch_ray(&ray, &boxes, &mut a);
-                on_every_kernel(widest, &a, |b| slab_ray_fixed(&s, &ray, &boxes, b), fresh, |a, b| same(&f, a, b))?;
-            }
+            check_shapes(&s, &rays, &boxes, (widest, widest), slab_batch_fixed, slab_ray_fixed, seed, &[0, 1, 7])?;
         }
     }
 
@@ -867,13 +872,42 @@ mod bound_block {
     }
 }
 
+/// Add, subtract, multiply and divide through `batch` (`out[i] = a[i] op b[i]`) on every
+/// kernel this machine has, each result equal to the format's own operation (its division
+/// mode included).
+fn ops_on_every_kernel<F: Format>(
+    f: &F,
+    name: &str,
+    a: &[F::V],
+    b: &[F::V],
+    batch: impl Fn(datapath::rti::Op, &[F::V], &[F::V], &mut [F::V]),
+) where
+    F::V: Default + PartialEq + std::fmt::Debug,
+{
+    use datapath::rti::Op;
+    for k in kernels_here() {
+        for op in [Op::Add, Op::Sub, Op::Mul, Op::Div] {
+            let mut out = vec![F::V::default(); a.len()];
+            with_kernel_cap(k, || batch(op, a, b, &mut out));
+            for i in 0..a.len() {
+                let want = match op {
+                    Op::Add => f.add(a[i], b[i]),
+                    Op::Sub => f.sub(a[i], b[i]),
+                    Op::Mul => f.mul(a[i], b[i]),
+                    _ => f.div(a[i], b[i]),
+                };
+                assert_eq!(out[i], want, "{name} {op:?} {:?} {:?} on {k:?}", a[i], b[i]);
+            }
+        }
+    }
+}
+
 /// The double-rounding argument of `datapath::format::narrow`, checked exhaustively: every
 /// operand pair of e5m4, e4m3, e3m2 and e2m1 (every subnormal and division mode) and 2^20
 /// random pairs of e8m16 and e10m24 (fewer under emu/avx512, see below), through + − × ÷ in binary64 lanes then rounded to the
 /// format, equals the soft-float model's correctly rounded operation, bit for bit.
 #[test]
 fn narrow_ops_in_binary64_lanes_equal_the_soft_float_model_exhaustively() {
-    use datapath::rti::Op;
     use datapath::simd::{op_batch_soft, op_kernel_soft};
     for name in ["e5m4", "e4m3", "e3m2", "e2m1", "e8m16", "e10m24"] {
         for opts in ["", ":ftz", ":divide", ":ftz+divide"] {
@@ -894,20 +928,10 @@ fn narrow_ops_in_binary64_lanes_equal_the_soft_float_model_exhaustively() {
             for k in kernels_here() {
                 let ran = with_kernel_cap(k, || op_kernel_soft(&f));
                 assert_eq!(ran, k.min(datapath::simd::WIDEST_NARROW), "{full}");
-                for op in [Op::Add, Op::Sub, Op::Mul, Op::Div] {
-                    let mut out = vec![0u64; a.len()];
-                    with_kernel_cap(k, || op_batch_soft(&f, op, &a, &b, &mut out));
-                    for i in 0..a.len() {
-                        let want = match op {
-                            Op::Add => f.add(a[i], b[i]),
-                            Op::Sub => f.sub(a[i], b[i]),
-                            Op::Mul => f.mul(a[i], b[i]),
-                            _ => f.div(a[i], b[i]),
-                        };
-                        assert_eq!(out[i], want, "{full} {op:?} {:#x} {:#x} on {k:?}", a[i], b[i]);
-                    }
-                }
             }
+            ops_on_every_kernel(&f, &full, &a, &b, |op, a, b, out| {
+                op_batch_soft(&f, op, a, b, out);
+            });
         }
     }
 }
@@ -990,7 +1014,6 @@ proptest! {
 #[test]
 fn fixed_point_ops_in_i64_lanes_equal_the_i128_model() {
     use datapath::fixed_lanes::op_batch_fixed;
-    use datapath::rti::Op;
     for name in FIXED_NAMES {
         for mode in FIXED_MODES {
             let full = format!("{name}{mode}");
@@ -1012,21 +1035,9 @@ fn fixed_point_ops_in_i64_lanes_equal_the_i128_model() {
                 };
                 (0..n).map(|_| (pick(&mut r), pick(&mut r))).unzip()
             };
-            for k in kernels_here() {
-                for op in [Op::Add, Op::Sub, Op::Mul, Op::Div] {
-                    let mut out = vec![0i64; a.len()];
-                    with_kernel_cap(k, || op_batch_fixed(&f, op, &a, &b, &mut out));
-                    for i in 0..a.len() {
-                        let want = match op {
-                            Op::Add => f.add(a[i], b[i]),
-                            Op::Sub => f.sub(a[i], b[i]),
-                            Op::Mul => f.mul(a[i], b[i]),
-                            _ => f.div(a[i], b[i]),
-                        };
-                        assert_eq!(out[i], want, "{full} {op:?} {} {} on {k:?}", a[i], b[i]);
-                    }
-                }
-            }
+            ops_on_every_kernel(&f, &full, &a, &b, |op, a, b, out| {
+                op_batch_fixed(&f, op, a, b, out);
+            });
         }
     }
 }
