@@ -36,7 +36,7 @@
 
 use crate::format::{DivMode, Fixed, FxOverflow, FxRound};
 use crate::rti::{Cull, HitsSoa, Op, RaysSoa, Rti, TrisSoa};
-use crate::simd::Kernel;
+use crate::simd::{Kernel, SlabRays};
 use crate::slab::{BoxesSoa, Slab, SlabOutSoa, SlabRay, SlabRaysSoa};
 use crate::Format as _;
 
@@ -386,7 +386,7 @@ fn rti_vec<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP: 
     (valid, hit, t, u, v)
 }
 
-/// The RTI loop over slots `0..n / L * L`; returns that count.
+/// The RTI loop over slots `0..full` (a multiple of `L`).
 #[inline(always)]
 fn rti_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP: bool>(
     x: &X,
@@ -395,8 +395,8 @@ fn rti_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP:
     rays: &RaysSoa<i64>,
     tris: &TrisSoa<i64>,
     out: &mut HitsSoa<i64>,
-    n: usize,
-) -> usize {
+    full: usize,
+) {
     let [o, d] = [&rays.o, &rays.d];
     let [v0, v1, v2] = &tris.v;
     let cols: [&[i64]; 17] = [
@@ -404,7 +404,6 @@ fn rti_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP:
         &v1[2], &v2[0], &v2[1], &v2[2],
     ];
     let thr = x.splat(thr);
-    let full = n / X::L * X::L;
     for i in (0..full).step_by(X::L) {
         let inp: [X::V; 17] = std::array::from_fn(|k| x.load(cols[k], i));
         let (valid, hit, t, u, v) = rti_vec::<X, R, WRAP, TWO, RECIP>(x, thr, backface, &inp);
@@ -414,7 +413,6 @@ fn rti_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP:
         x.store(&mut out.u, i, u);
         x.store(&mut out.v, i, v);
     }
-    full
 }
 
 /// One operation over columns, `L` lanes at a time (the tail on the scalar functions).
@@ -529,20 +527,19 @@ fn slab_vec<X: Ops, const R: u8, const WRAP: bool>(
     (x.le(near, far), near, far)
 }
 
-/// The slab loop over slots `0..n / L * L` (pairs, or one ray against every box); returns
-/// that count.
+/// The slab loop over slots `0..full` (a multiple of `L`; pairs, or one ray against every
+/// box).
 #[inline(always)]
 fn slab_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP: bool>(
     x: &X,
     s: &crate::slab::SlabConfig,
-    rays: SlabShape<'_>,
+    rays: SlabRays<'_, i64>,
     boxes: &BoxesSoa<i64>,
     out: &mut SlabOutSoa<i64>,
-) -> usize {
-    let n = out.hit.len();
-    let full = n / X::L * X::L;
+    full: usize,
+) {
     let one = match rays {
-        SlabShape::One(r) => Some(SlabRayV {
+        SlabRays::One(r) => Some(SlabRayV {
             o: r.o.map(|v| x.splat(v)),
             inv_d: r.inv_d.map(|v| x.splat(v)),
             inv_lo: r.inv_lo.map(|v| x.splat(v)),
@@ -551,12 +548,12 @@ fn slab_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP
             tmin: x.splat(r.tmin),
             tmax: x.splat(r.tmax),
         }),
-        SlabShape::Pairs(_) => None,
+        SlabRays::Pairs(_) => None,
     };
     for i in (0..full).step_by(X::L) {
         let ray = match (one, rays) {
             (Some(r), _) => r,
-            (None, SlabShape::Pairs(r)) => SlabRayV {
+            (None, SlabRays::Pairs(r)) => SlabRayV {
                 o: [0, 1, 2].map(|a| x.load(&r.o[a], i)),
                 inv_d: [0, 1, 2].map(|a| x.load(&r.inv_d[a], i)),
                 inv_lo: [0, 1, 2].map(|a| x.load(&r.inv_lo[a], i)),
@@ -565,7 +562,7 @@ fn slab_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP
                 tmin: x.load(&r.tmin, i),
                 tmax: x.load(&r.tmax, i),
             },
-            (None, SlabShape::One(_)) => unreachable!("the one-ray shape is broadcast above"),
+            (None, SlabRays::One(_)) => unreachable!("the one-ray shape is broadcast above"),
         };
         let bmin = [0, 1, 2].map(|a| x.load(&boxes.min[a], i));
         let bmax = [0, 1, 2].map(|a| x.load(&boxes.max[a], i));
@@ -574,14 +571,6 @@ fn slab_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP
         x.store(&mut out.t_near, i, near);
         x.store(&mut out.t_far, i, far);
     }
-    full
-}
-
-/// What a slab batch tests: ray i against box i, or one ray against every box.
-#[derive(Clone, Copy)]
-enum SlabShape<'a> {
-    Pairs(&'a SlabRaysSoa<i64>),
-    One(&'a SlabRay<i64>),
 }
 
 /// Calls `$f::<$x, R, WRAP, TWO, RECIP>($args)` for the format's modes.
@@ -791,13 +780,20 @@ mod zmm {
     }
 }
 
-/// The per-instruction-set entry points: AVX2 on portable 4-lane arrays, AVX-512F + DQ on
-/// [`zmm::Z`].
+/// The per-instruction-set kernels: AVX2 on portable 4-lane arrays, AVX-512F + DQ on
+/// [`zmm::Z`]; the RTI and slab ones in the signatures of `datapath::simd`'s dispatch tables
+/// (lanes `0..full`, a multiple of the lane count).
 #[cfg(target_arch = "x86_64")]
 mod isa {
     use super::*;
 
-    /// The RTI loop on lanes `x` for `rti`'s modes; returns the slots done.
+    /// The constants of a format the dispatch accepted (`kernel_fixed` names a kernel only
+    /// for formats that have them).
+    fn lanes(f: &Fixed) -> Lanes {
+        Lanes::of(f).expect("the dispatch checked the format")
+    }
+
+    /// The RTI loop on lanes `x` for `rti`'s modes.
     #[inline(always)]
     fn rti_any<X: Ops>(
         x: &X,
@@ -805,90 +801,89 @@ mod isa {
         rays: &RaysSoa<i64>,
         tris: &TrisSoa<i64>,
         out: &mut HitsSoa<i64>,
-        n: usize,
-    ) -> usize {
+        full: usize,
+    ) {
         let backface = rti.cull == Cull::Backface;
-        by_modes!(&rti.fmt, rti_loop, X, x, rti.det_thr, backface, rays, tris, out, n)
+        by_modes!(&rti.fmt, rti_loop, X, x, rti.det_thr, backface, rays, tris, out, full)
     }
 
     /// AVX2 (4 lanes).
     #[target_feature(enable = "avx2")]
     pub(super) fn rti_avx2(
         rti: &Rti<Fixed>,
-        c: &Lanes,
         rays: &RaysSoa<i64>,
         tris: &TrisSoa<i64>,
         out: &mut HitsSoa<i64>,
-        n: usize,
-    ) -> usize {
-        rti_any(&Port::<4>(*c), rti, rays, tris, out, n)
+        full: usize,
+    ) {
+        rti_any(&Port::<4>(lanes(&rti.fmt)), rti, rays, tris, out, full)
     }
 
     /// AVX-512F + DQ (8 lanes).
     #[target_feature(enable = "avx512f,avx512dq")]
     pub(super) fn rti_avx512(
         rti: &Rti<Fixed>,
-        c: &Lanes,
         rays: &RaysSoa<i64>,
         tris: &TrisSoa<i64>,
         out: &mut HitsSoa<i64>,
-        n: usize,
-    ) -> usize {
+        full: usize,
+    ) {
         // SAFETY: this function's features
-        let z = unsafe { zmm::Z::new(*c) };
-        rti_any(&z, rti, rays, tris, out, n)
+        let z = unsafe { zmm::Z::new(lanes(&rti.fmt)) };
+        rti_any(&z, rti, rays, tris, out, full)
     }
 
-    /// The slab loop on lanes `x` for the unit's modes; returns the slots done.
+    /// The slab loop on lanes `x` for the unit's modes.
     #[inline(always)]
     fn slab_any<X: Ops>(
         x: &X,
         s: &Slab<Fixed>,
-        rays: SlabShape<'_>,
+        rays: SlabRays<'_, i64>,
         boxes: &BoxesSoa<i64>,
         out: &mut SlabOutSoa<i64>,
-    ) -> usize {
-        by_modes!(&s.fmt, slab_loop, X, x, &s.cfg, rays, boxes, out)
+        full: usize,
+    ) {
+        by_modes!(&s.fmt, slab_loop, X, x, &s.cfg, rays, boxes, out, full)
     }
 
     /// AVX2 (4 lanes).
     #[target_feature(enable = "avx2")]
     pub(super) fn slab_avx2(
         s: &Slab<Fixed>,
-        c: &Lanes,
-        rays: SlabShape<'_>,
+        rays: SlabRays<'_, i64>,
         boxes: &BoxesSoa<i64>,
         out: &mut SlabOutSoa<i64>,
-    ) -> usize {
-        slab_any(&Port::<4>(*c), s, rays, boxes, out)
+        full: usize,
+    ) {
+        slab_any(&Port::<4>(lanes(&s.fmt)), s, rays, boxes, out, full)
     }
 
     /// AVX-512F + DQ (8 lanes).
     #[target_feature(enable = "avx512f,avx512dq")]
     pub(super) fn slab_avx512(
         s: &Slab<Fixed>,
-        c: &Lanes,
-        rays: SlabShape<'_>,
+        rays: SlabRays<'_, i64>,
         boxes: &BoxesSoa<i64>,
         out: &mut SlabOutSoa<i64>,
-    ) -> usize {
+        full: usize,
+    ) {
         // SAFETY: this function's features
-        let z = unsafe { zmm::Z::new(*c) };
-        slab_any(&z, s, rays, boxes, out)
+        let z = unsafe { zmm::Z::new(lanes(&s.fmt)) };
+        slab_any(&z, s, rays, boxes, out, full)
     }
 
     /// AVX2 (4 lanes).
     #[target_feature(enable = "avx2")]
-    pub(super) fn op_avx2(f: &Fixed, c: &Lanes, op: Op, a: &[i64], b: &[i64], out: &mut [i64]) {
-        let x = Port::<4>(*c);
+    pub(super) fn op_avx2(f: &Fixed, op: Op, a: &[i64], b: &[i64], out: &mut [i64]) {
+        let x = Port::<4>(lanes(f));
         by_modes!(f, op_loop, Port<4>, &x, op, a, b, out)
     }
 
     /// AVX-512F + DQ (8 lanes).
     #[target_feature(enable = "avx512f,avx512dq")]
-    pub(super) fn op_avx512(f: &Fixed, c: &Lanes, op: Op, a: &[i64], b: &[i64], out: &mut [i64]) {
+    pub(super) fn op_avx512(f: &Fixed, op: Op, a: &[i64], b: &[i64], out: &mut [i64]) {
         // SAFETY: this function's features
-        let z = unsafe { zmm::Z::new(*c) };
+        let z = unsafe { zmm::Z::new(lanes(f)) };
         by_modes!(f, op_loop, zmm::Z, &z, op, a, b, out)
     }
 }
@@ -910,25 +905,15 @@ pub fn kernel_fixed(f: &Fixed) -> Kernel {
 /// # Panics
 /// If the column lengths differ.
 pub fn rti_batch_fixed(rti: &Rti<Fixed>, rays: &RaysSoa<i64>, tris: &TrisSoa<i64>, out: &mut HitsSoa<i64>) -> Kernel {
-    let n = rays.len();
-    assert!(tris.len() == n && out.len() == n, "batch lengths differ");
-    let which = kernel_fixed(&rti.fmt);
-    #[cfg(target_arch = "x86_64")]
-    if let Some(c) = Lanes::of(&rti.fmt).filter(|_| crate::simd::rti_columns_ok(rays, tris, out, n)) {
-        // SAFETY: `which` names a kernel only after run-time feature detection.
-        let full = match which {
-            Kernel::Avx2 => unsafe { isa::rti_avx2(rti, &c, rays, tris, out, n) },
-            Kernel::Scalar => 0,
-            _ => unsafe { isa::rti_avx512(rti, &c, rays, tris, out, n) },
-        };
-        if which != Kernel::Scalar {
-            rti.batch_from(rays, tris, out, full);
-            return which;
-        }
-    }
-    let _ = which;
-    rti.batch(rays, tris, out);
-    Kernel::Scalar
+    crate::simd::rti_dispatch(
+        rti,
+        rays,
+        tris,
+        out,
+        kernel_fixed(&rti.fmt),
+        #[cfg(target_arch = "x86_64")]
+        (isa::rti_avx2, isa::rti_avx512, None),
+    )
 }
 
 /// `Add`, `Sub`, `Mul` or `Div` (in the format's division mode) of a fixed-point format on
@@ -941,14 +926,16 @@ pub fn op_batch_fixed(f: &Fixed, op: Op, a: &[i64], b: &[i64], out: &mut [i64]) 
     assert!(op != Op::Logic, "op_batch_fixed computes arithmetic only");
     let which = kernel_fixed(f);
     #[cfg(target_arch = "x86_64")]
-    if let Some(c) = Lanes::of(f) {
-        match which {
-            // SAFETY: as above.
-            Kernel::Avx2 => unsafe { isa::op_avx2(f, &c, op, a, b, out) },
-            Kernel::Scalar => {}
-            _ => unsafe { isa::op_avx512(f, &c, op, a, b, out) },
+    match which {
+        // SAFETY: `which` names a kernel only after run-time feature detection, and only for
+        // formats with lanes.
+        Kernel::Avx2 => {
+            unsafe { isa::op_avx2(f, op, a, b, out) };
+            return which;
         }
-        if which != Kernel::Scalar {
+        Kernel::Scalar => {}
+        _ => {
+            unsafe { isa::op_avx512(f, op, a, b, out) };
             return which;
         }
     }
@@ -970,46 +957,17 @@ pub fn slab_kernel_fixed(s: &Slab<Fixed>) -> Kernel {
     kernel_fixed(&s.fmt)
 }
 
-/// Runs the slab kernel `which` names on the full vectors, the scalar model on the rest.
-fn slab_fixed(s: &Slab<Fixed>, rays: SlabShape<'_>, boxes: &BoxesSoa<i64>, out: &mut SlabOutSoa<i64>) -> Kernel {
-    let n = out.hit.len();
-    let cols_ok = boxes.min.iter().chain(&boxes.max).all(|c| c.len() == n)
-        && [&out.t_near, &out.t_far].iter().all(|c| c.len() == n);
-    let rays_ok = match rays {
-        SlabShape::Pairs(r) => {
-            assert!(r.tmin.len() == n && boxes.min[0].len() == n, "batch lengths differ");
-            [&r.o, &r.inv_d, &r.inv_lo, &r.inv_hi].iter().all(|c| c.iter().all(|c| c.len() == n))
-                && r.parallel.iter().all(|c| c.len() == n)
-                && r.tmax.len() == n
-        }
-        SlabShape::One(_) => {
-            assert!(boxes.min[0].len() == n, "batch lengths differ");
-            true
-        }
-    };
-    let which = slab_kernel_fixed(s);
-    #[cfg(target_arch = "x86_64")]
-    if let Some(c) = Lanes::of(&s.fmt).filter(|_| cols_ok && rays_ok) {
-        // SAFETY: `which` names a kernel only after run-time feature detection.
-        let full = match which {
-            Kernel::Avx2 => unsafe { isa::slab_avx2(s, &c, rays, boxes, out) },
-            Kernel::Scalar => 0,
-            _ => unsafe { isa::slab_avx512(s, &c, rays, boxes, out) },
-        };
-        if which != Kernel::Scalar {
-            match rays {
-                SlabShape::Pairs(r) => s.batch_from(r, boxes, out, full),
-                SlabShape::One(r) => s.batch_ray_from(r, boxes, out, full),
-            }
-            return which;
-        }
-    }
-    let _ = (which, cols_ok, rays_ok);
-    match rays {
-        SlabShape::Pairs(r) => s.batch(r, boxes, out),
-        SlabShape::One(r) => s.batch_ray(r, boxes, out),
-    }
-    Kernel::Scalar
+/// The slab unit on the kernel `slab_kernel_fixed` names, through `datapath::simd`'s dispatch.
+fn slab_fixed(s: &Slab<Fixed>, rays: SlabRays<'_, i64>, boxes: &BoxesSoa<i64>, out: &mut SlabOutSoa<i64>) -> Kernel {
+    crate::simd::slab_dispatch(
+        s,
+        rays,
+        boxes,
+        out,
+        slab_kernel_fixed(s),
+        #[cfg(target_arch = "x86_64")]
+        (isa::slab_avx2, isa::slab_avx512, None),
+    )
 }
 
 /// [`Slab::batch`] for a fixed-point format on the fastest kernel available; the same bits.
@@ -1022,7 +980,7 @@ pub fn slab_batch_fixed(
     boxes: &BoxesSoa<i64>,
     out: &mut SlabOutSoa<i64>,
 ) -> Kernel {
-    slab_fixed(s, SlabShape::Pairs(rays), boxes, out)
+    slab_fixed(s, SlabRays::Pairs(rays), boxes, out)
 }
 
 /// [`Slab::batch_ray`] (one ray, many boxes) for a fixed-point format on the fastest kernel
@@ -1031,5 +989,5 @@ pub fn slab_batch_fixed(
 /// # Panics
 /// If the column lengths differ.
 pub fn slab_ray_fixed(s: &Slab<Fixed>, ray: &SlabRay<i64>, boxes: &BoxesSoa<i64>, out: &mut SlabOutSoa<i64>) -> Kernel {
-    slab_fixed(s, SlabShape::One(ray), boxes, out)
+    slab_fixed(s, SlabRays::One(ray), boxes, out)
 }

@@ -132,7 +132,7 @@ pub fn kernel_f16(rti: &Rti<Ieee<F16Half>>) -> Kernel {
 
 /// The signature of an RTI kernel: lanes `0..full` of every column.
 #[cfg(target_arch = "x86_64")]
-type RtiKernelFn<F> = unsafe fn(
+pub(crate) type RtiKernelFn<F> = unsafe fn(
     &Rti<F>,
     &RaysSoa<<F as crate::Format>::V>,
     &TrisSoa<<F as crate::Format>::V>,
@@ -151,7 +151,7 @@ pub(crate) fn rti_columns_ok<V>(rays: &RaysSoa<V>, tris: &TrisSoa<V>, out: &Hits
 
 /// A format's kernels: AVX2, AVX-512F and, for binary16, AVX512-FP16.
 #[cfg(target_arch = "x86_64")]
-type Table<K> = (K, K, Option<K>);
+pub(crate) type Table<K> = (K, K, Option<K>);
 
 /// The kernel of `table` that `which` names, and its lanes per vector.
 #[cfg(target_arch = "x86_64")]
@@ -167,7 +167,7 @@ fn pick<K>(which: Kernel, table: Table<K>) -> Option<(K, usize)> {
 
 /// Runs the kernel of `table` that `which` names (when every column has the batch's length)
 /// on the full vectors and the scalar model on the rest; otherwise the scalar model throughout.
-fn rti_dispatch<F: crate::Format>(
+pub(crate) fn rti_dispatch<F: crate::Format>(
     rti: &Rti<F>,
     rays: &RaysSoa<F::V>,
     tris: &TrisSoa<F::V>,
@@ -388,14 +388,16 @@ fn slab_rays_ok<V>(rays: &SlabRaysSoa<V>, n: usize) -> bool {
 
 /// What a slab batch tests: ray i against box i, or one ray against every box.
 #[derive(Clone, Copy)]
-enum SlabRays<'a, V> {
+pub(crate) enum SlabRays<'a, V> {
+    /// Ray i against box i.
     Pairs(&'a SlabRaysSoa<V>),
+    /// One ray against every box.
     One(&'a SlabRay<V>),
 }
 
 /// The signature of a slab kernel: lanes `0..full` of every column.
 #[cfg(target_arch = "x86_64")]
-type SlabKernelFn<F> = unsafe fn(
+pub(crate) type SlabKernelFn<F> = unsafe fn(
     &Slab<F>,
     SlabRays<<F as crate::Format>::V>,
     &BoxesSoa<<F as crate::Format>::V>,
@@ -405,7 +407,7 @@ type SlabKernelFn<F> = unsafe fn(
 
 /// Runs the kernel of `table` that `which` names (when every column has the batch's length)
 /// on the full vectors and the scalar model on the rest; otherwise the scalar model throughout.
-fn slab_dispatch<F: crate::Format>(
+pub(crate) fn slab_dispatch<F: crate::Format>(
     s: &Slab<F>,
     rays: SlabRays<F::V>,
     boxes: &BoxesSoa<F::V>,
