@@ -54,7 +54,8 @@ use half::f16;
 pub enum Kernel {
     /// The scalar model.
     Scalar,
-    /// AVX2 (binary32) or AVX2 + F16C (binary16), 8 lanes.
+    /// AVX2 (binary32) or AVX2 + F16C (binary16), 8 lanes; detected with FMA (the `eEmM`
+    /// kernels' exact product split uses it).
     Avx2,
     /// AVX-512F (binary32 and binary16, the latter through its conversions), 16 lanes.
     Avx512,
@@ -88,7 +89,7 @@ fn widest_here() -> Kernel {
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::is_x86_feature_detected as has;
-            if has!("avx2") && has!("f16c") {
+            if has!("avx2") && has!("f16c") && has!("fma") {
                 // the AVX-512 kernels use AVX2 for the binary16 step
                 return match (has!("avx512f"), has!("avx512bw") && has!("avx512fp16")) {
                     (true, true) => Kernel::Avx512Fp16,
@@ -1220,7 +1221,7 @@ mod isa {
     /// The narrow formats' rounding, filter and flush, in the ops of the ISA module that
     /// invokes it (`v4d`, `v8d`: binary64 lanes).
     macro_rules! narrow_ops {
-        ($feat:literal, $v:ty) => {
+        ($feat:literal, $fmafeat:literal, $v:ty, $fnmadd:ident) => {
             /// Every lane rounded to the format's precision p, nearest-even, by Veltkamp's
             /// splitting (g = x·(2^S + 1), then g − (g − x)); correct for |x| in [2^emin, max]
             /// and for zeros ([`round_full`] handles the rest of the range).
@@ -1230,6 +1231,25 @@ mod isa {
                 let g = mul(x, splat(n.split));
                 // g − (g − x) is g + (x − g) (nearest-even rounding is symmetric) with -0 kept
                 sub(g, sub(g, x))
+            }
+            /// b·(2^S + 1), exact in every lane holding a format value (its p significant bits
+            /// and their copy S = 53 − p places up span at most 53 bits): the factor
+            /// [`split_mul`] takes for b.
+            #[inline]
+            #[target_feature(enable = $feat)]
+            pub fn split_k(b: $v, n: &Narrow) -> $v {
+                mul(b, splat(n.split))
+            }
+            /// [`split`] of the product a·b of two format values, with bk = [`split_k`]`(b)`:
+            /// the same three values without forming a·b first. a·b is exact in binary64
+            /// (2p ≤ 53 bits), so g = RN(a·bk) is RN(a·b·(2^S + 1)), split's g; the negative
+            /// multiply-add RN(g − a·b) is split's RN(g − x) (its product is exact: no rounding
+            /// of the modelled datapath is fused away); g minus it is split's result, bit for bit.
+            #[inline]
+            #[target_feature(enable = $fmafeat)]
+            pub fn split_mul(a: $v, b: $v, bk: $v) -> $v {
+                let g = mul(a, bk);
+                sub(g, $fnmadd(a, b, g))
             }
             /// Every lane rounded to the format, nearest-even, with its range (see "Rounding in
             /// the lanes" in [`crate::format::narrow`]): [`split`] where |x| ≥ 2^emin; the
@@ -1421,7 +1441,7 @@ mod isa {
             }
             bits(and_m(good, le(splat(n.fast_lo), lo))) == (1 << LANES) - 1
         }
-        narrow_ops!("avx2", __m256d);
+        narrow_ops!("avx2", "avx2,fma", __m256d, _mm256_fnmadd_pd);
         /// Loads 4 `eEmM` encodings as binary64 (exact).
         ///
         /// # Safety
@@ -1656,7 +1676,7 @@ mod isa {
             let bottom = int((n.fast_lo.to_bits() << 1) - 1);
             _mm512_cmple_epu64_mask(hi, top) & _mm512_cmpge_epu64_mask(lo, bottom) == u8::MAX
         }
-        narrow_ops!("avx512f", __m512d);
+        narrow_ops!("avx512f", "avx512f", __m512d, _mm512_fnmadd_pd);
         /// Loads 8 `eEmM` encodings as binary64 (exact).
         ///
         /// # Safety
@@ -1906,18 +1926,20 @@ mod kernels {
     macro_rules! rti_kernel {
         ($x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $thr:expr, $start:expr, $end:expr) => {{
             let round = $round;
-            rti_kernel!($x, $rti, $rays, $tris, $out, $full, $load, round, round, |_: &[_; 12]| true, $store, $thr, $start, $end)
+            rti_kernel!($x, $rti, $rays, $tris, $out, $full, $load, round, round, |b| b, |a, b, _| round($x::mul(a, b)), |_: &[_; 12]| true, $store, $thr, $start, $end)
         }};
-        // `$fast` rounds without the filter; `$ok(v)` (v: the stage-1 results and the
-        // direction) says that `$fast` gives `$round`'s results at stages 2-6 on every lane
-        ($x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $fast:expr, $ok:expr, $store:expr, $thr:expr, $start:expr, $end:expr) => {{
+        // `$fast` rounds without the filter; `$fmulk(a, b, $k(b))` is `$fast` of the product
+        // a·b (`$k(b)` formed once for the products that share b); `$ok(v)` (v: the stage-1
+        // results and the direction) says that `$fast` gives `$round`'s results at stages 2-6
+        // on every lane
+        ($x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $fast:expr, $k:expr, $fmulk:expr, $ok:expr, $store:expr, $thr:expr, $start:expr, $end:expr) => {{
             // one loop per (culling, division mode), so that neither is decided per vector
             let backface = $rti.cull == Cull::Backface;
             match ($rti.fmt.opts.div, backface) {
-                (DivMode::RecipMul, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $ok, $store, $thr, $start, $end, false, true),
-                (DivMode::RecipMul, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $ok, $store, $thr, $start, $end, true, true),
-                (DivMode::Divide, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $ok, $store, $thr, $start, $end, false, false),
-                (DivMode::Divide, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $ok, $store, $thr, $start, $end, true, false),
+                (DivMode::RecipMul, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $k, $fmulk, $ok, $store, $thr, $start, $end, false, true),
+                (DivMode::RecipMul, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $k, $fmulk, $ok, $store, $thr, $start, $end, true, true),
+                (DivMode::Divide, false) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $k, $fmulk, $ok, $store, $thr, $start, $end, false, false),
+                (DivMode::Divide, true) => rti_kernel!(@loop $x, $rti, $rays, $tris, $out, $full, $load, $round, $fast, $k, $fmulk, $ok, $store, $thr, $start, $end, true, false),
             }
         }};
         // stage 1 in `$sub`: (e1, e2, s)
@@ -1929,24 +1951,28 @@ mod kernels {
                 ($sub($ox, v0x), $sub($oy, v0y), $sub($oz, v0z)),
             )
         }};
-        // stages 2-6 in `$sub`, `$add`, `$mul`: [det, u', v', t']
-        (@stages26 $sub:ident, $add:ident, $mul:ident, $e1:expr, $e2:expr, $s:expr, $d:expr) => {{
+        // stages 2-6 in `$sub`, `$add`, `$mul`: [det, u', v', t']. The 18 products with a
+        // factor of d or s go through `$mulk(a, b, $k(b))` with b that factor (multiplication
+        // commutes: `$mulk(e2z, dy, ..)` is the product dy·e2z of the table)
+        (@stages26 $sub:ident, $add:ident, $mul:ident, $k:ident, $mulk:ident, $e1:expr, $e2:expr, $s:expr, $d:expr) => {{
             let ((e1x, e1y, e1z), (e2x, e2y, e2z), (sx, sy, sz), (dx, dy, dz)) = ($e1, $e2, $s, $d);
+            let (kdx, kdy, kdz) = ($k(dx), $k(dy), $k(dz));
+            let (ksx, ksy, ksz) = ($k(sx), $k(sy), $k(sz));
             // stages 2, 3: p = d x e2, q = s x e1
-            let px = $sub($mul(dy, e2z), $mul(dz, e2y));
-            let py = $sub($mul(dz, e2x), $mul(dx, e2z));
-            let pz = $sub($mul(dx, e2y), $mul(dy, e2x));
-            let qx = $sub($mul(sy, e1z), $mul(sz, e1y));
-            let qy = $sub($mul(sz, e1x), $mul(sx, e1z));
-            let qz = $sub($mul(sx, e1y), $mul(sy, e1x));
+            let px = $sub($mulk(e2z, dy, kdy), $mulk(e2y, dz, kdz));
+            let py = $sub($mulk(e2x, dz, kdz), $mulk(e2z, dx, kdx));
+            let pz = $sub($mulk(e2y, dx, kdx), $mulk(e2x, dy, kdy));
+            let qx = $sub($mulk(e1z, sy, ksy), $mulk(e1y, sz, ksz));
+            let qy = $sub($mulk(e1x, sz, ksz), $mulk(e1z, sx, ksx));
+            let qz = $sub($mulk(e1y, sx, ksx), $mulk(e1x, sy, ksy));
             // stages 4-6: (x + y) + z
             let det = $add($add($mul(e1x, px), $mul(e1y, py)), $mul(e1z, pz));
-            let up = $add($add($mul(sx, px), $mul(sy, py)), $mul(sz, pz));
-            let vp = $add($add($mul(dx, qx), $mul(dy, qy)), $mul(dz, qz));
+            let up = $add($add($mulk(px, sx, ksx), $mulk(py, sy, ksy)), $mulk(pz, sz, ksz));
+            let vp = $add($add($mulk(qx, dx, kdx), $mulk(qy, dy, kdy)), $mulk(qz, dz, kdz));
             let tp = $add($add($mul(e2x, qx), $mul(e2y, qy)), $mul(e2z, qz));
             [det, up, vp, tp]
         }};
-        (@loop $x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $fast:expr, $ok:expr, $store:expr, $thr:expr, $start:expr, $end:expr, $backface:expr, $recip:expr) => {{
+        (@loop $x:ident, $rti:expr, $rays:expr, $tris:expr, $out:expr, $full:expr, $load:expr, $round:expr, $fast:expr, $k:expr, $fmulk:expr, $ok:expr, $store:expr, $thr:expr, $start:expr, $end:expr, $backface:expr, $recip:expr) => {{
             let (rays, tris, out) = ($rays, $tris, $out);
             let load = $load;
             let rd = $round;
@@ -1955,6 +1981,9 @@ mod kernels {
             let fsub = |a, b| fast($x::sub(a, b));
             let fadd = |a, b| fast($x::add(a, b));
             let fmul = |a, b| fast($x::mul(a, b));
+            let (fk, fmulk) = ($k, $fmulk);
+            // the filtered path's products as the table's: no factor formed ahead
+            let (nok, mulk) = (|b| b, |a, b, _| rd($x::mul(a, b)));
             let store = $store;
             // called before and after each block of vectors (the narrow formats' filter)
             let (start, end) = ($start, $end);
@@ -1996,10 +2025,10 @@ mod kernels {
                     let all = [e1.0, e1.1, e1.2, e2.0, e2.1, e2.2, s.0, s.1, s.2, dx, dy, dz];
                     unfiltered[k] = ok(&all);
                     *slot = if unfiltered[k] {
-                        rti_kernel!(@stages26 fsub, fadd, fmul, e1, e2, s, d)
+                        rti_kernel!(@stages26 fsub, fadd, fmul, fk, fmulk, e1, e2, s, d)
                     } else {
                         let (e1, e2, s) = rti_kernel!(@stage1 sub, v, ox, oy, oz);
-                        rti_kernel!(@stages26 sub, add, mul, e1, e2, s, d)
+                        rti_kernel!(@stages26 sub, add, mul, nok, mulk, e1, e2, s, d)
                     };
                 }
                 for (k, &[det, up, vp, tp]) in keep.iter().enumerate().take(nv) {
@@ -2437,6 +2466,8 @@ mod kernels {
                             |c: &Vec<$v>, i: usize| $x::flush(load(c, i), n),
                             |x| $x::round_full(x, n),
                             |x| $x::split(x, n),
+                            |b| $x::split_k(b, n),
+                            |a, b, bk| $x::split_mul(a, b, bk),
                             |v: &[_; 12]| $x::fast_ok(v, n),
                             $store,
                             super::super::narrow_thr(rti, n),
@@ -2620,6 +2651,6 @@ mod kernels {
     bf16_for!(b8, v8, "avx2");
     bf16_for!(b16, v16, "avx512f,avx2");
 
-    narrow_for!(v4d, "avx2");
+    narrow_for!(v4d, "avx2,fma");
     narrow_for!(v8d, "avx512f,avx2");
 }

@@ -64,6 +64,14 @@
 //! turns an infinite difference into a NaN, so both must take the full road). The reciprocal
 //! or division and the three final multiplies always round in full.
 //!
+//! **Products on the filtered path** (`split_mul` in `datapath::simd`): a product a·b of two
+//! target values is exact in binary64 (2p ≤ 50 bits), and so is b·(2^S + 1) (b's p bits and
+//! their copy S = 53 − p places up span 53 bits). So g = RN(a·(b·(2^S + 1))) is the split's
+//! g = RN(x·(2^S + 1)) of x = a·b, and one negative multiply-add RN(g − a·b) (its product exact)
+//! is the split's RN(g − x): the same three values, the same bits, one operation fewer, with
+//! b·(2^S + 1) formed once for the products that share b (the 18 products of stages 2–5 with a
+//! factor of d or s). The fused operation fuses none of the modelled datapath's roundings.
+//!
 //! **e8mM loads** (E = 8, M ≤ 23, binary32's exponent field and bias): an encoding shifted
 //! left by 23 − M is the binary32 encoding of the same value (subnormals, ±∞ and NaNs
 //! included), which widens to binary64 exactly; a stored lane (a target value, or binary64's
