@@ -498,15 +498,13 @@ pub fn slab_ray_kernel_bf16(s: &Slab<Ieee<Bf16>>) -> Kernel {
 }
 
 /// Whether the `eEmM` slab kernels take this unit (pairs, or one ray when `one`): M ≤ 24,
-/// E ≤ 10, IEEE subnormals, the canonical NaN rule; `e8mM` (M ≤ 23) in every variant but
-/// the directed one on pairs, the others in the variants without widening, guard or directed
-/// arithmetic (plain, take-on-false, embree).
+/// E ≤ 10, the canonical NaN rule, either subnormal mode, every variant but the directed one
+/// on pairs.
 fn soft_slab_ok(s: &Slab<Ieee<Soft>>, one: bool) -> bool {
     let c = &s.cfg;
     match narrow_of(&s.fmt) {
-        Some(n) if !n.ftz && n.e8 => !c.directed || (one && directed_one_ok(c)),
-        Some(n) if !n.ftz => !c.directed && c.widen_ulps == 0 && !c.guard,
-        _ => false,
+        Some(_) => !c.directed || (one && directed_one_ok(c)),
+        None => false,
     }
 }
 
@@ -1275,6 +1273,31 @@ mod isa {
                 let r = blend(split(x, n), xor(tiny, sgn), lt(a, splat(n.min_normal)));
                 blend(r, xor(splat(f64::INFINITY), sgn), le(splat(n.overflow_at), a))
             }
+            /// The next value above each lane on the format's grid, the model's `next_up` for
+            /// lanes holding format values (see "Grid steps" in [`crate::format::narrow`]):
+            /// a lane x ≥ +0 (−0 included) steps away from zero by its quantum
+            /// q(x) = max(2^⌊log2 x⌋ · 2^−M, 2^(emin − M)), a lane x < 0 toward zero by the
+            /// quantum of the magnitude just below |x| (the binade below at a power of two);
+            /// the step past max is +∞, −∞ steps to −max, NaN and +∞ stay. Under FTZ (no
+            /// subnormal lane: the caller's) a step that lands strictly between 0 and 2^emin
+            /// goes on to 2^emin (up from ±0) or to −0 (up from −2^emin).
+            #[inline]
+            #[target_feature(enable = $feat)]
+            pub fn next_up_soft(x: $v, n: &Narrow) -> $v {
+                let zero = splat(0.0);
+                let a = abs(x);
+                let toward = lt(x, zero);
+                let q = max(mul(exponent(blend(a, pred(a), toward)), splat(n.quantum)), splat(n.step));
+                let r = blend(add(a, q), xor(sub(a, q), splat(-0.0)), toward);
+                let r = blend(r, splat(-n.max_finite), lt(x, splat(-n.max_finite)));
+                let r = blend(r, splat(f64::INFINITY), lt(splat(n.max_finite), r));
+                if !n.ftz {
+                    return r;
+                }
+                let ar = abs(r);
+                let tiny = and_m(lt(zero, ar), lt(ar, splat(n.min_normal)));
+                blend(r, blend(splat(n.min_normal), splat(-0.0), toward), tiny)
+            }
             /// Under FTZ, subnormal lanes read as zeros of the same sign (the operand read).
             #[inline]
             #[target_feature(enable = $feat)]
@@ -1378,16 +1401,6 @@ mod isa {
         pub fn sign_m(x: __m256d) -> M {
             _mm256_castsi256_pd(_mm256_cmpgt_epi64(_mm256_setzero_si256(), _mm256_castpd_si256(x)))
         }
-        /// The next value above each lane on the grid of an `e8mM` format with M ≤ 23 (`n.e8`;
-        /// lanes holding its values): binary32 holds them exactly, and the target's encoding is
-        /// binary32's shifted by 23 − M, so the step is 2^(23 − M) binary32 encodings
-        /// (`v8::next_up_by`: NaN and +∞ unchanged, ±0 to the least subnormal).
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn next_up_e8(v: __m256d, n: &Narrow) -> __m256d {
-            let f = _mm256_castps128_ps256(_mm256_cvtpd_ps(v));
-            _mm256_cvtps_pd(_mm256_castps256_ps128(super::v8::next_up_by(f, 1 << n.e8_shift)))
-        }
         /// The sign bits of x (everything else cleared).
         #[inline]
         #[target_feature(enable = "avx2")]
@@ -1421,6 +1434,13 @@ mod isa {
         #[target_feature(enable = "avx2")]
         fn pred(a: __m256d) -> __m256d {
             _mm256_castsi256_pd(_mm256_sub_epi64(_mm256_castpd_si256(a), int(1)))
+        }
+        /// Each lane's binary64 exponent field alone: 2^⌊log2 |x|⌋ for a normal x, 0 for ±0
+        /// (and binary64 subnormals), +∞ for ±∞ and NaN.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn exponent(x: __m256d) -> __m256d {
+            _mm256_and_pd(x, _mm256_castsi256_pd(int(0x7ff0_0000_0000_0000)))
         }
         /// The range filter (see [`crate::format::narrow`]): true when on every lane the
         /// nonzero magnitudes among `v` (the stage-1 results and the direction) are at least
@@ -1618,12 +1638,6 @@ mod isa {
         pub fn sign_m(x: __m512d) -> M {
             _mm512_test_epi64_mask(ib(x), int(1 << 63))
         }
-        /// [`super::v4d::next_up_e8`] on 8 lanes.
-        #[inline]
-        #[target_feature(enable = "avx512f")]
-        pub fn next_up_e8(v: __m512d, n: &Narrow) -> __m512d {
-            _mm512_cvtps_pd(super::v8::next_up_by(_mm512_cvtpd_ps(v), 1 << n.e8_shift))
-        }
         /// The sign bits of x (everything else cleared).
         #[inline]
         #[target_feature(enable = "avx512f")]
@@ -1657,6 +1671,12 @@ mod isa {
         #[target_feature(enable = "avx512f")]
         fn pred(a: __m512d) -> __m512d {
             fb(_mm512_sub_epi64(ib(a), int(1)))
+        }
+        /// [`super::v4d::exponent`] on 8 lanes.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn exponent(x: __m512d) -> __m512d {
+            fb(_mm512_and_si512(ib(x), int(0x7ff0_0000_0000_0000)))
         }
         /// [`super::v4d::fast_ok`] on 8 lanes, in integer lanes: u = the encoding shifted left
         /// by one (the sign dropped; for magnitudes, the order of u is the order of the values,
@@ -2515,9 +2535,11 @@ mod kernels {
                 }
 
                 /// The `eEmM` slab kernel (pairs, or one ray against every box) on lanes
-                /// `0..full`, IEEE subnormals: every variant for `e8mM` (M ≤ 23), the variants
-                /// without widening, guard or directed arithmetic for the others
-                /// (`slab_kernel_soft`, `slab_ray_kernel_soft`).
+                /// `0..full`, every variant (the directed one on one-ray batches), either
+                /// subnormal mode (`slab_kernel_soft`, `slab_ray_kernel_soft`). Under FTZ the
+                /// operands read flushed; a t limit that is a nonzero subnormal encoding (the
+                /// model's comparators read it as zero but pass it on as it is) sends its lanes
+                /// (one ray: the batch) to the scalar model.
                 #[target_feature(enable = $feat)]
                 pub fn slab_soft(
                     s: &Slab<Ieee<Soft>>,
@@ -2528,6 +2550,12 @@ mod kernels {
                 ) {
                     let n: &Narrow = &super::super::narrow_of(&s.fmt).expect("the dispatch checked the format");
                     let f = s.fmt;
+                    let raw_sub = |v: u64| n.ftz && n.lay.is_subnormal(v);
+                    if let SlabRays::One(r) = rays {
+                        if raw_sub(r.tmin) || raw_sub(r.tmax) {
+                            return s.batch_ray(r, boxes, out);
+                        }
+                    }
                     // SAFETY (loads and stores): the caller checked that every column holds
                     // `full` lanes.
                     slab_kernel!(
@@ -2535,16 +2563,21 @@ mod kernels {
                         s,
                         rays,
                         boxes,
-                        out,
+                        &mut *out,
                         full,
-                        |c: *const u64, i: usize| unsafe { $x::load_soft(c, i, n) },
+                        |c: *const u64, i: usize| $x::flush(unsafe { $x::load_soft(c, i, n) }, n),
                         |x| $x::round_full(x, n),
                         |c: *mut u64, i: usize, x| unsafe { $x::store_soft(c, i, x, n) },
-                        // the grid step of e8mM formats; other formats never call it (the
-                        // dispatch refuses widening and the directed variant for them)
-                        |v| if n.e8 { $x::next_up_e8(v, n) } else { v },
-                        |v: u64| $x::splat(f.to_f64(v))
+                        |v| $x::next_up_soft(v, n),
+                        |v: u64| $x::flush($x::splat(f.to_f64(v)), n)
                     );
+                    if let (SlabRays::Pairs(r), true) = (rays, n.ftz) {
+                        for k in 0..full {
+                            if raw_sub(r.tmin[k]) || raw_sub(r.tmax[k]) {
+                                out.set(k, s.test(&r.get(k), &boxes.get(k)));
+                            }
+                        }
+                    }
                 }
 
                 /// One operation of an `eEmM` format on lanes `0..full`: `out[i] = a[i] op b[i]`,
@@ -2653,4 +2686,55 @@ mod kernels {
 
     narrow_for!(v4d, "avx2,fma");
     narrow_for!(v8d, "avx512f,avx2");
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::isa::{v4d, v8d};
+    use crate::format::{Ieee, Soft};
+    use crate::Format;
+
+    /// The lanes' grid step equals the model's `next_up` on every encoding of small formats
+    /// (subnormals, ±0, ±max, ±∞ and the FTZ rules dense), on every binary64-lane ISA here.
+    #[test]
+    fn next_up_in_binary64_lanes_equals_the_model_on_every_encoding() {
+        use std::arch::is_x86_feature_detected as has;
+        for name in ["e5m4", "e4m3", "e3m2", "e5m4:ftz", "e4m3:ftz", "e8m7", "e8m7:ftz", "e5m10", "e5m10:ftz"] {
+            let crate::AnyFormat::Soft(f) = name.parse::<crate::AnyFormat>().unwrap() else { unreachable!() };
+            let f: Ieee<Soft> = f;
+            let n = super::narrow_of(&f).unwrap();
+            let lay = n.lay;
+            // every value the lanes may hold: no raw subnormal under FTZ (operands read flushed)
+            let vals: Vec<u64> =
+                (0..1u64 << lay.width()).filter(|&b| !(lay.is_nan(b) || n.ftz && lay.is_subnormal(b))).collect();
+            for &b in &vals {
+                let want = f.to_f64(f.next_up(f.from_bits(b)));
+                let x = f.to_f64(f.from_bits(b));
+                let mut got = Vec::new();
+                if has!("avx2") && has!("fma") {
+                    // SAFETY: the features were detected.
+                    let v = unsafe {
+                        std::mem::transmute::<std::arch::x86_64::__m256d, [f64; 4]>(v4d::next_up_soft(
+                            v4d::splat(x),
+                            &n,
+                        ))
+                    };
+                    got.push(v[0]);
+                }
+                if has!("avx512f") {
+                    // SAFETY: the feature was detected.
+                    let v = unsafe {
+                        std::mem::transmute::<std::arch::x86_64::__m512d, [f64; 8]>(v8d::next_up_soft(
+                            v8d::splat(x),
+                            &n,
+                        ))
+                    };
+                    got.push(v[0]);
+                }
+                for g in got {
+                    assert_eq!(g.to_bits(), want.to_bits(), "{name}: next_up({x:e}) = {g:e}, the model {want:e}");
+                }
+            }
+        }
+    }
 }

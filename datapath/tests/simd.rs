@@ -322,9 +322,13 @@ mod slab {
             };
             // the t interval: mostly [0, inf), sometimes specials, NaN included (a one-ray batch
             // skips its per-vector NaN check when its interval holds numbers)
+            // (and the format's edges: ±max, ±least, ±min normal, whose grid steps leave the
+            // finite range or cross into or out of the subnormals)
+            let e = datapath::format::edges(f);
             let limit = |r: &mut SplitMix64, usual: f64| match r.below(20) {
                 0 => f64::NAN,
                 1 => f64_value(r),
+                2 => [e.max, -e.max, e.least, -e.least, e.min_normal, -e.min_normal][r.below(6) as usize],
                 _ => usual,
             };
             let tmin = limit(&mut r, 0.0);
@@ -337,6 +341,23 @@ mod slab {
             for t in [&mut ray.tmin, &mut ray.tmax] {
                 if r.below(20) == 0 {
                     *t = f.from_bits(inf | (1 + r.below(4)) | if r.below(2) == 0 { sign } else { 0 });
+                }
+            }
+            // and raw encodings `prepare` would have flushed under FTZ: subnormal t limits,
+            // origins and reciprocals (the model reads the operands flushed, and passes a t
+            // limit through its comparators as it is)
+            let raw_sub = |r: &mut SplitMix64| f.from_bits((1 + r.below(4)) | if r.below(2) == 0 { sign } else { 0 });
+            for t in [&mut ray.tmin, &mut ray.tmax] {
+                if r.below(24) == 0 {
+                    *t = raw_sub(&mut r);
+                }
+            }
+            for a in 0..3 {
+                if r.below(40) == 0 {
+                    ray.o[a] = raw_sub(&mut r);
+                }
+                if r.below(40) == 0 {
+                    ray.inv_d[a] = raw_sub(&mut r);
                 }
             }
             rays.push(&ray);
@@ -505,6 +526,17 @@ mod slab {
         let bf = |o| Ieee::new(datapath::format::Bf16, o);
         check_edges(datapath::simd::WIDEST_NARROW, bf(FpOpts::default()), slab_batch_bf16, slab_ray_bf16).unwrap();
         check_edges(datapath::simd::WIDEST_NARROW, bf(div), slab_batch_bf16, slab_ray_bf16).unwrap();
+        // eEmM: grid steps in binary64 lanes next to ±max and the least subnormal
+        for name in ["e8m16", "e5m10", "e6m9:divide", "e10m24"] {
+            let datapath::AnyFormat::Soft(f) = name.parse().unwrap() else { unreachable!() };
+            check_edges(
+                datapath::simd::WIDEST_NARROW,
+                f,
+                datapath::simd::slab_batch_soft,
+                datapath::simd::slab_ray_soft,
+            )
+            .unwrap();
+        }
     }
 
     const VARIANTS: [&str; 5] = ["plain", "conservative", "take-on-false", "embree", "directed"];
@@ -533,22 +565,18 @@ mod slab {
     proptest! {
         #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
 
-        /// The `eEmM` slab kernels (binary64 lanes, each result rounded in the lanes), pairs and
-        /// one ray against every box: the scalar model's bits; e8mM in every variant (grid
-        /// steps through binary32), other layouts without widening, guard or directed
-        /// arithmetic, FTZ formats on the scalar model.
+        /// The `eEmM` slab kernels (binary64 lanes, each result rounded in the lanes, grid steps
+        /// in the lanes), pairs and one ray against every box: the scalar model's bits in every
+        /// variant (the directed one on one-ray batches), either subnormal mode (under FTZ with
+        /// raw subnormal t limits, origins and reciprocals in the columns).
         #[test]
-        fn soft_float_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..5, fmt in 0usize..7) {
+        fn soft_float_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..5, fmt in 0usize..10) {
             use datapath::simd::{slab_batch_soft, slab_kernel_soft, slab_ray_kernel_soft, slab_ray_soft, WIDEST_NARROW};
-            let names = ["e8m16", "e5m4", "e10m24:divide", "e8m7", "e6m9:divide", "e8m16:ftz", "e8m23:divide"];
+            let names = ["e8m16", "e5m4", "e10m24:divide", "e8m7", "e6m9:divide", "e8m16:ftz", "e8m23:divide", "e5m10:ftz", "e6m9:ftz+divide", "e4m3:ftz"];
             let datapath::AnyFormat::Soft(f) = names[fmt].parse().unwrap() else { unreachable!() };
             let s = Slab::new(f, SlabConfig::named(VARIANTS[v]).unwrap());
-            // e8mM (binary32's exponent): every variant (the directed one on one-ray batches);
-            // the others: the variants without widening, guard or directed arithmetic
-            let (e8, ftz) = (names[fmt].starts_with("e8"), names[fmt].contains("ftz"));
-            let plainish = VARIANTS[v] != "conservative" && VARIANTS[v] != "directed";
-            let best = |ok: bool| if ok && !ftz { WIDEST_NARROW } else { Kernel::Scalar };
-            let (pairs_widest, one_widest) = (best(plainish || (e8 && VARIANTS[v] != "directed")), best(plainish || e8));
+            let best = |ok: bool| if ok { WIDEST_NARROW } else { Kernel::Scalar };
+            let (pairs_widest, one_widest) = (best(VARIANTS[v] != "directed"), best(true));
             let here = *kernels_here().last().unwrap();
             prop_assert_eq!(slab_kernel_soft(&s), here.min(pairs_widest));
             prop_assert_eq!(slab_ray_kernel_soft(&s), here.min(one_widest));

@@ -96,6 +96,8 @@ pub struct Narrow {
     pub max_finite: f64,
     /// 2^(emin − M), the subnormal step (decode: fraction × step).
     pub step: f64,
+    /// 2^−M: a normal value's quantum over its power of two.
+    pub quantum: f64,
     /// 2^(M − emin), the inverse of the step (encode).
     pub inv_step: f64,
     /// 2^S + 1 with S = 52 − M, Veltkamp's splitting constant for rounding to p = 53 − S bits.
@@ -127,6 +129,7 @@ impl Narrow {
             min_normal: lay.min_normal(),
             max_finite: lay.max_finite(),
             step: super::layout::pow2(lay.emin() - m),
+            quantum: super::layout::pow2(-m),
             inv_step: super::layout::pow2(m - lay.emin()),
             split: super::layout::pow2(52 - m) + 1.0,
             sub_grid: super::layout::pow2(lay.emin() - m + 52),
