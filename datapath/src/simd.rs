@@ -121,9 +121,10 @@ pub const WIDEST_F32: Kernel = Kernel::Avx512;
 /// The widest kernel binary16 has.
 pub const WIDEST_F16: Kernel = Kernel::Avx512Fp16;
 
-/// The kernel `rti_batch_f32` uses for this unit on this machine (and this thread's cap).
+/// The kernel `rti_batch_f32` uses for this unit on this machine (and this thread's cap):
+/// IEEE subnormals or FTZ (flushed in the lanes), the canonical NaN rule.
 pub fn kernel_f32(rti: &Rti<Ieee<F32Native>>) -> Kernel {
-    best_kernel(eligible(&rti.fmt) && rti.det_thr >= 0.0, WIDEST_F32)
+    best_kernel(rti.fmt.opts.nan == NanMode::Canonical && rti.det_thr >= 0.0, WIDEST_F32)
 }
 
 /// The kernel `rti_batch_f16` uses for this unit on this machine (and this thread's cap).
@@ -2402,19 +2403,44 @@ mod kernels {
         };
         (@f32 $x:ident, $f32feat:literal) => {
             kernels_for!(@format $x, $f32feat, rti_f32, slab_f32, Ieee<F32Native>, f32, load32, store32,
-                |x| x, |v| $x::next_up(v), |x: f32| $x::splat(x), |r: &Rti<Ieee<F32Native>>| r.det_thr);
+                |x| x, |v| $x::next_up(v), |x: f32| $x::splat(x), |r: &Rti<Ieee<F32Native>>| r.det_thr,
+                |x| $x::flush_bf16(x, true), true);
         };
         (@f16 $x:ident, $f16feat:literal) => {
             kernels_for!(@format $x, $f16feat, rti_f16, slab_f16, Ieee<F16Half>, f16, load16, store16,
                 |v| $x::round16(v), |v| $x::next_up16(v), |x: f16| $x::splat16(x),
-                |r: &Rti<Ieee<F16Half>>| r.det_thr.to_f32());
+                |r: &Rti<Ieee<F16Half>>| r.det_thr.to_f32(), |x| x, false);
         };
         // one format's RTI and slab kernels: its column type, loads and stores, rounding, grid
-        // step, ray broadcast and det threshold (as the lanes hold it)
+        // step, ray broadcast, det threshold (as the lanes hold it), and the FTZ flush (a
+        // subnormal lane to zero of its sign) when `$ftz` (the RTI kernel under FTZ flushes
+        // every operand read and every rounded result in the lanes)
         (@format $x:ident, $feat:literal, $rti:ident, $slab:ident, $fmt:ty, $v:ty, $load:ident, $store:ident,
-         $round:expr, $up:expr, $bcast:expr, $thr:expr) => {
+         $round:expr, $up:expr, $bcast:expr, $thr:expr, $flush:expr, $ftz:literal) => {
             #[target_feature(enable = $feat)]
             pub fn $rti(rti: &Rti<$fmt>, rays: &RaysSoa<$v>, tris: &TrisSoa<$v>, out: &mut HitsSoa<$v>, full: usize) {
+                if $ftz && rti.fmt.opts.subnormals == Subnormals::Ftz {
+                    let (flush, round) = ($flush, $round);
+                    // the comparator reads the threshold flushed, but det is ±0 or normal here,
+                    // so a subnormal threshold decides as zero does: no flush needed
+                    let thr = ($thr)(rti);
+                    // SAFETY (loads and stores): as below.
+                    rti_kernel!(
+                        $x,
+                        rti,
+                        rays,
+                        tris,
+                        out,
+                        full,
+                        |c: &Vec<$v>, i: usize| flush(unsafe { $x::$load(c.as_ptr(), i) }),
+                        |x| flush(round(x)),
+                        |c: &mut Vec<$v>, i: usize, x| unsafe { $x::$store(c.as_mut_ptr(), i, x) },
+                        thr,
+                        || {},
+                        |_: usize, _: usize, _: &[u32; 8], _: &mut HitsSoa<$v>| {}
+                    );
+                    return;
+                }
                 // SAFETY (loads and stores): the caller checked that every column holds
                 // `full` lanes; the column types are plain values.
                 rti_kernel!(
