@@ -2419,44 +2419,35 @@ mod kernels {
          $round:expr, $up:expr, $bcast:expr, $thr:expr, $flush:expr, $ftz:literal) => {
             #[target_feature(enable = $feat)]
             pub fn $rti(rti: &Rti<$fmt>, rays: &RaysSoa<$v>, tris: &TrisSoa<$v>, out: &mut HitsSoa<$v>, full: usize) {
-                if $ftz && rti.fmt.opts.subnormals == Subnormals::Ftz {
-                    let (flush, round) = ($flush, $round);
-                    // the comparator reads the threshold flushed, but det is ±0 or normal here,
-                    // so a subnormal threshold decides as zero does: no flush needed
-                    let thr = ($thr)(rti);
-                    // SAFETY (loads and stores): as below.
-                    rti_kernel!(
-                        $x,
-                        rti,
-                        rays,
-                        tris,
-                        out,
-                        full,
-                        |c: &Vec<$v>, i: usize| flush(unsafe { $x::$load(c.as_ptr(), i) }),
-                        |x| flush(round(x)),
-                        |c: &mut Vec<$v>, i: usize, x| unsafe { $x::$store(c.as_mut_ptr(), i, x) },
-                        thr,
-                        || {},
-                        |_: usize, _: usize, _: &[u32; 8], _: &mut HitsSoa<$v>| {}
-                    );
-                    return;
-                }
                 // SAFETY (loads and stores): the caller checked that every column holds
                 // `full` lanes; the column types are plain values.
-                rti_kernel!(
-                    $x,
-                    rti,
-                    rays,
-                    tris,
-                    out,
-                    full,
-                    |c: &Vec<$v>, i: usize| unsafe { $x::$load(c.as_ptr(), i) },
-                    $round,
-                    |c: &mut Vec<$v>, i: usize, x| unsafe { $x::$store(c.as_mut_ptr(), i, x) },
-                    ($thr)(rti),
-                    || {},
-                    |_: usize, _: usize, _: &[u32; 8], _: &mut HitsSoa<$v>| {}
-                );
+                macro_rules! run {
+                    ($ld:expr, $rd:expr) => {
+                        rti_kernel!(
+                            $x,
+                            rti,
+                            rays,
+                            tris,
+                            out,
+                            full,
+                            $ld,
+                            $rd,
+                            |c: &mut Vec<$v>, i: usize, x| unsafe { $x::$store(c.as_mut_ptr(), i, x) },
+                            ($thr)(rti),
+                            || {},
+                            |_: usize, _: usize, _: &[u32; 8], _: &mut HitsSoa<$v>| {}
+                        )
+                    };
+                }
+                let load = |c: &Vec<$v>, i: usize| unsafe { $x::$load(c.as_ptr(), i) };
+                if $ftz && rti.fmt.opts.subnormals == Subnormals::Ftz {
+                    // (the comparator reads the threshold flushed, but det is ±0 or normal
+                    // here, so a subnormal threshold decides as zero does)
+                    let (flush, round) = ($flush, $round);
+                    run!(|c: &Vec<$v>, i: usize| flush(load(c, i)), |x| flush(round(x)));
+                } else {
+                    run!(load, $round);
+                }
             }
 
             #[target_feature(enable = $feat)]
