@@ -127,9 +127,10 @@ pub fn kernel_f32(rti: &Rti<Ieee<F32Native>>) -> Kernel {
     best_kernel(rti.fmt.opts.nan == NanMode::Canonical && rti.det_thr >= 0.0, WIDEST_F32)
 }
 
-/// The kernel `rti_batch_f16` uses for this unit on this machine (and this thread's cap).
+/// The kernel `rti_batch_f16` uses for this unit on this machine (and this thread's cap):
+/// IEEE subnormals or FTZ (flushed in the lanes), the canonical NaN rule.
 pub fn kernel_f16(rti: &Rti<Ieee<F16Half>>) -> Kernel {
-    best_kernel(eligible(&rti.fmt) && rti.det_thr.to_f32() >= 0.0, WIDEST_F16)
+    best_kernel(rti.fmt.opts.nan == NanMode::Canonical && rti.det_thr.to_f32() >= 0.0, WIDEST_F16)
 }
 
 /// The signature of an RTI kernel: lanes `0..full` of every column.
@@ -2404,19 +2405,19 @@ mod kernels {
         (@f32 $x:ident, $f32feat:literal) => {
             kernels_for!(@format $x, $f32feat, rti_f32, slab_f32, Ieee<F32Native>, f32, load32, store32,
                 |x| x, |v| $x::next_up(v), |x: f32| $x::splat(x), |r: &Rti<Ieee<F32Native>>| r.det_thr,
-                |x| $x::flush_bf16(x, true), true);
+                f32::MIN_POSITIVE);
         };
         (@f16 $x:ident, $f16feat:literal) => {
             kernels_for!(@format $x, $f16feat, rti_f16, slab_f16, Ieee<F16Half>, f16, load16, store16,
                 |v| $x::round16(v), |v| $x::next_up16(v), |x: f16| $x::splat16(x),
-                |r: &Rti<Ieee<F16Half>>| r.det_thr.to_f32(), |x| x, false);
+                |r: &Rti<Ieee<F16Half>>| r.det_thr.to_f32(), f16::MIN_POSITIVE.to_f32());
         };
         // one format's RTI and slab kernels: its column type, loads and stores, rounding, grid
-        // step, ray broadcast, det threshold (as the lanes hold it), and the FTZ flush (a
-        // subnormal lane to zero of its sign) when `$ftz` (the RTI kernel under FTZ flushes
-        // every operand read and every rounded result in the lanes)
+        // step, ray broadcast, det threshold (as the lanes hold it), and smallest normal (the RTI
+        // kernel under FTZ flushes every operand read and every rounded result in the lanes: a
+        // lane below it becomes zero of its sign)
         (@format $x:ident, $feat:literal, $rti:ident, $slab:ident, $fmt:ty, $v:ty, $load:ident, $store:ident,
-         $round:expr, $up:expr, $bcast:expr, $thr:expr, $flush:expr, $ftz:literal) => {
+         $round:expr, $up:expr, $bcast:expr, $thr:expr, $min_normal:expr) => {
             #[target_feature(enable = $feat)]
             pub fn $rti(rti: &Rti<$fmt>, rays: &RaysSoa<$v>, tris: &TrisSoa<$v>, out: &mut HitsSoa<$v>, full: usize) {
                 // SAFETY (loads and stores): the caller checked that every column holds
@@ -2440,10 +2441,11 @@ mod kernels {
                     };
                 }
                 let load = |c: &Vec<$v>, i: usize| unsafe { $x::$load(c.as_ptr(), i) };
-                if $ftz && rti.fmt.opts.subnormals == Subnormals::Ftz {
+                if rti.fmt.opts.subnormals == Subnormals::Ftz {
                     // (the comparator reads the threshold flushed, but det is ±0 or normal
                     // here, so a subnormal threshold decides as zero does)
-                    let (flush, round) = ($flush, $round);
+                    let flush = |x| $x::blend(x, $x::sign(x), $x::lt($x::abs(x), $x::splat($min_normal)));
+                    let round = $round;
                     run!(|c: &Vec<$v>, i: usize| flush(load(c, i)), |x| flush(round(x)));
                 } else {
                     run!(load, $round);
