@@ -58,10 +58,10 @@ pub struct SpeedReport {
 
 /// The RTI batch path of each format family (the SIMD kernels of `datapath::simd`).
 pub const BATCH_PATHS: [&str; 5] = [
-    "f32, fp16: binary32 / binary16 kernels (IEEE subnormals, canonical NaN; the RTI kernels also under FTZ, flushing in the lanes)",
-    "bf16: binary32 lanes, each op rounded to bf16 in integer lanes (IEEE or FTZ, canonical NaN; the slab kernels: IEEE)",
+    "f32, fp16: binary32 / binary16 kernels (IEEE subnormals or FTZ, flushing in the lanes; canonical NaN)",
+    "bf16: binary32 lanes, each op rounded to bf16 in integer lanes (IEEE or FTZ, canonical NaN)",
     "eEmM with M <= 24, E <= 10: binary64 lanes, each op rounded to the format in the lanes (subnormals, FTZ, overflow), a range filter skipping that work where the stage-1 values prove it unneeded (IEEE or FTZ, canonical NaN); the slab kernels: every variant, IEEE or FTZ, grid steps in the lanes (a raw subnormal t limit under FTZ: that lane on the scalar model)",
-    "scalar model only: the f32, fp16 and bf16 slab units under FTZ, the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float; every format's directed slab variant on ray-box pairs (one ray x many boxes has kernels)",
+    "scalar model only: the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float; every format's directed slab variant on ray-box pairs (one ray x many boxes has kernels)",
     "fixed point qI.F with I + F <= 32: i64 lanes for RTI and slab (every variant), every rounding, overflow and division mode (datapath::fixed_lanes); wider fixed point: scalar model only",
 ];
 

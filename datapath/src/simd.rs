@@ -30,8 +30,9 @@
 //! with a subnormal, overflowing or infinite intermediate to the scalar model; the argument is
 //! in [`crate::format::narrow`]), IEEE or FTZ, canonical NaN, either division mode.
 //!
-//! Eligible formats (binary32 / binary16): IEEE subnormals and canonical NaN (either division
-//! mode, either culling; every slab variant but the directed one); others, and machines
+//! Eligible formats (binary32 / binary16): the canonical NaN rule, IEEE subnormals or FTZ
+//! (flushed in the lanes), either division mode, either culling; every slab variant (the
+//! directed one on one-ray batches); others, and machines
 //! without AVX2, run the scalar model, as does a det threshold that is negative or NaN (the RTI kernels' sign-flip
 //! side tests need det_ok to exclude det = ±0). Columns are processed a vector at a time
 //! straight from the SoA inputs; a batch's last `n mod lanes` slots run the scalar model.
@@ -102,9 +103,10 @@ fn widest_here() -> Kernel {
     })
 }
 
-/// The kernels model this binary32 / binary16 format: IEEE subnormals and canonical NaN.
+/// The kernels model this binary32 / binary16 / bf16 format: the canonical NaN rule, IEEE
+/// subnormals or FTZ (flushed in the lanes).
 fn eligible<B: crate::format::IeeeBackend>(f: &Ieee<B>) -> bool {
-    f.opts.subnormals == Subnormals::Ieee && f.opts.nan == NanMode::Canonical
+    f.opts.nan == NanMode::Canonical
 }
 
 /// The widest kernel this machine has within this thread's cap and `useful` (the widest
@@ -124,13 +126,13 @@ pub const WIDEST_F16: Kernel = Kernel::Avx512Fp16;
 /// The kernel `rti_batch_f32` uses for this unit on this machine (and this thread's cap):
 /// IEEE subnormals or FTZ (flushed in the lanes), the canonical NaN rule.
 pub fn kernel_f32(rti: &Rti<Ieee<F32Native>>) -> Kernel {
-    best_kernel(rti.fmt.opts.nan == NanMode::Canonical && rti.det_thr >= 0.0, WIDEST_F32)
+    best_kernel(eligible(&rti.fmt) && rti.det_thr >= 0.0, WIDEST_F32)
 }
 
 /// The kernel `rti_batch_f16` uses for this unit on this machine (and this thread's cap):
 /// IEEE subnormals or FTZ (flushed in the lanes), the canonical NaN rule.
 pub fn kernel_f16(rti: &Rti<Ieee<F16Half>>) -> Kernel {
-    best_kernel(rti.fmt.opts.nan == NanMode::Canonical && rti.det_thr.to_f32() >= 0.0, WIDEST_F16)
+    best_kernel(eligible(&rti.fmt) && rti.det_thr.to_f32() >= 0.0, WIDEST_F16)
 }
 
 /// The signature of an RTI kernel: lanes `0..full` of every column.
@@ -488,8 +490,8 @@ slab_entry!(
     slab_ray_f16, Ieee<F16Half>, f16, SlabRay<f16>, One, slab_ray_kernel_f16, v8, v16, slab_f16, Some(kernels::v32h::slab_f16)
 );
 
-/// The kernel `slab_batch_bf16` uses for this unit on this machine (IEEE subnormals and the
-/// canonical NaN rule; every variant but the directed one).
+/// The kernel `slab_batch_bf16` uses for this unit on this machine (the canonical NaN rule;
+/// every variant but the directed one).
 pub fn slab_kernel_bf16(s: &Slab<Ieee<Bf16>>) -> Kernel {
     best_kernel(eligible(&s.fmt) && !s.cfg.directed, WIDEST_NARROW)
 }
@@ -2352,6 +2354,58 @@ mod kernels {
         }};
     }
 
+    /// [`slab_kernel!`] with the format's subnormal rule: as it is under IEEE subnormals; under
+    /// FTZ every operand read (columns and broadcast ray values) and every rounded result
+    /// flushed in the lanes (a lane below `$min`, the smallest normal, becomes zero of its
+    /// sign), and a grid step that lands strictly between 0 and `$min` goes on to `$min` (up
+    /// from ±0) or to −0 (up from −`$min`), the model's `next_up`. The model's comparators read a
+    /// t limit flushed but pass it on as it is, so a limit that is a nonzero subnormal encoding
+    /// (`$raw_sub`) sends its lane, or the whole one-ray batch, to the scalar model.
+    macro_rules! slab_ftz {
+        ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $bcast:expr, $min:expr, $raw_sub:expr) => {{
+            let (s, rays, boxes, out, full) = ($s, $rays, $boxes, $out, $full);
+            if s.fmt.opts.subnormals != Subnormals::Ftz {
+                slab_kernel!($x, s, rays, boxes, out, full, $load, $round, $store, $up, $bcast);
+            } else {
+                let raw_sub = $raw_sub;
+                if let SlabRays::One(r) = rays {
+                    if raw_sub(r.tmin) || raw_sub(r.tmax) {
+                        return s.batch_ray(r, boxes, out);
+                    }
+                }
+                let (load, round, up, bcast) = ($load, $round, $up, $bcast);
+                let (min, zero) = ($x::splat($min), $x::splat(0.0));
+                let flush = move |x| $x::blend(x, $x::sign(x), $x::lt($x::abs(x), min));
+                let up_ftz = move |v| {
+                    let r = up(v);
+                    let a = $x::abs(r);
+                    let tiny = $x::and_m($x::lt(zero, a), $x::lt(a, min));
+                    $x::blend(r, $x::blend(min, $x::splat(-0.0), $x::lt(v, zero)), tiny)
+                };
+                slab_kernel!(
+                    $x,
+                    s,
+                    rays,
+                    boxes,
+                    &mut *out,
+                    full,
+                    |c, i| flush(load(c, i)),
+                    |x| flush(round(x)),
+                    $store,
+                    up_ftz,
+                    |v| flush(bcast(v))
+                );
+                if let SlabRays::Pairs(r) = rays {
+                    for k in 0..full {
+                        if raw_sub(r.tmin[k]) || raw_sub(r.tmax[k]) {
+                            out.set(k, s.test(&r.get(k), &boxes.get(k)));
+                        }
+                    }
+                }
+            }
+        }};
+    }
+
     /// The lanes of `0..full` with a NaN output, again by the scalar model (the slab kernels'
     /// rare NaN path, kept out of their loops).
     ///
@@ -2405,19 +2459,19 @@ mod kernels {
         (@f32 $x:ident, $f32feat:literal) => {
             kernels_for!(@format $x, $f32feat, rti_f32, slab_f32, Ieee<F32Native>, f32, load32, store32,
                 |x| x, |v| $x::next_up(v), |x: f32| $x::splat(x), |r: &Rti<Ieee<F32Native>>| r.det_thr,
-                f32::MIN_POSITIVE);
+                f32::MIN_POSITIVE, |v: f32| v != 0.0 && v.abs() < f32::MIN_POSITIVE);
         };
         (@f16 $x:ident, $f16feat:literal) => {
             kernels_for!(@format $x, $f16feat, rti_f16, slab_f16, Ieee<F16Half>, f16, load16, store16,
                 |v| $x::round16(v), |v| $x::next_up16(v), |x: f16| $x::splat16(x),
-                |r: &Rti<Ieee<F16Half>>| r.det_thr.to_f32(), f16::MIN_POSITIVE.to_f32());
+                |r: &Rti<Ieee<F16Half>>| r.det_thr.to_f32(), f16::MIN_POSITIVE.to_f32(), |v: f16| v.to_bits() & 0x7c00 == 0 && v.to_bits() & 0x3ff != 0);
         };
         // one format's RTI and slab kernels: its column type, loads and stores, rounding, grid
         // step, ray broadcast, det threshold (as the lanes hold it), and smallest normal (the RTI
         // kernel under FTZ flushes every operand read and every rounded result in the lanes: a
         // lane below it becomes zero of its sign)
         (@format $x:ident, $feat:literal, $rti:ident, $slab:ident, $fmt:ty, $v:ty, $load:ident, $store:ident,
-         $round:expr, $up:expr, $bcast:expr, $thr:expr, $min_normal:expr) => {
+         $round:expr, $up:expr, $bcast:expr, $thr:expr, $min_normal:expr, $raw_sub:expr) => {
             #[target_feature(enable = $feat)]
             pub fn $rti(rti: &Rti<$fmt>, rays: &RaysSoa<$v>, tris: &TrisSoa<$v>, out: &mut HitsSoa<$v>, full: usize) {
                 // SAFETY (loads and stores): the caller checked that every column holds
@@ -2455,7 +2509,7 @@ mod kernels {
             #[target_feature(enable = $feat)]
             pub fn $slab(s: &Slab<$fmt>, rays: SlabRays<$v>, boxes: &BoxesSoa<$v>, out: &mut SlabOutSoa<$v>, full: usize) {
                 // SAFETY (loads and stores): as above.
-                slab_kernel!(
+                slab_ftz!(
                     $x,
                     s,
                     rays,
@@ -2466,7 +2520,9 @@ mod kernels {
                     $round,
                     |c: *mut $v, i: usize, x| unsafe { $x::$store(c, i, x) },
                     $up,
-                    $bcast
+                    $bcast,
+                    $min_normal,
+                    $raw_sub
                 );
             }
         };
@@ -2569,34 +2625,23 @@ mod kernels {
                 ) {
                     let n: &Narrow = &super::super::narrow_of(&s.fmt).expect("the dispatch checked the format");
                     let f = s.fmt;
-                    let raw_sub = |v: u64| n.ftz && n.lay.is_subnormal(v);
-                    if let SlabRays::One(r) = rays {
-                        if raw_sub(r.tmin) || raw_sub(r.tmax) {
-                            return s.batch_ray(r, boxes, out);
-                        }
-                    }
                     // SAFETY (loads and stores): the caller checked that every column holds
                     // `full` lanes.
-                    slab_kernel!(
+                    slab_ftz!(
                         $x,
                         s,
                         rays,
                         boxes,
-                        &mut *out,
+                        out,
                         full,
-                        |c: *const u64, i: usize| $x::flush(unsafe { $x::load_soft(c, i, n) }, n),
+                        |c: *const u64, i: usize| unsafe { $x::load_soft(c, i, n) },
                         |x| $x::round_full(x, n),
                         |c: *mut u64, i: usize, x| unsafe { $x::store_soft(c, i, x, n) },
                         |v| $x::next_up_soft(v, n),
-                        |v: u64| $x::flush($x::splat(f.to_f64(v)), n)
+                        |v: u64| $x::splat(f.to_f64(v)),
+                        n.min_normal,
+                        |v: u64| n.lay.is_subnormal(v)
                     );
-                    if let (SlabRays::Pairs(r), true) = (rays, n.ftz) {
-                        for k in 0..full {
-                            if raw_sub(r.tmin[k]) || raw_sub(r.tmax[k]) {
-                                out.set(k, s.test(&r.get(k), &boxes.get(k)));
-                            }
-                        }
-                    }
                 }
 
                 /// One operation of an `eEmM` format on lanes `0..full`: `out[i] = a[i] op b[i]`,
@@ -2671,7 +2716,7 @@ mod kernels {
                     );
                 }
 
-                /// The bf16 slab kernel on lanes `0..full` (IEEE subnormals: the dispatch checks).
+                /// The bf16 slab kernel on lanes `0..full`, IEEE subnormals or FTZ ([`slab_ftz!`]).
                 #[target_feature(enable = $feat)]
                 pub fn slab_bf16(
                     s: &Slab<Ieee<Bf16>>,
@@ -2682,7 +2727,7 @@ mod kernels {
                 ) {
                     // SAFETY (loads and stores): the caller checked that every column holds
                     // `full` lanes; the column types are plain values.
-                    slab_kernel!(
+                    slab_ftz!(
                         $x,
                         s,
                         rays,
@@ -2693,7 +2738,9 @@ mod kernels {
                         |x| $x::round_bf16(x),
                         |c: *mut u16, i: usize, x| unsafe { $x::store_bf16(c, i, x) },
                         |v| $x::next_up_bf16(v),
-                        |x: u16| $x::splat(f32::from_bits((x as u32) << 16))
+                        |x: u16| $x::splat(f32::from_bits((x as u32) << 16)),
+                        f32::MIN_POSITIVE,
+                        |v: u16| v & 0x7f80 == 0 && v & 0x7f != 0
                     );
                 }
             }
