@@ -6,6 +6,7 @@
 
 pub mod bvh;
 pub mod explain;
+pub mod faults;
 pub mod judge;
 pub mod plan;
 pub mod render;

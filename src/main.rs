@@ -287,6 +287,38 @@ enum Cmd {
         #[command(flatten)]
         rti: RtiArgs,
     },
+    /// Run the fault bank against a vector set: which hardware bugs the set detects.
+    Faults {
+        /// Unit (units with a fault bank: rti).
+        #[arg(long, default_value = "rti")]
+        unit: String,
+        /// Number format of the generated set (default f32).
+        #[arg(long, value_parser = parse_format)]
+        format: Option<AnyFormat>,
+        /// Coverage level of the generated set: 1 or 2.
+        #[arg(long, default_value_t = 1)]
+        level: u32,
+        /// Vectors per coverage class of the generated set.
+        #[arg(long, default_value_t = 64)]
+        count: u64,
+        /// Seed of the generated set.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Compare only the outputs (valid, hit, t, u, v), as for a DUT without probe ports.
+        #[arg(long)]
+        outputs_only: bool,
+        /// Run on the set in this directory instead of generating one (its unit, format and options).
+        #[arg(long, conflicts_with_all = ["format", "level", "count", "seed"])]
+        set: Option<PathBuf>,
+        /// Print the campaign as JSON.
+        #[arg(long)]
+        json: bool,
+        /// Worker threads for generating the set (the result does not depend on it).
+        #[arg(long)]
+        threads: Option<usize>,
+        #[command(flatten)]
+        rti: RtiArgs,
+    },
     /// What a scene needs: tree depth and history bits, culling, and the narrowest format within an error budget.
     Plan {
         /// OBJ scene (default: the built-in scene).
@@ -689,6 +721,32 @@ fn run() -> Result<Outcome, String> {
                 m.seed
             );
             Ok(Outcome::Pass)
+        }
+        Some(Cmd::Faults { unit, format, level, count, seed, outputs_only, set, json, threads, rti }) => {
+            let c = match set {
+                Some(dir) => raypipe::faults::on_dir(&dir, outputs_only)?,
+                None => {
+                    limit("--count", count, MAX_VECTOR_COUNT, "a set is built in memory")?;
+                    let unit: vectors::gen::Unit = unit.parse()?;
+                    let req = vectors::gen::Request {
+                        unit,
+                        tree: None,
+                        leaves: 8,
+                        max_levels: 64,
+                        threads: threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+                        format: format.unwrap_or_else(|| "f32".parse().expect("built-in format name")),
+                        count: count as usize,
+                        seed,
+                        level,
+                        command: command_without_threads(),
+                        rti: rti.config()?,
+                        slab_variant: "plain".into(),
+                    };
+                    raypipe::faults::on_request(&req, outputs_only)?
+                }
+            };
+            emit(json, &c, raypipe::faults::render)?;
+            Ok(Outcome::from(c.complete()))
         }
         Some(Cmd::Plan { scene, format, pipelines, budget, rays, seed, levels, json }) => {
             let scene = load_scene(scene.as_deref())?;

@@ -6,6 +6,7 @@
 pub mod alloc;
 pub mod bound;
 pub mod bvh;
+pub mod fault;
 pub mod fixed_lanes;
 pub mod format;
 pub mod lanes;

@@ -11,6 +11,7 @@
 //! Every operation is the format's rounded op; nothing is fused; dot products add as
 //! `(x + y) + z`; comparisons are the format's IEEE ordered compares (NaN → false, −0 == +0).
 
+use crate::fault::{Cmp, Fault, NoFault};
 use crate::format::{DivMode, Format};
 use crate::probe::{NoProbe, Probe};
 use crate::{record, record_flags};
@@ -280,96 +281,115 @@ impl<F: Format> Rti<F> {
     /// Runs one ray–triangle test through every stage, reporting each signal to the probe.
     #[inline(always)]
     pub fn trace<P: Probe<F::V>>(&self, ray: &Ray<F::V>, tri: &Tri<F::V>, p: &mut P) -> RtiOut<F::V> {
+        self.trace_faulty(ray, tri, p, &NoFault)
+    }
+
+    /// [`Rti::trace`] with every arithmetic and compare site computed by `x` (a hardware
+    /// fault; [`NoFault`] is the datapath itself). Sites are the signal names below.
+    #[inline(always)]
+    pub fn trace_faulty<P: Probe<F::V>, X: Fault<F>>(
+        &self,
+        ray: &Ray<F::V>,
+        tri: &Tri<F::V>,
+        p: &mut P,
+        x: &X,
+    ) -> RtiOut<F::V> {
         let f = &self.fmt;
+        let sub = |s, a, b| x.arith(f, s, Op::Sub, a, b);
+        let add = |s, a, b| x.arith(f, s, Op::Add, a, b);
+        let mul = |s, a, b| x.arith(f, s, Op::Mul, a, b);
+        let div = |s, a, b| x.arith(f, s, Op::Div, a, b);
+        let lt = |s, a, b| x.compare(f, s, Cmp::Lt, a, b);
+        let le = |s, a, b| x.compare(f, s, Cmp::Le, a, b);
         let [ox, oy, oz] = ray.o;
         let [dx, dy, dz] = ray.d;
         let [[v0x, v0y, v0z], [v1x, v1y, v1z], [v2x, v2y, v2z]] = tri.v;
         // stage 1
-        let e1x = f.sub(v1x, v0x);
-        let e1y = f.sub(v1y, v0y);
-        let e1z = f.sub(v1z, v0z);
-        let e2x = f.sub(v2x, v0x);
-        let e2y = f.sub(v2y, v0y);
-        let e2z = f.sub(v2z, v0z);
-        let sx = f.sub(ox, v0x);
-        let sy = f.sub(oy, v0y);
-        let sz = f.sub(oz, v0z);
+        let e1x = sub("e1x", v1x, v0x);
+        let e1y = sub("e1y", v1y, v0y);
+        let e1z = sub("e1z", v1z, v0z);
+        let e2x = sub("e2x", v2x, v0x);
+        let e2y = sub("e2y", v2y, v0y);
+        let e2z = sub("e2z", v2z, v0z);
+        let sx = sub("sx", ox, v0x);
+        let sy = sub("sy", oy, v0y);
+        let sz = sub("sz", oz, v0z);
         record!(p; e1x, e1y, e1z, e2x, e2y, e2z, sx, sy, sz);
         // stage 2
-        let pxa = f.mul(dy, e2z);
-        let pxb = f.mul(dz, e2y);
-        let pya = f.mul(dz, e2x);
-        let pyb = f.mul(dx, e2z);
-        let pza = f.mul(dx, e2y);
-        let pzb = f.mul(dy, e2x);
-        let qxa = f.mul(sy, e1z);
-        let qxb = f.mul(sz, e1y);
-        let qya = f.mul(sz, e1x);
-        let qyb = f.mul(sx, e1z);
-        let qza = f.mul(sx, e1y);
-        let qzb = f.mul(sy, e1x);
+        let pxa = mul("pxa", dy, e2z);
+        let pxb = mul("pxb", dz, e2y);
+        let pya = mul("pya", dz, e2x);
+        let pyb = mul("pyb", dx, e2z);
+        let pza = mul("pza", dx, e2y);
+        let pzb = mul("pzb", dy, e2x);
+        let qxa = mul("qxa", sy, e1z);
+        let qxb = mul("qxb", sz, e1y);
+        let qya = mul("qya", sz, e1x);
+        let qyb = mul("qyb", sx, e1z);
+        let qza = mul("qza", sx, e1y);
+        let qzb = mul("qzb", sy, e1x);
         record!(p; pxa, pxb, pya, pyb, pza, pzb, qxa, qxb, qya, qyb, qza, qzb);
         // stage 3
-        let px = f.sub(pxa, pxb);
-        let py = f.sub(pya, pyb);
-        let pz = f.sub(pza, pzb);
-        let qx = f.sub(qxa, qxb);
-        let qy = f.sub(qya, qyb);
-        let qz = f.sub(qza, qzb);
+        let px = sub("px", pxa, pxb);
+        let py = sub("py", pya, pyb);
+        let pz = sub("pz", pza, pzb);
+        let qx = sub("qx", qxa, qxb);
+        let qy = sub("qy", qya, qyb);
+        let qz = sub("qz", qza, qzb);
         record!(p; px, py, pz, qx, qy, qz);
         // stage 4
-        let detx = f.mul(e1x, px);
-        let dety = f.mul(e1y, py);
-        let detz = f.mul(e1z, pz);
-        let upx = f.mul(sx, px);
-        let upy = f.mul(sy, py);
-        let upz = f.mul(sz, pz);
-        let vpx = f.mul(dx, qx);
-        let vpy = f.mul(dy, qy);
-        let vpz = f.mul(dz, qz);
-        let tpx = f.mul(e2x, qx);
-        let tpy = f.mul(e2y, qy);
-        let tpz = f.mul(e2z, qz);
+        let detx = mul("detx", e1x, px);
+        let dety = mul("dety", e1y, py);
+        let detz = mul("detz", e1z, pz);
+        let upx = mul("upx", sx, px);
+        let upy = mul("upy", sy, py);
+        let upz = mul("upz", sz, pz);
+        let vpx = mul("vpx", dx, qx);
+        let vpy = mul("vpy", dy, qy);
+        let vpz = mul("vpz", dz, qz);
+        let tpx = mul("tpx", e2x, qx);
+        let tpy = mul("tpy", e2y, qy);
+        let tpz = mul("tpz", e2z, qz);
         record!(p; detx, dety, detz, upx, upy, upz, vpx, vpy, vpz, tpx, tpy, tpz);
         // stage 5
-        let det_xy = f.add(detx, dety);
-        let up_xy = f.add(upx, upy);
-        let vp_xy = f.add(vpx, vpy);
-        let tp_xy = f.add(tpx, tpy);
+        let det_xy = add("det_xy", detx, dety);
+        let up_xy = add("up_xy", upx, upy);
+        let vp_xy = add("vp_xy", vpx, vpy);
+        let tp_xy = add("tp_xy", tpx, tpy);
         record!(p; det_xy, up_xy, vp_xy, tp_xy);
         // stage 6
-        let det = f.add(det_xy, detz);
-        let up = f.add(up_xy, upz);
-        let vp = f.add(vp_xy, vpz);
-        let tp = f.add(tp_xy, tpz);
+        let det = add("det", det_xy, detz);
+        let up = add("up", up_xy, upz);
+        let vp = add("vp", vp_xy, vpz);
+        let tp = add("tp", tp_xy, tpz);
         record!(p; det, up, vp, tp);
         // stage 7: validity without division
-        let uv = f.add(up, vp);
+        let uv = add("uv", up, vp);
         record!(p; uv);
         let zero = f.zero();
         let det_ok = match self.cull {
-            Cull::TwoSided => f.lt(self.det_thr, f.abs(det)),
-            Cull::Backface => f.lt(self.det_thr, det),
+            Cull::TwoSided => lt("det_ok", self.det_thr, f.abs(det)),
+            Cull::Backface => lt("det_ok", self.det_thr, det),
         };
-        let pos = f.lt(zero, det);
-        let u_ok = if pos { f.le(zero, up) } else { f.le(up, zero) };
-        let v_ok = if pos { f.le(zero, vp) } else { f.le(vp, zero) };
-        let uv_ok = if pos { f.le(uv, det) } else { f.le(det, uv) };
-        let t_ok = if pos { f.le(zero, tp) } else { f.le(tp, zero) };
+        let pos = lt("pos", zero, det);
+        let u_ok = if pos { le("u_ok", zero, up) } else { le("u_ok", up, zero) };
+        let v_ok = if pos { le("v_ok", zero, vp) } else { le("v_ok", vp, zero) };
+        let uv_ok = if pos { le("uv_ok", uv, det) } else { le("uv_ok", det, uv) };
+        let t_ok = if pos { le("t_ok", zero, tp) } else { le("t_ok", tp, zero) };
         let valid = det_ok & u_ok & v_ok & uv_ok & t_ok;
         record_flags!(p; det_ok, u_ok, v_ok, uv_ok, t_ok, valid);
         // stages 8-9 (8-10): the divide last
         let (t, u, v) = match f.div_mode() {
             DivMode::RecipMul => {
-                let inv_det = f.div(f.one(), det);
+                let inv_det = div("inv_det", f.one(), det);
                 record!(p; inv_det);
-                (f.mul(tp, inv_det), f.mul(up, inv_det), f.mul(vp, inv_det))
+                (mul("t", tp, inv_det), mul("u", up, inv_det), mul("v", vp, inv_det))
             }
-            DivMode::Divide => (f.div(tp, det), f.div(up, det), f.div(vp, det)),
+            DivMode::Divide => (div("t", tp, det), div("u", up, det), div("v", vp, det)),
         };
         record!(p; t, u, v);
-        let tmin_ok = f.le(ray.tmin, t);
-        let tmax_ok = f.le(t, ray.tmax);
+        let tmin_ok = le("tmin_ok", ray.tmin, t);
+        let tmax_ok = le("tmax_ok", t, ray.tmax);
         let hit = valid & tmin_ok & tmax_ok;
         record_flags!(p; tmin_ok, tmax_ok, hit);
         RtiOut { valid, hit, t, u, v }
@@ -385,13 +405,19 @@ impl<F: Format> Rti<F> {
     /// held hit (`t < best` under [`TieRule::First`], `t <= best` under [`TieRule::Last`]).
     #[inline(always)]
     pub fn capture(&self, c: &mut Capture<F::V>, out: &RtiOut<F::V>, id: u32) {
+        self.capture_faulty(c, out, id, &NoFault)
+    }
+
+    /// [`Rti::capture`] with its compare site `take` computed by `x`.
+    #[inline(always)]
+    pub fn capture_faulty<X: Fault<F>>(&self, c: &mut Capture<F::V>, out: &RtiOut<F::V>, id: u32, x: &X) {
         if !out.hit {
             return;
         }
         let take = !c.hit
             || match self.tie {
-                TieRule::First => self.fmt.lt(out.t, c.t),
-                TieRule::Last => self.fmt.le(out.t, c.t),
+                TieRule::First => x.compare(&self.fmt, "take", Cmp::Lt, out.t, c.t),
+                TieRule::Last => x.compare(&self.fmt, "take", Cmp::Le, out.t, c.t),
             };
         if take {
             *c = Capture { hit: true, t: out.t, u: out.u, v: out.v, id };

@@ -1005,36 +1005,53 @@ pub fn write_set(set: &VectorSet, dir: &Path) -> Result<PathBuf, String> {
 pub use crate::check::check_set;
 
 /// Reads every data file the manifest lists, checking its hash, digit count and row count.
-pub(crate) fn read_files(dir: &Path, m: &Manifest) -> Result<Vec<Vec<Vec<u64>>>, String> {
+pub fn read_files(dir: &Path, m: &Manifest) -> Result<Vec<Vec<Vec<u64>>>, String> {
     let mut contents = Vec::new();
     for fm in &m.files {
         let c = std::fs::read_to_string(dir.join(&fm.name)).map_err(|e| format!("{}: {e}", fm.name))?;
         if sha256_hex(c.as_bytes()) != fm.sha256 {
             return Err(format!("{}: sha256 differs from the manifest", fm.name));
         }
-        let rows: Vec<Vec<u64>> = c
-            .lines()
-            .enumerate()
-            .map(|(i, l)| {
-                if l.len() != fm.digits as usize {
-                    return Err(format!(
-                        "{} line {}: {} hex digits, the manifest says {}",
-                        fm.name,
-                        i + 1,
-                        l.len(),
-                        fm.digits
-                    ));
-                }
-                unpack(l, &fm.fields.iter().map(|x| x.width).collect::<Vec<_>>())
-                    .map_err(|e| format!("{} line {}: {e}", fm.name, i + 1))
-            })
-            .collect::<Result<_, _>>()?;
-        if rows.len() != fm.rows {
-            return Err(format!("{}: {} rows, manifest says {}", fm.name, rows.len(), fm.rows));
-        }
-        contents.push(rows);
+        contents.push(parse_rows(fm, &c)?);
     }
     Ok(contents)
+}
+
+/// The rows of a generated set's files (in the manifest's order), unpacked into fields.
+pub fn set_rows(set: &VectorSet) -> Result<Vec<Vec<Vec<u64>>>, String> {
+    set.manifest
+        .files
+        .iter()
+        .map(|fm| {
+            let text = set.files.iter().find(|(n, _)| *n == fm.name).map(|(_, t)| t.as_str());
+            parse_rows(fm, text.ok_or(format!("{}: not in the set", fm.name))?)
+        })
+        .collect()
+}
+
+/// One file's rows, each unpacked into its fields (widths from the manifest).
+fn parse_rows(fm: &crate::manifest::File, c: &str) -> Result<Vec<Vec<u64>>, String> {
+    let rows: Vec<Vec<u64>> = c
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if l.len() != fm.digits as usize {
+                return Err(format!(
+                    "{} line {}: {} hex digits, the manifest says {}",
+                    fm.name,
+                    i + 1,
+                    l.len(),
+                    fm.digits
+                ));
+            }
+            unpack(l, &fm.fields.iter().map(|x| x.width).collect::<Vec<_>>())
+                .map_err(|e| format!("{} line {}: {e}", fm.name, i + 1))
+        })
+        .collect::<Result<_, _>>()?;
+    if rows.len() != fm.rows {
+        return Err(format!("{}: {} rows, manifest says {}", fm.name, rows.len(), fm.rows));
+    }
+    Ok(rows)
 }
 
 /// Re-runs the model on every input row and compares every expected and stage row bit for
@@ -1159,7 +1176,8 @@ fn check_traverse<F: Format>(f: F, m: &Manifest, contents: &[Vec<Vec<u64>>]) -> 
     Ok(want.len())
 }
 
-fn rti_config_from(m: &Manifest) -> Result<RtiConfig, String> {
+/// The RTI options a manifest records.
+pub fn rti_config_from(m: &Manifest) -> Result<RtiConfig, String> {
     use datapath::rti::{Cull, TieRule};
     let cull = match m.options.get("cull").map(String::as_str) {
         Some("Backface") => Cull::Backface,

@@ -1,0 +1,70 @@
+//! Fault injection: a hardware bug as a change to what one named site of a stage model
+//! computes. A model calls its fault at every arithmetic site (the stage table's signal names:
+//! `e1x`, `pxa`, `det_xy`, `inv_det`, `t`, …) and every compare site (`det_ok`, `pos`, `u_ok`,
+//! `v_ok`, `uv_ok`, `t_ok`, `tmin_ok`, `tmax_ok`, and the min-capture unit's `take`); with
+//! [`NoFault`] (`ON == false`) each call is the format's own operation and the model's code
+//! is what it was without the hook. The fault models themselves (which site, which bug) live
+//! in the `faults` crate.
+
+use crate::rti::Op;
+use crate::Format;
+
+/// The comparison a compare site makes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cmp {
+    /// a < b (false when either is NaN).
+    Lt,
+    /// a <= b (false when either is NaN).
+    Le,
+}
+
+impl Cmp {
+    /// `a self b` in format `f` (the operands read as the format reads them).
+    #[inline(always)]
+    pub fn eval<F: Format>(self, f: &F, a: F::V, b: F::V) -> bool {
+        match self {
+            Cmp::Lt => f.lt(a, b),
+            Cmp::Le => f.le(a, b),
+        }
+    }
+}
+
+/// `a op b` in format `f`, as the fault-free datapath computes it (`Op::Logic` is no
+/// arithmetic: it gives `a`).
+#[inline(always)]
+pub fn fault_free<F: Format>(f: &F, op: Op, a: F::V, b: F::V) -> F::V {
+    match op {
+        Op::Sub => f.sub(a, b),
+        Op::Add => f.add(a, b),
+        Op::Mul => f.mul(a, b),
+        Op::Div => f.div(a, b),
+        Op::Logic => a,
+    }
+}
+
+/// What a model's sites compute: the fault-free datapath, or one with a bug.
+pub trait Fault<F: Format> {
+    /// False for [`NoFault`].
+    const ON: bool;
+    /// The value arithmetic site `site` produces from its operands (`op` names the
+    /// fault-free operation, [`fault_free`]).
+    fn arith(&self, f: &F, site: &'static str, op: Op, a: F::V, b: F::V) -> F::V;
+    /// The bit compare site `site` produces (fault-free: `cmp.eval(f, a, b)`).
+    fn compare(&self, f: &F, site: &'static str, cmp: Cmp, a: F::V, b: F::V) -> bool;
+}
+
+/// The fault-free datapath: every site is the format's own operation.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoFault;
+
+impl<F: Format> Fault<F> for NoFault {
+    const ON: bool = false;
+    #[inline(always)]
+    fn arith(&self, f: &F, _: &'static str, op: Op, a: F::V, b: F::V) -> F::V {
+        fault_free(f, op, a, b)
+    }
+    #[inline(always)]
+    fn compare(&self, f: &F, _: &'static str, cmp: Cmp, a: F::V, b: F::V) -> bool {
+        cmp.eval(f, a, b)
+    }
+}

@@ -1,0 +1,194 @@
+//! A fault campaign: every fault of the bank for a unit, injected into the stage model, run on
+//! every input row of a vector set; a fault is detected when some vector's outputs (valid,
+//! hit, t, u, v), or with probes any stage signal, differ from the set's expected rows. The set
+//! must first match the fault-free model (else the campaign would measure another model).
+
+use crate::bank::{Spec, BANK};
+use crate::inject::Injected;
+use datapath::fault::NoFault;
+use datapath::probe::{Recorder, Signal};
+use datapath::rti::{Ray, Rti, RtiOut, Tri};
+use datapath::{with_format, AnyFormat, Format};
+use serde::Serialize;
+use vectors::manifest::Manifest;
+
+/// What the campaign found for one fault.
+#[derive(Clone, Debug, Serialize)]
+pub struct Outcome {
+    /// The fault's name.
+    pub name: &'static str,
+    /// The site it changes.
+    pub site: &'static str,
+    /// The RTL bug it stands for.
+    pub what: &'static str,
+    /// Its outputs equal the fault-free unit's on every input (the argument is in the bank).
+    pub benign: bool,
+    /// The fault applies: its site exists in this unit's configuration and the fault is
+    /// modelled in this format.
+    pub applicable: bool,
+    /// Why not, when it does not apply.
+    pub not_applicable: Option<String>,
+    /// Some vector detects it.
+    pub detected: bool,
+    /// How many vectors detect it.
+    pub vectors: usize,
+    /// The first detecting vector (0-based input row).
+    pub first_vector: Option<usize>,
+    /// Every detecting vector (0-based input rows, ascending).
+    pub catching: Vec<usize>,
+    /// That vector's coverage class.
+    pub first_class: Option<String>,
+    /// How many vectors of each class detect it (classes in the manifest's order).
+    pub by_class: Vec<(String, usize)>,
+}
+
+/// A whole campaign.
+#[derive(Clone, Debug, Serialize)]
+pub struct Campaign {
+    /// Unit.
+    pub unit: String,
+    /// Format.
+    pub format: String,
+    /// The set's seed, level and command (from its manifest).
+    pub set_seed: u64,
+    /// The set's coverage level.
+    pub set_level: u32,
+    /// The command that wrote the set.
+    pub set_command: String,
+    /// Vectors run.
+    pub vectors: usize,
+    /// Only the outputs compared (a DUT without probe ports).
+    pub outputs_only: bool,
+    /// One outcome per fault of the unit's bank.
+    pub faults: Vec<Outcome>,
+    /// Applicable non-benign faults detected.
+    pub detected: usize,
+    /// Applicable non-benign faults no vector detects.
+    pub escaped: usize,
+}
+
+impl Campaign {
+    /// Every applicable non-benign fault is detected.
+    pub fn complete(&self) -> bool {
+        self.escaped == 0
+    }
+}
+
+/// The units with fault models.
+pub const UNITS: [&str; 1] = ["rti"];
+
+/// Runs the bank of the set's unit over the set (`rows`: its files' rows in manifest order).
+pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<Campaign, String> {
+    if !UNITS.contains(&m.unit.as_str()) {
+        return Err(format!("unit {} has no fault models yet (units with a bank: {})", m.unit, UNITS.join(", ")));
+    }
+    let any: AnyFormat = m.format.parse().map_err(|e| format!("manifest.json: field format: {e}"))?;
+    let cfg = vectors::gen::rti_config_from(m)?;
+    let bank: Vec<&Spec> = BANK.iter().filter(|s| s.unit == m.unit).collect();
+    let (inputs, expected, stages) = match rows {
+        [i, e, s, ..] => (i, e, s),
+        _ => return Err("the set has no input, expected and stage files".into()),
+    };
+    let class_name = |id: u64| m.classes.iter().find(|c| c.id as u64 == id).map_or(format!("{id}"), |c| c.name.clone());
+    let mut outcomes: Vec<Outcome> = bank
+        .iter()
+        .map(|s| Outcome {
+            name: s.name,
+            site: s.site,
+            what: s.what,
+            benign: s.benign.is_some(),
+            applicable: true,
+            not_applicable: None,
+            detected: false,
+            vectors: 0,
+            first_vector: None,
+            catching: Vec::new(),
+            first_class: None,
+            by_class: m.classes.iter().map(|c| (c.name.clone(), 0)).collect(),
+        })
+        .collect();
+    with_format!(any, |f| {
+        let rti = Rti::new(f, cfg);
+        let injected: Vec<Injected> = bank.iter().map(|s| Injected::new(s)).collect();
+        for (i, input) in inputs.iter().enumerate() {
+            let (class, bits) = (input[0], &input[1..]);
+            let v = |k: usize| f.from_bits(bits[k]);
+            let ray = Ray { o: [v(0), v(1), v(2)], d: [v(3), v(4), v(5)], tmin: v(6), tmax: v(7) };
+            let tri = Tri { v: [[v(8), v(9), v(10)], [v(11), v(12), v(13)], [v(14), v(15), v(16)]] };
+            // the set is the fault-free model's
+            let (out, probes) = run_one(&rti, &ray, &tri, &NoFault);
+            if outputs(&f, &out) != expected[i] || probes != stages[i] {
+                return Err(format!(
+                    "vector {} (input row {}): the set's expected rows differ from this raypipe's model; check the set with `raypipe vectors --check`",
+                    i,
+                    i + 1
+                ));
+            }
+            for (x, o) in injected.iter().zip(outcomes.iter_mut()) {
+                x.next_test();
+                let (fo, fp) = run_one(&rti, &ray, &tri, x);
+                if outputs(&f, &fo) != expected[i] || (!outputs_only && fp != stages[i]) {
+                    o.vectors += 1;
+                    o.catching.push(i);
+                    if o.first_vector.is_none() {
+                        o.first_vector = Some(i);
+                        o.first_class = Some(class_name(class));
+                    }
+                    if let Some(c) = m.classes.iter().position(|c| c.id as u64 == class) {
+                        o.by_class[c].1 += 1;
+                    }
+                }
+            }
+        }
+        for (x, o) in injected.iter().zip(outcomes.iter_mut()) {
+            o.detected = o.vectors > 0;
+            if !x.reached() {
+                o.applicable = false;
+                o.not_applicable = Some("the site is not in this configuration's datapath".into());
+            } else if x.unmodelled() {
+                o.applicable = false;
+                o.not_applicable = Some(format!("not modelled in {}", m.format));
+            }
+        }
+        Ok::<(), String>(())
+    })?;
+    let counted = |o: &&Outcome| o.applicable && !o.benign;
+    Ok(Campaign {
+        unit: m.unit.clone(),
+        format: m.format.clone(),
+        set_seed: m.seed,
+        set_level: m.level,
+        set_command: m.command.clone(),
+        vectors: inputs.len(),
+        outputs_only,
+        detected: outcomes.iter().filter(counted).filter(|o| o.detected).count(),
+        escaped: outcomes.iter().filter(counted).filter(|o| !o.detected).count(),
+        faults: outcomes,
+    })
+}
+
+/// One test with probes: the outputs and every stage signal as the set encodes them.
+fn run_one<F: Format, X: datapath::fault::Fault<F>>(
+    rti: &Rti<F>,
+    ray: &Ray<F::V>,
+    tri: &Tri<F::V>,
+    x: &X,
+) -> (RtiOut<F::V>, Vec<u64>) {
+    let mut rec = Recorder::new();
+    let out = rti.trace_faulty(ray, tri, &mut rec, x);
+    let f = &rti.fmt;
+    let probes = rec
+        .signals
+        .iter()
+        .map(|(_, s)| match s {
+            Signal::Value(v) => f.to_bits(*v),
+            Signal::Flag(b) => *b as u64,
+        })
+        .collect();
+    (out, probes)
+}
+
+/// The expected-row fields of one output: valid, hit, t, u, v.
+fn outputs<F: Format>(f: &F, o: &RtiOut<F::V>) -> Vec<u64> {
+    vec![o.valid as u64, o.hit as u64, f.to_bits(o.t), f.to_bits(o.u), f.to_bits(o.v)]
+}

@@ -1,0 +1,151 @@
+//! A bank fault as a [`Fault`] the stage models run with: every site computes what the
+//! fault-free datapath computes, except the fault's site, which computes the bug. Other
+//! rounding modes and the fused multiply-add are exact (`rustc_apfloat`) for binary32,
+//! binary16 and bfloat16 with either subnormal mode and the canonical NaN rule; in other
+//! formats such a fault is not modelled (and a campaign says so).
+
+use crate::bank::{Kind, Mode, Spec};
+use datapath::fault::{fault_free, Cmp, Fault};
+use datapath::format::FormatKind;
+use datapath::rti::Op;
+use datapath::Format;
+use rustc_apfloat::ieee::{BFloat, Half, Single};
+use rustc_apfloat::{Float, Round};
+use std::cell::{Cell, RefCell};
+
+/// One bank fault, injected; remembers whether its site was reached and could be modelled.
+#[derive(Debug)]
+pub struct Injected {
+    spec: Spec,
+    /// The operands (as encodings) of every arithmetic site of the current test, in order.
+    operands: RefCell<Vec<(&'static str, u64, u64)>>,
+    reached: Cell<bool>,
+    unmodelled: Cell<bool>,
+}
+
+impl Injected {
+    /// `spec`, ready to inject.
+    pub fn new(spec: &Spec) -> Self {
+        Self {
+            spec: *spec,
+            operands: RefCell::new(Vec::new()),
+            reached: Cell::new(false),
+            unmodelled: Cell::new(false),
+        }
+    }
+    /// Forgets the current test's operands (call before each test).
+    pub fn next_test(&self) {
+        self.operands.borrow_mut().clear();
+    }
+    /// The fault's site was computed at least once.
+    pub fn reached(&self) -> bool {
+        self.reached.get()
+    }
+    /// The fault could not be modelled in this format (its site then computed the fault-free
+    /// value).
+    pub fn unmodelled(&self) -> bool {
+        self.unmodelled.get()
+    }
+    fn hit<T>(&self, fallback: T, v: Option<T>) -> T {
+        v.unwrap_or_else(|| {
+            self.unmodelled.set(true);
+            fallback
+        })
+    }
+}
+
+impl<F: Format> Fault<F> for Injected {
+    const ON: bool = true;
+    fn arith(&self, f: &F, site: &'static str, op: Op, a: F::V, b: F::V) -> F::V {
+        self.operands.borrow_mut().push((site, f.to_bits(a), f.to_bits(b)));
+        let r = fault_free(f, op, a, b);
+        if site != self.spec.site {
+            return r;
+        }
+        self.reached.set(true);
+        match self.spec.kind {
+            Kind::Swap => fault_free(f, op, b, a),
+            Kind::FirstTwice => fault_free(f, op, a, a),
+            Kind::Round(m) => self.hit(r, exact(f, op, a, b, None, m)),
+            Kind::Fused { product, first } => {
+                let p = self.operands.borrow().iter().rev().find(|(s, _, _)| *s == product).map(|&(_, x, y)| (x, y));
+                let addend = if first { b } else { a };
+                let v = p.and_then(|(x, y)| exact(f, Op::Mul, f.from_bits(x), f.from_bits(y), Some(addend), None));
+                self.hit(r, v)
+            }
+            Kind::Flush => match f.kind() {
+                FormatKind::Float(l) if l.is_subnormal(f.to_bits(r)) => f.from_bits(f.to_bits(r) & l.sign_mask()),
+                FormatKind::Float(_) => r,
+                _ => self.hit(r, None),
+            },
+            Kind::Strict | Kind::Loose | Kind::Stuck(_) => r,
+        }
+    }
+    fn compare(&self, f: &F, site: &'static str, cmp: Cmp, a: F::V, b: F::V) -> bool {
+        let r = cmp.eval(f, a, b);
+        if site != self.spec.site {
+            return r;
+        }
+        self.reached.set(true);
+        match self.spec.kind {
+            Kind::Strict => f.lt(a, b),
+            Kind::Loose => f.le(a, b),
+            Kind::Stuck(v) => v,
+            _ => r,
+        }
+    }
+}
+
+/// `a op b` rounded in `mode` (or, with `c`, the fused a × b + c rounded to nearest-even),
+/// with the format's operand read, FTZ and canonical NaN rules; `None` where the format has no
+/// exact model here (not binary32 / binary16 / bfloat16, or the propagate NaN rule).
+fn exact<F: Format>(f: &F, op: Op, a: F::V, b: F::V, c: Option<F::V>, mode: impl Into<Option<Mode>>) -> Option<F::V> {
+    let FormatKind::Float(l) = f.kind() else { return None };
+    if f.nan_propagates() {
+        return None;
+    }
+    let read = |v: F::V| {
+        let x = f.to_bits(v);
+        if f.flushes() && l.is_subnormal(x) {
+            x & l.sign_mask()
+        } else {
+            x
+        }
+    };
+    let round = match mode.into() {
+        None => Round::NearestTiesToEven,
+        Some(Mode::TowardZero) => Round::TowardZero,
+        Some(Mode::TowardPositive) => Round::TowardPositive,
+        Some(Mode::TowardNegative) => Round::TowardNegative,
+        Some(Mode::NearestTiesToAway) => Round::NearestTiesToAway,
+    };
+    let (x, y, z) = (read(a), read(b), c.map(read));
+    let r = match (l.exp_bits, l.man_bits) {
+        (8, 23) => apply::<Single>(op, x, y, z, round),
+        (5, 10) => apply::<Half>(op, x, y, z, round),
+        (8, 7) => apply::<BFloat>(op, x, y, z, round),
+        _ => return None,
+    }?;
+    let r = if l.is_nan(r) {
+        l.canonical_nan()
+    } else if f.flushes() && l.is_subnormal(r) {
+        r & l.sign_mask()
+    } else {
+        r
+    };
+    Some(f.from_bits(r))
+}
+
+fn apply<T: Float>(op: Op, x: u64, y: u64, z: Option<u64>, round: Round) -> Option<u64> {
+    let (a, b) = (T::from_bits(x as u128), T::from_bits(y as u128));
+    let r = match (op, z) {
+        (Op::Mul, Some(c)) => a.mul_add_r(b, T::from_bits(c as u128), round),
+        (_, Some(_)) => return None,
+        (Op::Add, None) => a.add_r(b, round),
+        (Op::Sub, None) => a.sub_r(b, round),
+        (Op::Mul, None) => a.mul_r(b, round),
+        (Op::Div, None) => a.div_r(b, round),
+        (Op::Logic, None) => return None,
+    };
+    Some(r.value.to_bits() as u64)
+}

@@ -1,0 +1,68 @@
+//! `raypipe faults`: the fault bank against a vector set (generated, or read from a directory),
+//! printed as a detection table.
+
+use faults::Campaign;
+use std::path::Path;
+
+/// The campaign over the set in `dir` (its manifest and rows, checked against their hashes).
+pub fn on_dir(dir: &Path, outputs_only: bool) -> Result<Campaign, String> {
+    let path = dir.join("manifest.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let m: vectors::manifest::Manifest = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let rows = vectors::gen::read_files(dir, &m)?;
+    faults::run(&m, &rows, outputs_only)
+}
+
+/// The campaign over the set `req` generates (in memory).
+pub fn on_request(req: &vectors::gen::Request, outputs_only: bool) -> Result<Campaign, String> {
+    let set = vectors::gen::generate(req)?;
+    let rows = vectors::gen::set_rows(&set)?;
+    faults::run(&set.manifest, &rows, outputs_only)
+}
+
+/// The detection table.
+pub fn render(c: &Campaign) -> String {
+    let mut s = format!(
+        "raypipe faults: unit {}, format {}, {} vectors (set: level {}, seed {}, `{}`), compared: {}\n\n",
+        c.unit,
+        c.format,
+        c.vectors,
+        c.set_level,
+        c.set_seed,
+        c.set_command,
+        if c.outputs_only { "outputs only (valid, hit, t, u, v)" } else { "outputs and every stage probe" }
+    );
+    s += &format!("{:<22} {:<10} {:>8}  {:<16} what\n", "fault", "detected", "vectors", "first class");
+    for o in &c.faults {
+        let state = match (o.applicable, o.detected, o.benign) {
+            (false, _, _) => "n/a",
+            (true, true, _) => "yes",
+            (true, false, true) => "benign",
+            (true, false, false) => "ESCAPED",
+        };
+        s += &format!(
+            "{:<22} {:<10} {:>8}  {:<16} {}{}\n",
+            o.name,
+            state,
+            o.vectors,
+            o.first_class.as_deref().unwrap_or("-"),
+            o.what,
+            o.not_applicable.as_deref().map(|w| format!(" [{w}]")).unwrap_or_default()
+        );
+    }
+    let applicable = c.faults.iter().filter(|o| o.applicable && !o.benign).count();
+    s += &format!(
+        "\ndetected {} of {} applicable non-benign faults; escaped {}; benign {}; not applicable {}\n",
+        c.detected,
+        applicable,
+        c.escaped,
+        c.faults.iter().filter(|o| o.applicable && o.benign).count(),
+        c.faults.iter().filter(|o| !o.applicable).count()
+    );
+    s += if c.complete() {
+        "property: PASS (the set detects every applicable non-benign fault)\n"
+    } else {
+        "property: FAIL (some hardware faults escape this set: it needs the input classes that catch them)\n"
+    };
+    s
+}

@@ -1,0 +1,119 @@
+//! `raypipe faults`: the bank against generated and written vector sets, its JSON, exit codes
+//! and refusals.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn raypipe(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_raypipe")).args(args).output().expect("run raypipe")
+}
+
+fn json(o: &Output) -> serde_json::Value {
+    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&o.stdout)))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("raypipe-faults-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// Every fault's verdict, without the command that wrote the set.
+fn verdicts(v: &serde_json::Value) -> Vec<(String, bool, bool, bool, u64)> {
+    v["faults"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            (
+                f["name"].as_str().unwrap().to_string(),
+                f["detected"].as_bool().unwrap(),
+                f["benign"].as_bool().unwrap(),
+                f["applicable"].as_bool().unwrap(),
+                f["vectors"].as_u64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn the_exit_code_is_the_verdict_and_the_json_names_every_fault() {
+    for fmt in ["f32", "fp16"] {
+        for probes in [false, true] {
+            let mut args = vec!["faults", "--format", fmt, "--count", "16", "--json"];
+            if !probes {
+                args.push("--outputs-only");
+            }
+            let o = raypipe(&args);
+            let v = json(&o);
+            let escaped = v["escaped"].as_u64().unwrap();
+            assert_eq!(o.status.code(), Some(if escaped == 0 { 0 } else { 1 }), "{fmt}");
+            let faults = v["faults"].as_array().unwrap();
+            assert!(faults.len() >= 30);
+            let counted: Vec<_> = faults.iter().filter(|f| f["applicable"] == true && f["benign"] == false).collect();
+            assert_eq!(counted.iter().filter(|f| f["detected"] == false).count() as u64, escaped);
+            // a wired-backwards subtractor cannot escape any set
+            let swap = faults.iter().find(|f| f["name"] == "rti.e1x.swap").unwrap();
+            assert_eq!(swap["detected"], true);
+            let first = swap["first_vector"].as_u64().unwrap();
+            assert_eq!(swap["catching"][0].as_u64(), Some(first));
+            // the probes see at least what the outputs see
+            if probes {
+                let o2 = json(&raypipe(&["faults", "--format", fmt, "--count", "16", "--json", "--outputs-only"]));
+                assert!(v["detected"].as_u64() >= o2["detected"].as_u64());
+            }
+        }
+    }
+}
+
+#[test]
+fn a_written_set_gives_the_verdicts_of_the_generated_one() {
+    let dir = temp_dir("set");
+    let w = raypipe(&[
+        "vectors",
+        "--unit",
+        "rti",
+        "--format",
+        "fp16",
+        "--count",
+        "8",
+        "--seed",
+        "7",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(w.status.success(), "{}", String::from_utf8_lossy(&w.stderr));
+    let from_dir = json(&raypipe(&["faults", "--set", dir.to_str().unwrap(), "--json", "--outputs-only"]));
+    let generated =
+        json(&raypipe(&["faults", "--format", "fp16", "--count", "8", "--seed", "7", "--json", "--outputs-only"]));
+    assert_eq!(verdicts(&from_dir), verdicts(&generated));
+    assert_eq!(from_dir["set_seed"], 7);
+    // a set whose rows were changed is refused, not measured
+    let inputs = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.file_name().unwrap().to_str().unwrap().contains("input"))
+        .expect("an input file");
+    let mut text = std::fs::read_to_string(&inputs).unwrap();
+    let last = text.pop().unwrap();
+    text.push(if last == '0' { '1' } else { '0' });
+    std::fs::write(&inputs, text).unwrap();
+    let o = raypipe(&["faults", "--set", dir.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stdout));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_requests_are_refused_with_exit_2() {
+    for args in [
+        &["faults", "--unit", "slab"][..],
+        &["faults", "--unit", "nope"],
+        &["faults", "--set", "/nonexistent/raypipe-set"],
+        &["faults", "--set", "/tmp", "--format", "f32"],
+        &["faults", "--count", "1000000"],
+    ] {
+        let o = raypipe(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", String::from_utf8_lossy(&o.stdout));
+        assert!(!o.stderr.is_empty(), "{args:?}: a message");
+    }
+}
