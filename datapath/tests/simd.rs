@@ -89,6 +89,41 @@ fn on_every_kernel<O>(
     Ok(())
 }
 
+/// A typed RTI batch entry point (`rti_batch_f32`, …).
+type RtiBatchFn<F> =
+    fn(&Rti<F>, &RaysSoa<<F as Format>::V>, &TrisSoa<<F as Format>::V>, &mut HitsSoa<<F as Format>::V>) -> Kernel;
+
+/// FTZ options, either division mode.
+fn ftz_opts(divide: bool) -> FpOpts {
+    FpOpts {
+        div: if divide { DivMode::Divide } else { DivMode::RecipMul },
+        subnormals: Subnormals::Ftz,
+        ..FpOpts::default()
+    }
+}
+
+/// `batch` on every kernel against the scalar model, on columns of the edge encodings and on
+/// ordinary columns at scale 2^k.
+fn check_ftz<F: Format + Copy>(
+    rti: &Rti<F>,
+    n: usize,
+    seed: u64,
+    (specials, k): (&[u64], i32),
+    widest: Kernel,
+    batch: RtiBatchFn<F>,
+) -> Result<(), TestCaseError>
+where
+    F::V: Default,
+{
+    let f = rti.fmt;
+    for (rays, tris) in [columns(&f, n, seed, specials), scaled_columns(&f, n, seed, k)] {
+        let mut a = HitsSoa::with_len(n);
+        rti.batch(&rays, &tris, &mut a);
+        on_every_kernel(widest, &a, |b| batch(rti, &rays, &tris, b), || HitsSoa::with_len(n), |a, b| same(&f, a, b))?;
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
@@ -107,25 +142,15 @@ proptest! {
     /// a scale where the products of stages 2-7 fall into the subnormal range.
     #[test]
     fn f32_ftz_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-40), Just(0.5)], k in -48i32..-20) {
-        let f = Ieee::new(F32Native, FpOpts { div: if divide { DivMode::Divide } else { DivMode::RecipMul }, subnormals: Subnormals::Ftz, ..FpOpts::default() });
-        let rti = Rti::new(f, config(cull, thr));
-        for (rays, tris) in [columns(&f, n, seed, &F32_SPECIALS), scaled_columns(&f, n, seed, k)] {
-            let mut a = HitsSoa::with_len(n);
-            rti.batch(&rays, &tris, &mut a);
-            on_every_kernel(WIDEST_F32, &a, |b| rti_batch_f32(&rti, &rays, &tris, b), || HitsSoa::with_len(n), |a, b| same(&f, a, b))?;
-        }
+        let f = Ieee::new(F32Native, ftz_opts(divide));
+        check_ftz(&Rti::new(f, config(cull, thr)), n, seed, (&F32_SPECIALS, k), WIDEST_F32, rti_batch_f32)?;
     }
 
     /// binary16 under FTZ, likewise (products subnormal at scales 2^−12…2^−3).
     #[test]
     fn f16_ftz_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-3), Just(0.5)], k in -12i32..-2) {
-        let f = Ieee::new(F16Half, FpOpts { div: if divide { DivMode::Divide } else { DivMode::RecipMul }, subnormals: Subnormals::Ftz, ..FpOpts::default() });
-        let rti = Rti::new(f, config(cull, thr));
-        for (rays, tris) in [columns(&f, n, seed, &F16_SPECIALS), scaled_columns(&f, n, seed, k)] {
-            let mut a = HitsSoa::with_len(n);
-            rti.batch(&rays, &tris, &mut a);
-            on_every_kernel(WIDEST_F16, &a, |b| rti_batch_f16(&rti, &rays, &tris, b), || HitsSoa::with_len(n), |a, b| same(&f, a, b))?;
-        }
+        let f = Ieee::new(F16Half, ftz_opts(divide));
+        check_ftz(&Rti::new(f, config(cull, thr)), n, seed, (&F16_SPECIALS, k), WIDEST_F16, rti_batch_f16)?;
     }
 
     #[test]
