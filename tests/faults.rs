@@ -117,3 +117,25 @@ fn bad_requests_are_refused_with_exit_2() {
         assert!(!o.stderr.is_empty(), "{args:?}: a message");
     }
 }
+
+/// The guarantee of docs/faults.md: the default level-1 RTI sets detect every applicable
+/// non-benign fault of the bank from the outputs alone, in f32 and fp16.
+#[test]
+fn the_default_rti_sets_detect_the_whole_bank_from_the_outputs() {
+    for fmt in ["f32", "fp16"] {
+        for seed in ["1", "2", "3"] {
+            let o = raypipe(&["faults", "--format", fmt, "--seed", seed, "--outputs-only", "--json"]);
+            let v = json(&o);
+            let escaped: Vec<_> = v["faults"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|f| f["applicable"] == true && f["benign"] == false && f["detected"] == false)
+                .map(|f| f["name"].as_str().unwrap().to_string())
+                .collect();
+            assert!(escaped.is_empty(), "{fmt} seed {seed}: {escaped:?} escape");
+            assert_eq!(o.status.code(), Some(0));
+            assert!(v["detected"].as_u64().unwrap() >= 32);
+        }
+    }
+}

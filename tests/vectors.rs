@@ -90,7 +90,11 @@ fn every_class_is_covered_and_counted() {
     assert!(set.manifest.classes.iter().all(|c| c.count == 3), "{:?}", set.manifest.classes);
     let fixed = generate(&req(Unit::Rti, "q8.24:divide", 3)).unwrap();
     let names: Vec<_> = fixed.manifest.classes.iter().filter(|c| c.count == 0).map(|c| c.name.as_str()).collect();
-    assert_eq!(names, ["subnormal", "inf_nan"], "fixed point has no subnormals or inf/NaN");
+    assert_eq!(
+        names,
+        ["subnormal", "inf_nan", "tiny_products", "t_subnormal"],
+        "fixed point has no subnormals or inf/NaN"
+    );
     let total: usize = set.manifest.classes.iter().map(|c| c.count).sum();
     assert_eq!(total, set.manifest.files[0].rows);
 }
@@ -288,23 +292,25 @@ fn one_and_two_threads_write_the_same_bytes() {
 
 #[test]
 fn level_2_crosses_the_classes() {
-    // rti: the 12 level-1 classes, then 6 placements x 5 modifiers, every one filled in a float format
+    // rti: the 17 level-1 classes, then 11 placements x 5 modifiers, every one filled in a float format
     let set = generate(&Request { level: 2, ..req(Unit::Rti, "fp16", 2) }).unwrap();
     let c = &set.manifest.classes;
-    assert_eq!(c.len(), 12 + 6 * 5);
+    assert_eq!(c.len(), 17 + 11 * 5);
     assert!(c.iter().all(|c| c.count == 2), "{c:?}");
     assert!(c.iter().any(|c| c.name == "edge+subnormal") && c.iter().any(|c| c.name == "needle+huge"));
     // level 1's classes keep their ids and names
     let l1 = generate(&req(Unit::Rti, "fp16", 2)).unwrap();
     assert_eq!(
         l1.manifest.classes.iter().map(|c| &c.name).collect::<Vec<_>>(),
-        c[..12].iter().map(|c| &c.name).collect::<Vec<_>>()
+        c[..17].iter().map(|c| &c.name).collect::<Vec<_>>()
     );
     // in fixed point the crossings with subnormal and inf/NaN do not apply
     let fx = generate(&Request { level: 2, ..req(Unit::Rti, "q8.24:divide", 2) }).unwrap();
     let empty: Vec<_> = fx.manifest.classes.iter().filter(|c| c.count == 0).map(|c| c.name.clone()).collect();
-    assert_eq!(empty.len(), 2 + 2 * 6, "{empty:?}");
-    assert!(empty.iter().all(|n| n.contains("subnormal") || n.contains("inf_nan")));
+    // level 1: subnormal, inf_nan, tiny_products, t_subnormal; level 2: every placement with
+    // subnormal or inf_nan (11 x 2), tiny_products and t_subnormal with the other 3 modifiers
+    assert_eq!(empty.len(), 4 + 11 * 2 + 2 * 3, "{empty:?}");
+    assert!(empty.iter().all(|n| n.contains("subnormal") || n.contains("inf_nan") || n.contains("tiny_products")));
     // slab and op gain crossed classes; the set still checks bit for bit
     let slab = generate(&Request { level: 2, ..req(Unit::Slab, "f32", 3) }).unwrap();
     assert_eq!(slab.manifest.classes.len(), 8 + 7);

@@ -109,8 +109,8 @@ fn contract_map<F: Format>(f: &F) -> BTreeMap<String, String> {
     .collect()
 }
 
-/// Geometric RTI classes (level 1 ids 0-5 and 8): how the triangle and ray are placed.
-const RTI_GEOMETRY: [(usize, &str, &str); 7] = [
+/// Geometric RTI classes (level 1 ids 0-5, 8 and 12-16): how the triangle and ray are placed.
+const RTI_GEOMETRY: [(usize, &str, &str); 12] = [
     (0, "random", "ray aimed at a random barycentric point in [-0.3, 1.3]^2 of a random triangle in [-1, 1]^3"),
     (1, "edge", "aimed exactly at a point of an edge (one barycentric 0)"),
     (2, "vertex", "aimed exactly at a vertex"),
@@ -118,6 +118,27 @@ const RTI_GEOMETRY: [(usize, &str, &str); 7] = [
     (4, "degenerate", "collinear vertices (zero area)"),
     (5, "needle", "long triangle 1e-3 wide"),
     (8, "t_near_zero", "origin on the triangle's plane (t = 0)"),
+    (
+        12,
+        "t_at_limits",
+        "a random placement the model finds valid with a number t, then the t interval ending on that t: tmax = t (a hit only if the compare is t <= tmax), or tmin = the next value above t (a miss only if the tmin compare is made)",
+    ),
+    (13, "point_triangle", "all three vertices at one point: det, u', v' and t' are zero, so only the det check rejects it"),
+    (
+        14,
+        "ties",
+        "v0 = 0, e2.y = 0 and d.z = 0, so p.x = d.y * e2.z and p.y = -d.x * e2.z are exact; e1, o (so s), and e2.x, e2.z, d.x, d.y odd integers of a, be and bd bits scaled by powers of two (a = floor((p + 1) / 2), bd = floor((p + 2 - a) / 2), be = p + 2 - a - bd for a float of p significant bits): detx = e1.x * p.x and upy = s.y * p.y span p or p + 1 bits and, at p + 1, fall exactly halfway between two values (round-half-even vs half-away)",
+    ),
+    (
+        15,
+        "tiny_products",
+        "a random placement with the origin and vertices scaled by 2^floor((emin - 1) / 2) (floats only): stage-2 and stage-3 results fall into the subnormal range",
+    ),
+    (
+        16,
+        "t_subnormal",
+        "a random placement with the origin and vertices scaled by L = 2^(ceil(emin / 3) + 1) and the direction by L * 2^(2 - emin) (floats only): t near 2^(emin - 2), a subnormal, with det, u' and t' normal",
+    ),
 ];
 
 /// Value modifiers of the RTI classes (level 1 ids 6, 7, 9, 10, 11), applied after placement.
@@ -182,7 +203,7 @@ fn rti_crosses(level: u32) -> Vec<RtiCross> {
             names: (g, m),
         }
     };
-    let mut v: Vec<RtiCross> = (0..12)
+    let mut v: Vec<RtiCross> = (0..17)
         .map(|id| match RTI_GEOMETRY.iter().position(|g| g.0 == id) {
             Some(g) => cross(g, None),
             None => cross(0, RTI_MODIFIERS.iter().position(|m| m.0 == id)),
@@ -281,6 +302,7 @@ fn rti_case(cross: RtiCross, r: &mut SplitMix64) -> [f64; 17] {
             let k = r.below(3);
             (b1, b2) = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)][k as usize];
         }
+        13 => v = [v[0]; 3],
         4 => {
             let t = r.range(-1.0, 2.0);
             v[2] = std::array::from_fn(|a| v[0][a] + t * (v[1][a] - v[0][a]));
@@ -457,6 +479,68 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                         return Ok(None);
                     }
                     let mut x = rti_case(cross, r);
+                    match (cross.geom, f.kind()) {
+                        (14, FormatKind::Float(l)) => {
+                            let p = l.man_bits as i32 + 1;
+                            let a = (p + 1) / 2;
+                            let bd = (p + 2 - a) / 2;
+                            let be = p + 2 - a - bd;
+                            // ± an odd integer of n bits, over 2^n
+                            let mut odd = |n: i32| {
+                                let v = ((1u64 << (n - 1)) + r.below(1u64 << (n - 1))) | 1;
+                                let s = if r.below(2) == 0 { 1.0 } else { -1.0 };
+                                s * v as f64 / (n as f64).exp2()
+                            };
+                            let (o, e1) = ([odd(a), odd(a), odd(a)], [odd(a), odd(a), odd(a)]);
+                            let (dx, dy, e2x, e2z) = (odd(bd), odd(bd), odd(be), odd(be));
+                            x = [
+                                o[0],
+                                o[1],
+                                o[2],
+                                dx,
+                                dy,
+                                0.0,
+                                0.0,
+                                f64::INFINITY,
+                                0.0,
+                                0.0,
+                                0.0,
+                                e1[0],
+                                e1[1],
+                                e1[2],
+                                e2x,
+                                0.0,
+                                e2z,
+                            ];
+                        }
+                        (15 | 16, FormatKind::Float(l)) => {
+                            let (lv, dv) = if cross.geom == 15 {
+                                (((l.emin() - 1).div_euclid(2) as f64).exp2(), 1.0)
+                            } else {
+                                let lv = ((-(-l.emin()).div_euclid(3) + 1) as f64).exp2();
+                                (lv, lv * ((2 - l.emin()) as f64).exp2())
+                            };
+                            for (i, xi) in x.iter_mut().enumerate() {
+                                if (3..6).contains(&i) {
+                                    *xi *= dv;
+                                } else if i != 6 && i != 7 {
+                                    *xi *= lv;
+                                }
+                            }
+                        }
+                        (15 | 16, _) => return Ok(None),
+                        _ => {}
+                    }
+                    // t_at_limits: placements until the model finds one valid with a number t
+                    // (at most 16)
+                    for _ in 0..16 * (cross.geom == 12) as usize {
+                        let (ray, tri) = rti_inputs(&f, &x);
+                        let o = rti.test(&ray, &tri);
+                        if o.valid && !f.is_nan(o.t) {
+                            break;
+                        }
+                        x = rti_case(cross, r);
+                    }
                     if let Some(sp) = cross.special {
                         for _ in 0..1 + r.below(3) {
                             let i = r.below(17) as usize;
@@ -472,7 +556,17 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                             };
                         }
                     }
-                    let bits: Vec<u64> = x.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
+                    let mut bits: Vec<u64> = x.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
+                    if cross.geom == 12 {
+                        let (ray, tri) = rti_inputs(&f, &x);
+                        let o = rti.test(&ray, &tri);
+                        if o.valid && !f.is_nan(o.t) {
+                            match r.below(2) {
+                                0 => bits[7] = f.to_bits(o.t),
+                                _ => bits[6] = f.to_bits(f.next_up(o.t)),
+                            }
+                        }
+                    }
                     Ok(Some(rti_rows(&rti, c as u64, &bits).to_vec()))
                 })
             })?;
@@ -757,6 +851,15 @@ fn op_eval<F: Format>(f: &F, op: u64, x: F::V, y: F::V) -> (u64, u64) {
 }
 
 /// Model rows for one RTI vector: inputs, expected outputs, stage signals.
+/// The ray and triangle of a case's 17 f64 inputs (o, d, tmin, tmax, v0, v1, v2) in format `f`.
+fn rti_inputs<F: Format>(f: &F, x: &[f64; 17]) -> (Ray<F::V>, Tri<F::V>) {
+    let v = |i: usize| f.from_f64(x[i]);
+    (
+        Ray { o: [v(0), v(1), v(2)], d: [v(3), v(4), v(5)], tmin: v(6), tmax: v(7) },
+        Tri { v: [[v(8), v(9), v(10)], [v(11), v(12), v(13)], [v(14), v(15), v(16)]] },
+    )
+}
+
 fn rti_rows<F: Format>(rti: &Rti<F>, class: u64, bits: &[u64]) -> [Vec<u64>; 3] {
     let f = &rti.fmt;
     let v = |i: usize| f.from_bits(bits[i]);
