@@ -182,8 +182,8 @@ impl RtiCross {
     }
 }
 
-/// The RTI classes of a level, in class-id order: level 1 as the twelve named classes (ids
-/// 0-11), level 2 adds every placement other than random crossed with every modifier.
+/// The RTI classes of a level, in class-id order: level 1 as the seventeen named classes (ids
+/// 0-16), level 2 adds every placement other than random crossed with every modifier.
 fn rti_crosses(level: u32) -> Vec<RtiCross> {
     let cross = |g: usize, m: Option<usize>| {
         let id = m.map(|m| RTI_MODIFIERS[m].0);
