@@ -6,10 +6,10 @@
 use crate::bank::{Spec, BANK};
 use crate::inject::Injected;
 use datapath::fault::NoFault;
-use datapath::probe::{Recorder, Signal};
-use datapath::rti::{Ray, Rti, RtiOut, Tri};
-use datapath::{with_format, AnyFormat, Format};
+use datapath::rti::Rti;
+use datapath::{with_format, AnyFormat};
 use serde::Serialize;
+use vectors::gen::{rti_case_of, rti_out_rows};
 use vectors::manifest::Manifest;
 
 /// What the campaign found for one fault.
@@ -111,13 +111,10 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
         let rti = Rti::new(f, cfg);
         let injected: Vec<Injected> = bank.iter().map(|s| Injected::new(s)).collect();
         for (i, input) in inputs.iter().enumerate() {
-            let (class, bits) = (input[0], &input[1..]);
-            let v = |k: usize| f.from_bits(bits[k]);
-            let ray = Ray { o: [v(0), v(1), v(2)], d: [v(3), v(4), v(5)], tmin: v(6), tmax: v(7) };
-            let tri = Tri { v: [[v(8), v(9), v(10)], [v(11), v(12), v(13)], [v(14), v(15), v(16)]] };
+            let class = input[0];
+            let (ray, tri) = rti_case_of(&f, &input[1..]);
             // the set is the fault-free model's
-            let (out, probes) = run_one(&rti, &ray, &tri, &NoFault);
-            if outputs(&f, &out) != expected[i] || probes != stages[i] {
+            if rti_out_rows(&rti, &ray, &tri, &NoFault) != [&expected[i][..], &stages[i][..]] {
                 return Err(format!(
                     "vector {} (input row {}): the set's expected rows differ from this raypipe's model; check the set with `raypipe vectors --check`",
                     i,
@@ -126,8 +123,8 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
             }
             for (x, o) in injected.iter().zip(outcomes.iter_mut()) {
                 x.next_test();
-                let (fo, fp) = run_one(&rti, &ray, &tri, x);
-                if outputs(&f, &fo) != expected[i] || (!outputs_only && fp != stages[i]) {
+                let [fo, fp] = rti_out_rows(&rti, &ray, &tri, x);
+                if fo != expected[i] || (!outputs_only && fp != stages[i]) {
                     o.vectors += 1;
                     o.catching.push(i);
                     if o.first_vector.is_none() {
@@ -165,30 +162,4 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
         escaped: outcomes.iter().filter(counted).filter(|o| !o.detected).count(),
         faults: outcomes,
     })
-}
-
-/// One test with probes: the outputs and every stage signal as the set encodes them.
-fn run_one<F: Format, X: datapath::fault::Fault<F>>(
-    rti: &Rti<F>,
-    ray: &Ray<F::V>,
-    tri: &Tri<F::V>,
-    x: &X,
-) -> (RtiOut<F::V>, Vec<u64>) {
-    let mut rec = Recorder::new();
-    let out = rti.trace_faulty(ray, tri, &mut rec, x);
-    let f = &rti.fmt;
-    let probes = rec
-        .signals
-        .iter()
-        .map(|(_, s)| match s {
-            Signal::Value(v) => f.to_bits(*v),
-            Signal::Flag(b) => *b as u64,
-        })
-        .collect();
-    (out, probes)
-}
-
-/// The expected-row fields of one output: valid, hit, t, u, v.
-fn outputs<F: Format>(f: &F, o: &RtiOut<F::V>) -> Vec<u64> {
-    vec![o.valid as u64, o.hit as u64, f.to_bits(o.t), f.to_bits(o.u), f.to_bits(o.v)]
 }

@@ -11,14 +11,14 @@ use datapath::rti::Op;
 use datapath::Format;
 use rustc_apfloat::ieee::{BFloat, Half, Single};
 use rustc_apfloat::{Float, Round};
-use std::cell::{Cell, RefCell};
+use std::cell::Cell;
 
 /// One bank fault, injected; remembers whether its site was reached and could be modelled.
 #[derive(Debug)]
 pub struct Injected {
     spec: Spec,
-    /// The operands (as encodings) of every arithmetic site of the current test, in order.
-    operands: RefCell<Vec<(&'static str, u64, u64)>>,
+    /// A fused fault's product site's operands (as encodings) in the current test.
+    operands: Cell<Option<(u64, u64)>>,
     reached: Cell<bool>,
     unmodelled: Cell<bool>,
 }
@@ -26,16 +26,11 @@ pub struct Injected {
 impl Injected {
     /// `spec`, ready to inject.
     pub fn new(spec: &Spec) -> Self {
-        Self {
-            spec: *spec,
-            operands: RefCell::new(Vec::new()),
-            reached: Cell::new(false),
-            unmodelled: Cell::new(false),
-        }
+        Self { spec: *spec, operands: Cell::new(None), reached: Cell::new(false), unmodelled: Cell::new(false) }
     }
     /// Forgets the current test's operands (call before each test).
     pub fn next_test(&self) {
-        self.operands.borrow_mut().clear();
+        self.operands.set(None);
     }
     /// The fault's site was computed at least once.
     pub fn reached(&self) -> bool {
@@ -57,7 +52,11 @@ impl Injected {
 impl<F: Format> Fault<F> for Injected {
     const ON: bool = true;
     fn arith(&self, f: &F, site: &'static str, op: Op, a: F::V, b: F::V) -> F::V {
-        self.operands.borrow_mut().push((site, f.to_bits(a), f.to_bits(b)));
+        if let Kind::Fused { product, .. } = self.spec.kind {
+            if site == product {
+                self.operands.set(Some((f.to_bits(a), f.to_bits(b))));
+            }
+        }
         let r = fault_free(f, op, a, b);
         if site != self.spec.site {
             return r;
@@ -67,8 +66,8 @@ impl<F: Format> Fault<F> for Injected {
             Kind::Swap => fault_free(f, op, b, a),
             Kind::FirstTwice => fault_free(f, op, a, a),
             Kind::Round(m) => self.hit(r, exact(f, op, a, b, None, m)),
-            Kind::Fused { product, first } => {
-                let p = self.operands.borrow().iter().rev().find(|(s, _, _)| *s == product).map(|&(_, x, y)| (x, y));
+            Kind::Fused { first, .. } => {
+                let p = self.operands.get();
                 let addend = if first { b } else { a };
                 let v = p.and_then(|(x, y)| exact(f, Op::Mul, f.from_bits(x), f.from_bits(y), Some(addend), None));
                 self.hit(r, v)

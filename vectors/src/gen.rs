@@ -7,6 +7,7 @@
 use crate::manifest::{self, Class, Field, Kind, Manifest, Stage};
 use crate::pack::unpack;
 use crate::rows::{is_float, kind_of, per_class_rows, push_rows, slab_options, Layout, Rows};
+use datapath::fault::{Fault, NoFault};
 use datapath::format::FormatKind;
 use datapath::probe::{Recorder, Signal};
 use datapath::rng::SplitMix64;
@@ -853,24 +854,32 @@ fn op_eval<F: Format>(f: &F, op: u64, x: F::V, y: F::V) -> (u64, u64) {
 /// Model rows for one RTI vector: inputs, expected outputs, stage signals.
 /// The ray and triangle of a case's 17 f64 inputs (o, d, tmin, tmax, v0, v1, v2) in format `f`.
 fn rti_inputs<F: Format>(f: &F, x: &[f64; 17]) -> (Ray<F::V>, Tri<F::V>) {
-    let v = |i: usize| f.from_f64(x[i]);
+    rti_case_of(f, &x.map(|v| f.to_bits(f.from_f64(v))))
+}
+
+/// The ray and triangle of an RTI input row's 17 encodings (o, d, tmin, tmax, v0, v1, v2).
+pub fn rti_case_of<F: Format>(f: &F, bits: &[u64]) -> (Ray<F::V>, Tri<F::V>) {
+    let v = |i: usize| f.from_bits(bits[i]);
     (
         Ray { o: [v(0), v(1), v(2)], d: [v(3), v(4), v(5)], tmin: v(6), tmax: v(7) },
         Tri { v: [[v(8), v(9), v(10)], [v(11), v(12), v(13)], [v(14), v(15), v(16)]] },
     )
 }
 
-fn rti_rows<F: Format>(rti: &Rti<F>, class: u64, bits: &[u64]) -> [Vec<u64>; 3] {
+/// The expected row (valid, hit, t, u, v) and the stage row of one RTI test with every site
+/// computed by `x` (`NoFault`: the rows a set holds).
+pub fn rti_out_rows<F: Format, X: Fault<F>>(rti: &Rti<F>, ray: &Ray<F::V>, tri: &Tri<F::V>, x: &X) -> [Vec<u64>; 2] {
     let f = &rti.fmt;
-    let v = |i: usize| f.from_bits(bits[i]);
-    let ray = Ray { o: [v(0), v(1), v(2)], d: [v(3), v(4), v(5)], tmin: v(6), tmax: v(7) };
-    let tri = Tri { v: [[v(8), v(9), v(10)], [v(11), v(12), v(13)], [v(14), v(15), v(16)]] };
     let mut rec = Recorder::new();
-    let out = rti.trace(&ray, &tri, &mut rec);
+    let out = rti.trace_faulty(ray, tri, &mut rec, x);
+    [vec![out.valid as u64, out.hit as u64, f.to_bits(out.t), f.to_bits(out.u), f.to_bits(out.v)], signals(f, &rec)]
+}
+
+fn rti_rows<F: Format>(rti: &Rti<F>, class: u64, bits: &[u64]) -> [Vec<u64>; 3] {
+    let (ray, tri) = rti_case_of(&rti.fmt, bits);
+    let [expected, stages] = rti_out_rows(rti, &ray, &tri, &NoFault);
     let mut inputs = vec![class];
     inputs.extend_from_slice(bits);
-    let expected = vec![out.valid as u64, out.hit as u64, f.to_bits(out.t), f.to_bits(out.u), f.to_bits(out.v)];
-    let stages = signals(f, &rec);
     [inputs, expected, stages]
 }
 
