@@ -30,9 +30,15 @@ pub fn render(c: &Campaign) -> String {
         c.set_level,
         c.set_seed,
         c.set_command,
-        if c.outputs_only { "outputs only (valid, hit, t, u, v)" } else { "outputs and every stage probe" }
+        if !c.outputs_only {
+            "outputs and every stage probe"
+        } else if c.unit == "slab" {
+            "outputs only (hit, t_near, t_far)"
+        } else {
+            "outputs only (valid, hit, t, u, v)"
+        }
     );
-    s += &format!("{:<22} {:<10} {:>8}  {:<16} what\n", "fault", "detected", "vectors", "first class");
+    s += &format!("{:<24} {:<10} {:>8}  {:<16} what\n", "fault", "detected", "vectors", "first class");
     for o in &c.faults {
         let state = match (o.applicable, o.detected, o.benign) {
             (false, _, _) => "n/a",
@@ -41,7 +47,7 @@ pub fn render(c: &Campaign) -> String {
             (true, false, false) => "ESCAPED",
         };
         s += &format!(
-            "{:<22} {:<10} {:>8}  {:<16} {}{}\n",
+            "{:<24} {:<10} {:>8}  {:<16} {}{}\n",
             o.name,
             state,
             o.vectors,

@@ -289,9 +289,12 @@ enum Cmd {
     },
     /// Run the fault bank against a vector set: which hardware bugs the set detects.
     Faults {
-        /// Unit (units with a fault bank: rti).
+        /// Unit (units with a fault bank: rti, slab).
         #[arg(long, default_value = "rti")]
         unit: String,
+        /// Slab variant of the generated set (unit slab): plain, conservative, take-on-false, embree.
+        #[arg(long, default_value = "plain", conflicts_with = "set")]
+        variant: String,
         /// Number format of the generated set (default f32).
         #[arg(long, value_parser = parse_format)]
         format: Option<AnyFormat>,
@@ -304,7 +307,8 @@ enum Cmd {
         /// Seed of the generated set.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Compare only the outputs (valid, hit, t, u, v), as for a DUT without probe ports.
+        /// Compare only the outputs (rti: valid, hit, t, u, v; slab: hit, t_near, t_far), as for
+        /// a DUT without probe ports.
         #[arg(long)]
         outputs_only: bool,
         /// Run on the set in this directory instead of generating one (its unit, format and options).
@@ -722,7 +726,7 @@ fn run() -> Result<Outcome, String> {
             );
             Ok(Outcome::Pass)
         }
-        Some(Cmd::Faults { unit, format, level, count, seed, outputs_only, set, json, threads, rti }) => {
+        Some(Cmd::Faults { unit, variant, format, level, count, seed, outputs_only, set, json, threads, rti }) => {
             let c = match set {
                 Some(dir) => raypipe::faults::on_dir(&dir, outputs_only)?,
                 None => {
@@ -740,7 +744,7 @@ fn run() -> Result<Outcome, String> {
                         level,
                         command: command_without_threads(),
                         rti: rti.config()?,
-                        slab_variant: "plain".into(),
+                        slab_variant: variant,
                     };
                     raypipe::faults::on_request(&req, outputs_only)?
                 }

@@ -106,8 +106,10 @@ fn a_written_set_gives_the_verdicts_of_the_generated_one() {
 #[test]
 fn bad_requests_are_refused_with_exit_2() {
     for args in [
-        &["faults", "--unit", "slab"][..],
+        &["faults", "--unit", "op"][..],
         &["faults", "--unit", "nope"],
+        &["faults", "--unit", "slab", "--variant", "directed"],
+        &["faults", "--unit", "slab", "--variant", "nope"],
         &["faults", "--set", "/nonexistent/raypipe-set"],
         &["faults", "--set", "/tmp", "--format", "f32"],
         &["faults", "--count", "1000000"],
@@ -138,4 +140,50 @@ fn the_default_rti_sets_detect_the_whole_bank_from_the_outputs() {
             assert!(v["detected"].as_u64().unwrap() >= 32);
         }
     }
+}
+
+/// The same guarantee for the slab unit, in every variant a vector set supports: the default
+/// level-1 slab sets detect every applicable non-benign fault from the outputs (hit, t_near,
+/// t_far) alone, in f32 and fp16; and every slab fault applies in some variant.
+#[test]
+fn the_default_slab_sets_detect_the_whole_bank_from_the_outputs() {
+    let mut applies: std::collections::BTreeMap<String, bool> = Default::default();
+    for variant in ["plain", "conservative", "take-on-false", "embree"] {
+        for fmt in ["f32", "fp16"] {
+            for seed in ["1", "2", "3"] {
+                let o = raypipe(&[
+                    "faults",
+                    "--unit",
+                    "slab",
+                    "--variant",
+                    variant,
+                    "--format",
+                    fmt,
+                    "--seed",
+                    seed,
+                    "--outputs-only",
+                    "--json",
+                ]);
+                let v = json(&o);
+                let faults = v["faults"].as_array().unwrap();
+                let escaped: Vec<_> = faults
+                    .iter()
+                    .filter(|f| f["applicable"] == true && f["benign"] == false && f["detected"] == false)
+                    .map(|f| f["name"].as_str().unwrap().to_string())
+                    .collect();
+                assert!(escaped.is_empty(), "{variant} {fmt} seed {seed}: {escaped:?} escape");
+                assert_eq!(o.status.code(), Some(0));
+                assert!(v["detected"].as_u64().unwrap() >= 20, "{variant} {fmt}");
+                for f in faults {
+                    assert!(f["name"].as_str().unwrap().starts_with("slab."));
+                    *applies.entry(f["name"].as_str().unwrap().to_string()).or_default() |= f["applicable"] == true;
+                    // a benign verdict carries its argument
+                    assert_eq!(f["benign"] == true, f["benign_why"].is_string(), "{}", f["name"]);
+                }
+            }
+        }
+    }
+    assert!(applies.len() >= 25);
+    let never: Vec<_> = applies.iter().filter(|(_, &a)| !a).map(|(n, _)| n).collect();
+    assert!(never.is_empty(), "slab faults no variant reaches: {never:?}");
 }

@@ -313,8 +313,12 @@ fn level_2_crosses_the_classes() {
     assert!(empty.iter().all(|n| n.contains("subnormal") || n.contains("inf_nan") || n.contains("tiny_products")));
     // slab and op gain crossed classes; the set still checks bit for bit
     let slab = generate(&Request { level: 2, ..req(Unit::Slab, "f32", 3) }).unwrap();
-    assert_eq!(slab.manifest.classes.len(), 8 + 7);
+    assert_eq!(slab.manifest.classes.len(), 13 + 7);
     assert!(slab.manifest.classes.iter().all(|c| c.count == 3), "{:?}", slab.manifest.classes);
+    // fixed point: the float-only slab classes are empty
+    let fxs = generate(&req(Unit::Slab, "q8.24", 3)).unwrap();
+    let empty: Vec<_> = fxs.manifest.classes.iter().filter(|c| c.count == 0).map(|c| c.name.as_str()).collect();
+    assert_eq!(empty, ["inf_nan", "ties", "subnormal_gap"]);
     let op = generate(&Request { level: 2, ..req(Unit::Op, "fp16", 8) }).unwrap();
     assert!(op.manifest.classes[2].count > 0);
     let trav = generate(&Request { level: 2, ..req(Unit::Traverse, "f32", 2) }).unwrap();

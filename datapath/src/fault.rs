@@ -1,9 +1,11 @@
 //! Fault injection: a hardware bug as a change to what one named site of a stage model
 //! computes. A model calls its fault at every arithmetic site (the stage table's signal names:
 //! `e1x`, `pxa`, `det_xy`, `inv_det`, `t`, …) and every compare site (`det_ok`, `pos`, `u_ok`,
-//! `v_ok`, `uv_ok`, `t_ok`, `tmin_ok`, `tmax_ok`, and the min-capture unit's `take`); with
-//! [`NoFault`] (`ON == false`) each call is the format's own operation and the model's code
-//! is what it was without the hook. The fault models themselves (which site, which bug) live
+//! `v_ok`, `uv_ok`, `t_ok`, `tmin_ok`, `tmax_ok`, and the min-capture unit's `take`), every
+//! logic bit that steers the datapath (the slab unit's sign selects `negx`…, its guard
+//! decisions) and every grid step (the slab unit's widening); with [`NoFault`]
+//! (`ON == false`) each call is the format's own operation and the model's code is what it
+//! was without the hook. The fault models themselves (which site, which bug) live
 //! in the `faults` crate.
 
 use crate::rti::Op;
@@ -51,6 +53,21 @@ pub trait Fault<F: Format> {
     fn arith(&self, f: &F, site: &'static str, op: Op, a: F::V, b: F::V) -> F::V;
     /// The bit compare site `site` produces (fault-free: `cmp.eval(f, a, b)`).
     fn compare(&self, f: &F, site: &'static str, cmp: Cmp, a: F::V, b: F::V) -> bool;
+    /// The bit logic site `site` produces where the fault-free datapath produces `v`.
+    #[inline(always)]
+    fn flag(&self, _site: &'static str, v: bool) -> bool {
+        v
+    }
+    /// The grid step site `site` produces from `v`: fault-free, IEEE nextUp (`up`) or
+    /// nextDown of `v` in format `f` (see `slab::STEP_RULES`).
+    #[inline(always)]
+    fn step(&self, f: &F, _site: &'static str, up: bool, v: F::V) -> F::V {
+        if up {
+            f.next_up(v)
+        } else {
+            f.next_down(v)
+        }
+    }
 }
 
 /// The fault-free datapath: every site is the format's own operation.

@@ -44,6 +44,7 @@
 //! difference becomes zero and the argument fails, and fixed point has no ∞ to overflow to:
 //! `conservative` refuses both (use `directed`).
 
+use crate::fault::{Cmp, Fault, NoFault};
 use crate::format::Format;
 use crate::probe::{NoProbe, Probe};
 use crate::rti::{Op, SigDef};
@@ -326,14 +327,33 @@ impl<F: Format> Slab<F> {
         p: &mut P,
     ) -> SlabRay<F::V> {
         let f = &self.fmt;
+        let q = |x: f64| f.from_f64(x);
+        self.prepare_faulty(o.map(q), d.map(q), q(tmin), q(tmax), p, &NoFault)
+    }
+
+    /// Stage 0 on a ray already in the format, with every site computed by `x` (a hardware
+    /// fault; [`NoFault`] is the datapath itself). Sites: the arithmetic sites `inv_dx`,
+    /// `inv_dy`, `inv_dz`; the compare sites `pdx`, `pdy`, `pdz` (Embree: `|d| < δ`); the
+    /// logic sites `pdx_sign`, `pdy_sign`, `pdz_sign` (Embree: the replacement's sign, d's sign
+    /// bit) and `guard_recip` (the conservative guard's reciprocal decision).
+    pub fn prepare_faulty<P: Probe<F::V>, X: Fault<F>>(
+        &self,
+        o: [F::V; 3],
+        d: [F::V; 3],
+        tmin: F::V,
+        tmax: F::V,
+        p: &mut P,
+        x: &X,
+    ) -> SlabRay<F::V> {
+        let f = &self.fmt;
         let one = f.one();
-        let [dx, dy, dz] = d.map(|x| f.from_f64(x));
-        let prep = |v: F::V| match self.cfg.prep {
+        let [dx, dy, dz] = d;
+        let prep = |site, sign_site, v: F::V| match self.cfg.prep {
             DirPrep::Plain => v,
             DirPrep::Embree => {
                 let delta = self.delta();
-                if f.lt(f.abs(v), delta) {
-                    if f.sign_bit(v) {
+                if x.compare(f, site, Cmp::Lt, f.abs(v), delta) {
+                    if x.flag(sign_site, f.sign_bit(v)) {
                         f.sub(f.zero(), delta)
                     } else {
                         delta
@@ -343,29 +363,23 @@ impl<F: Format> Slab<F> {
                 }
             }
         };
-        let (pdx, pdy, pdz) = (prep(dx), prep(dy), prep(dz));
+        let (pdx, pdy, pdz) = (prep("pdx", "pdx_sign", dx), prep("pdy", "pdy_sign", dy), prep("pdz", "pdz_sign", dz));
         let guard = self.guard_layout();
-        let recip = |d: F::V| {
-            let r = f.div(one, d);
+        let recip = |site, d: F::V| {
+            let r = x.arith(f, site, Op::Div, one, d);
             match guard {
-                Some(l) if guarded_recip(l, f.to_bits(d), f.to_bits(r)) => f.from_bits(l.canonical_nan()),
+                Some(l) if x.flag("guard_recip", guarded_recip(l, f.to_bits(d), f.to_bits(r))) => {
+                    f.from_bits(l.canonical_nan())
+                }
                 _ => r,
             }
         };
-        let inv_dx = recip(pdx);
-        let inv_dy = recip(pdy);
-        let inv_dz = recip(pdz);
+        let inv_dx = recip("inv_dx", pdx);
+        let inv_dy = recip("inv_dy", pdy);
+        let inv_dz = recip("inv_dz", pdz);
         record!(p; dx, dy, dz, pdx, pdy, pdz, inv_dx, inv_dy, inv_dz);
         let inv = [inv_dx, inv_dy, inv_dz];
-        let mut ray = SlabRay {
-            o: o.map(|x| f.from_f64(x)),
-            inv_d: inv,
-            tmin: f.from_f64(tmin),
-            tmax: f.from_f64(tmax),
-            inv_lo: inv,
-            inv_hi: inv,
-            parallel: [false; 3],
-        };
+        let mut ray = SlabRay { o, inv_d: inv, tmin, tmax, inv_lo: inv, inv_hi: inv, parallel: [false; 3] };
         if self.cfg.directed {
             let (top, bottom) = (f.from_f64(f64::INFINITY), f.from_f64(f64::NEG_INFINITY));
             // a fixed format without 1 (q1.F) holds no reciprocal of any of its values but
@@ -407,13 +421,23 @@ impl<F: Format> Slab<F> {
         }
     }
 
-    /// A stage-1 subtract `a ⊖ b`, guarded: the canonical NaN if finite operands overflowed.
+    /// The stage-1 subtract at `site`, `a ⊖ b`, guarded: the canonical NaN if finite operands
+    /// overflowed (the logic site `guard_sub` is the guard's decision).
     #[inline(always)]
-    fn sub_guarded(&self, g: Option<crate::format::FloatLayout>, a: F::V, b: F::V) -> F::V {
+    fn sub_guarded<X: Fault<F>>(
+        &self,
+        x: &X,
+        g: Option<crate::format::FloatLayout>,
+        site: &'static str,
+        a: F::V,
+        b: F::V,
+    ) -> F::V {
         let f = &self.fmt;
-        let r = f.sub(a, b);
+        let r = x.arith(f, site, Op::Sub, a, b);
         match g {
-            Some(l) if guarded_sub(l, f.to_bits(a), f.to_bits(b), f.to_bits(r)) => f.from_bits(l.canonical_nan()),
+            Some(l) if x.flag("guard_sub", guarded_sub(l, f.to_bits(a), f.to_bits(b), f.to_bits(r))) => {
+                f.from_bits(l.canonical_nan())
+            }
             _ => r,
         }
     }
@@ -424,45 +448,46 @@ impl<F: Format> Slab<F> {
         f.round_up(2.0 / f.error_model().max)
     }
 
-    /// The compare-select of the near chain: `acc` replaced by `x` when x is farther in.
+    /// The compare-select of the near chain at compare site `site`: `acc` replaced by `v` when
+    /// v is farther in.
     #[inline(always)]
-    fn near_sel(&self, acc: F::V, x: F::V) -> F::V {
+    fn near_sel<X: Fault<F>>(&self, x: &X, site: &'static str, acc: F::V, v: F::V) -> F::V {
         let f = &self.fmt;
         match self.cfg.nan {
             SlabNan::Ignore => {
-                if f.lt(acc, x) {
-                    x
+                if x.compare(f, site, Cmp::Lt, acc, v) {
+                    v
                 } else {
                     acc
                 }
             }
             SlabNan::TakeOnFalse => {
-                if f.le(x, acc) {
+                if x.compare(f, site, Cmp::Le, v, acc) {
                     acc
                 } else {
-                    x
+                    v
                 }
             }
         }
     }
 
-    /// The compare-select of the far chain.
+    /// The compare-select of the far chain at compare site `site`.
     #[inline(always)]
-    fn far_sel(&self, acc: F::V, x: F::V) -> F::V {
+    fn far_sel<X: Fault<F>>(&self, x: &X, site: &'static str, acc: F::V, v: F::V) -> F::V {
         let f = &self.fmt;
         match self.cfg.nan {
             SlabNan::Ignore => {
-                if f.lt(x, acc) {
-                    x
+                if x.compare(f, site, Cmp::Lt, v, acc) {
+                    v
                 } else {
                     acc
                 }
             }
             SlabNan::TakeOnFalse => {
-                if f.le(acc, x) {
+                if x.compare(f, site, Cmp::Le, acc, v) {
                     acc
                 } else {
-                    x
+                    v
                 }
             }
         }
@@ -471,6 +496,22 @@ impl<F: Format> Slab<F> {
     /// One ray–box test through every stage, reporting each signal to the probe.
     #[inline(always)]
     pub fn trace<P: Probe<F::V>>(&self, r: &SlabRay<F::V>, b: &Aabb<F::V>, p: &mut P) -> SlabOut<F::V> {
+        self.trace_faulty(r, b, p, &NoFault)
+    }
+
+    /// [`Slab::trace`] with every site computed by `x` (a hardware fault; [`NoFault`] is the
+    /// datapath itself). Sites are the stage table's signal names: arithmetic `lox` … `hiz`,
+    /// `tlox` … `thiz`; logic `negx`, `negy`, `negz` and `guard_sub`; compare `tn_x`, `tn_xy`,
+    /// `tn_xyz`, `tf_x`, `tf_xy`, `tf_xyz` (the compare-selects) and `hit`; grid steps `t_near`,
+    /// `t_far` (each widening step). The directed variant has no fault sites (it ignores `x`).
+    #[inline(always)]
+    pub fn trace_faulty<P: Probe<F::V>, X: Fault<F>>(
+        &self,
+        r: &SlabRay<F::V>,
+        b: &Aabb<F::V>,
+        p: &mut P,
+        x: &X,
+    ) -> SlabOut<F::V> {
         if self.cfg.directed {
             return self.trace_directed(r, b, p);
         }
@@ -479,50 +520,49 @@ impl<F: Format> Slab<F> {
         let [ix, iy, iz] = r.inv_d;
         // stage 1: six subtracts (guarded in the conservative variant)
         let g = self.guard_layout();
-        let lox = self.sub_guarded(g, b.min[0], ox);
-        let hix = self.sub_guarded(g, b.max[0], ox);
-        let loy = self.sub_guarded(g, b.min[1], oy);
-        let hiy = self.sub_guarded(g, b.max[1], oy);
-        let loz = self.sub_guarded(g, b.min[2], oz);
-        let hiz = self.sub_guarded(g, b.max[2], oz);
+        let lox = self.sub_guarded(x, g, "lox", b.min[0], ox);
+        let hix = self.sub_guarded(x, g, "hix", b.max[0], ox);
+        let loy = self.sub_guarded(x, g, "loy", b.min[1], oy);
+        let hiy = self.sub_guarded(x, g, "hiy", b.max[1], oy);
+        let loz = self.sub_guarded(x, g, "loz", b.min[2], oz);
+        let hiz = self.sub_guarded(x, g, "hiz", b.max[2], oz);
         record!(p; lox, hix, loy, hiy, loz, hiz);
         // stage 2: six multiplies
-        let tlox = f.mul(lox, ix);
-        let thix = f.mul(hix, ix);
-        let tloy = f.mul(loy, iy);
-        let thiy = f.mul(hiy, iy);
-        let tloz = f.mul(loz, iz);
-        let thiz = f.mul(hiz, iz);
+        let mul = |s, a, b| x.arith(f, s, Op::Mul, a, b);
+        let tlox = mul("tlox", lox, ix);
+        let thix = mul("thix", hix, ix);
+        let tloy = mul("tloy", loy, iy);
+        let thiy = mul("thiy", hiy, iy);
+        let tloz = mul("tloz", loz, iz);
+        let thiz = mul("thiz", hiz, iz);
         record!(p; tlox, thix, tloy, thiy, tloz, thiz);
         // stage 3: near/far by the sign bit of inv_d
-        let (negx, negy, negz) = (f.sign_bit(ix), f.sign_bit(iy), f.sign_bit(iz));
+        let negx = x.flag("negx", f.sign_bit(ix));
+        let negy = x.flag("negy", f.sign_bit(iy));
+        let negz = x.flag("negz", f.sign_bit(iz));
         let (nearx, farx) = if negx { (thix, tlox) } else { (tlox, thix) };
         let (neary, fary) = if negy { (thiy, tloy) } else { (tloy, thiy) };
         let (nearz, farz) = if negz { (thiz, tloz) } else { (tloz, thiz) };
         record_flags!(p; negx, negy, negz);
         record!(p; nearx, farx, neary, fary, nearz, farz);
         // stage 4: the compare unit, accumulating from tmin / tmax in axis order x, y, z
-        let tn_x = self.near_sel(r.tmin, nearx);
-        let tn_xy = self.near_sel(tn_x, neary);
-        let tn_xyz = self.near_sel(tn_xy, nearz);
-        let tf_x = self.far_sel(r.tmax, farx);
-        let tf_xy = self.far_sel(tf_x, fary);
-        let tf_xyz = self.far_sel(tf_xy, farz);
+        let tn_x = self.near_sel(x, "tn_x", r.tmin, nearx);
+        let tn_xy = self.near_sel(x, "tn_xy", tn_x, neary);
+        let tn_xyz = self.near_sel(x, "tn_xyz", tn_xy, nearz);
+        let tf_x = self.far_sel(x, "tf_x", r.tmax, farx);
+        let tf_xy = self.far_sel(x, "tf_xy", tf_x, fary);
+        let tf_xyz = self.far_sel(x, "tf_xyz", tf_xy, farz);
         record!(p; tn_x, tn_xy, tn_xyz, tf_x, tf_xy, tf_xyz);
         // stage 5: widening (conservative variants): t_near toward −∞, t_far toward +∞
         let (mut t_near, mut t_far) = (tn_xyz, tf_xyz);
+        let wide = self.cfg.widen_ulps > 0;
         for _ in 0..self.cfg.widen_ulps.unsigned_abs() {
-            if self.cfg.widen_ulps > 0 {
-                t_near = f.next_down(t_near);
-                t_far = f.next_up(t_far);
-            } else {
-                t_near = f.next_up(t_near);
-                t_far = f.next_down(t_far);
-            }
+            t_near = x.step(f, "t_near", !wide, t_near);
+            t_far = x.step(f, "t_far", wide, t_far);
         }
         record!(p; t_near, t_far);
         // stage 6: decision
-        let hit = f.le(t_near, t_far);
+        let hit = x.compare(f, "hit", Cmp::Le, t_near, t_far);
         record_flags!(p; hit);
         SlabOut { hit, t_near, t_far }
     }
@@ -596,8 +636,8 @@ impl<F: Format> Slab<F> {
                 p.value(["entry_x", "entry_y", "entry_z"][a], t_entry);
                 p.value(["exit_x", "exit_y", "exit_z"][a], t_exit);
             }
-            near = self.near_sel(near, t_entry);
-            far = self.far_sel(far, t_exit);
+            near = self.near_sel(&NoFault, "", near, t_entry);
+            far = self.far_sel(&NoFault, "", far, t_exit);
         }
         let (t_near, t_far) = (near, far);
         record!(p; t_near, t_far);

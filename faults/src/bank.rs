@@ -39,8 +39,42 @@ pub enum Kind {
     Strict,
     /// The compare site is loose where it should be strict (a < b computed as a ≤ b).
     Loose,
-    /// The compare site's output is stuck at this value (a check left out, or tied off).
+    /// The compare or logic site's output is stuck at this value (a check left out, a
+    /// select tied off).
     Stuck(bool),
+    /// The compare site's tie goes the other way (a < b computed as a ≤ b, a ≤ b as a < b):
+    /// a compare-select that takes the new operand on a tie where it should keep the held one,
+    /// or the reverse.
+    TieSwap,
+    /// The compare site is true when an operand is NaN (the compare written as the negation
+    /// of the opposite compare, `!(b <= a)` for `a < b`): the NaN handling of a select inverted.
+    Unordered,
+    /// The grid-step site passes its input through (the widening stage bypassed).
+    Bypass,
+    /// The grid-step site adds (nextUp) or subtracts (nextDown) one on the encoding as an
+    /// unsigned integer, wrapping in the format's width: right for positive numbers, the wrong
+    /// way for negative ones, ±0 and ±∞ step into the other sign or a NaN.
+    TwosStep,
+}
+
+/// When a fault changes no output, and why.
+#[derive(Clone, Copy, Debug)]
+pub enum Benign {
+    /// On every input of every configuration of its unit.
+    Always(&'static str),
+    /// On every input of the named slab variants (the argument holds there only).
+    InVariants(&'static [&'static str], &'static str),
+}
+
+impl Benign {
+    /// The argument, when the fault is benign in the configuration of slab variant `variant`
+    /// (`None` for units without variants).
+    pub fn applies(&self, variant: Option<&str>) -> Option<&'static str> {
+        match *self {
+            Benign::Always(why) => Some(why),
+            Benign::InVariants(v, why) => variant.filter(|x| v.contains(x)).map(|_| why),
+        }
+    }
 }
 
 /// One fault of the bank.
@@ -48,7 +82,7 @@ pub enum Kind {
 pub struct Spec {
     /// Unique name: `unit.site.kind`.
     pub name: &'static str,
-    /// The unit it is injected into (`rti`).
+    /// The unit it is injected into (`rti`, `slab`).
     pub unit: &'static str,
     /// The site it changes (a signal name of the unit's stage table).
     pub site: &'static str,
@@ -56,14 +90,32 @@ pub struct Spec {
     pub kind: Kind,
     /// The RTL bug it stands for, in one line.
     pub what: &'static str,
-    /// When the outputs (valid, hit, t, u, v) are identical to the fault-free unit's on every
-    /// input: the argument. Such a fault may still show on a stage probe.
-    pub benign: Option<&'static str>,
+    /// When the unit's outputs (rti: valid, hit, t, u, v; slab: hit, t_near, t_far) are
+    /// identical to the fault-free unit's on every input: where, and the argument. Such a
+    /// fault may still show on a stage probe.
+    pub benign: Option<Benign>,
 }
 
 const fn rti(name: &'static str, site: &'static str, kind: Kind, what: &'static str) -> Spec {
     Spec { name, unit: "rti", site, kind, what, benign: None }
 }
+
+const fn slab(name: &'static str, site: &'static str, kind: Kind, what: &'static str) -> Spec {
+    Spec { name, unit: "slab", site, kind, what, benign: None }
+}
+
+const fn slab_benign(name: &'static str, site: &'static str, kind: Kind, what: &'static str, b: Benign) -> Spec {
+    Spec { name, unit: "slab", site, kind, what, benign: Some(b) }
+}
+
+/// Where a slab fault that only flips the sign of a zero t_near / t_far is benign: the
+/// conservative variant's widening maps +0 and −0 to the same value (4 steps toward −∞ from
+/// either zero is the 4th negative value, toward +∞ the 4th positive one), and the decision
+/// compares the widened values.
+const ZERO_SIGN_WIDENED: Benign = Benign::InVariants(
+    &["conservative"],
+    "the fault changes only the sign of a zero: a tie of two numbers is a tie of equal encodings except +0 against -0; t_near and t_far are then widened by 4 grid steps, and 4 steps from +0 or from -0 give the same value, so hit, t_near and t_far are unchanged",
+);
 
 /// Every fault of the bank.
 pub const BANK: &[Spec] = &[
@@ -145,17 +197,81 @@ pub const BANK: &[Spec] = &[
         site: "pos",
         kind: Kind::Loose,
         what: "stage 7: the det sign select tests 0 ≤ det instead of 0 < det",
-        benign: Some(
+        benign: Some(Benign::Always(
             "the selects differ only when det is ±0, and then det_ok is false (the threshold is ≥ 0, \
              so neither thr < |±0| nor thr < ±0 holds), valid and hit are false whatever the selects \
              give, and t, u, v do not read them; the u_ok, v_ok, uv_ok, t_ok probes do show it",
-        ),
+        )),
     },
     rti("rti.t_ok.stuck1", "t_ok", Kind::Stuck(true), "stage 7: the t' ≥ 0 check left out (hits behind the origin)"),
     rti("rti.uv_ok.stuck1", "uv_ok", Kind::Stuck(true), "stage 7: the u' + v' ≤ det check left out"),
     rti("rti.det_ok.stuck1", "det_ok", Kind::Stuck(true), "stage 7: the det threshold check left out"),
     rti("rti.tmax_ok.stuck1", "tmax_ok", Kind::Stuck(true), "t interval: the tmax compare tied off"),
     rti("rti.tmin_ok.stuck1", "tmin_ok", Kind::Stuck(true), "t interval: the tmin compare tied off"),
+    slab("slab.lox.swap", "lox", Kind::Swap, "stage 1: lo.x wired as o.x − min.x (operand order of one subtractor)"),
+    slab("slab.hiz.swap", "hiz", Kind::Swap, "stage 1: hi.z wired as o.z − max.z"),
+    slab("slab.hiy.first", "hiy", Kind::FirstTwice, "stage 1: hi.y = max.y − max.y (the second operand mux selects the first)"),
+    slab("slab.thix.first", "thix", Kind::FirstTwice, "stage 2: t_hi.x = hi.x × hi.x instead of hi.x × inv_d.x"),
+    slab("slab.tloy.rz", "tloy", Kind::Round(Mode::TowardZero), "stage 2: multiplier t_lo.y truncates (rounds toward zero)"),
+    slab("slab.thiz.rup", "thiz", Kind::Round(Mode::TowardPositive), "stage 2: multiplier t_hi.z rounds toward +∞"),
+    slab("slab.loz.rdn", "loz", Kind::Round(Mode::TowardNegative), "stage 1: subtractor lo.z rounds toward −∞"),
+    slab("slab.hix.rna", "hix", Kind::Round(Mode::NearestTiesToAway), "stage 1: subtractor hi.x rounds half away from zero"),
+    slab("slab.tlox.rna", "tlox", Kind::Round(Mode::NearestTiesToAway), "stage 2: multiplier t_lo.x rounds half away from zero"),
+    slab("slab.inv_dx.rz", "inv_dx", Kind::Round(Mode::TowardZero), "stage 0: reciprocal 1/d.x truncates"),
+    slab_benign(
+        "slab.inv_dz.rna",
+        "inv_dz",
+        Kind::Round(Mode::NearestTiesToAway),
+        "stage 0: reciprocal 1/d.z rounds half away from zero",
+        Benign::Always(
+            "1/d has a finite binary expansion only when |d| is a power of two (an odd significand factor m > 1 makes 1/m periodic), and then 1/d = ±2^k is representable, overflows (both modes give ±inf) or would be half the least subnormal, which needs |d| = 2^(emax+M) > max (binary32, binary16, bfloat16): 1/d is never exactly halfway, and ties-away agrees with ties-to-even; zeros, infinities and NaN give the same special results",
+        ),
+    ),
+    slab_benign(
+        "slab.inv_dy.ftz",
+        "inv_dy",
+        Kind::Flush,
+        "stage 0: reciprocal 1/d.y flushes a subnormal result to zero (a huge d)",
+        Benign::InVariants(
+            &["conservative"],
+            "the guard turns a reciprocal of a finite nonzero d that is subnormal or zero into the canonical NaN alike, so flushing a subnormal 1/d first changes nothing",
+        ),
+    ),
+    slab("slab.loy.ftz", "loy", Kind::Flush, "stage 1: subtractor lo.y flushes a subnormal difference to zero"),
+    slab("slab.tloz.ftz", "tloz", Kind::Flush, "stage 2: multiplier t_lo.z flushes a subnormal product to zero"),
+    slab("slab.negx.stuck0", "negx", Kind::Stuck(false), "stage 3: the x near/far select ignores the sign of 1/d.x (select tied to 0)"),
+    slab("slab.negz.stuck1", "negz", Kind::Stuck(true), "stage 3: the z near/far select always swaps (select tied to 1)"),
+    slab_benign(
+        "slab.tn_x.tie",
+        "tn_x",
+        Kind::TieSwap,
+        "stage 4: the first near compare-select (against tmin) breaks a tie the other way",
+        ZERO_SIGN_WIDENED,
+    ),
+    slab_benign(
+        "slab.tf_xyz.tie",
+        "tf_xyz",
+        Kind::TieSwap,
+        "stage 4: the last far compare-select breaks a tie the other way",
+        ZERO_SIGN_WIDENED,
+    ),
+    slab("slab.tn_xy.nan", "tn_xy", Kind::Unordered, "stage 4: the y near compare-select's NaN handling inverted (the compare written as the negation of the opposite one)"),
+    slab("slab.tf_x.nan", "tf_x", Kind::Unordered, "stage 4: the x far compare-select's NaN handling inverted"),
+    slab("slab.hit.strict", "hit", Kind::Strict, "stage 6: t_near ≤ t_far tested as t_near < t_far (touching and zero-extent boxes missed)"),
+    slab("slab.guard_sub.stuck0", "guard_sub", Kind::Stuck(false), "conservative guard: the overflowed-subtract check left out"),
+    slab("slab.guard_recip.stuck0", "guard_recip", Kind::Stuck(false), "conservative guard: the non-normal-reciprocal check left out"),
+    slab("slab.t_near.bypass", "t_near", Kind::Bypass, "stage 5: t_near's widening bypassed (its mux select tied)"),
+    slab("slab.t_far.twos", "t_far", Kind::TwosStep, "stage 5: t_far's nextUp adds one to the encoding (wrong way for negative values)"),
+    slab_benign(
+        "slab.pdx.loose",
+        "pdx",
+        Kind::Loose,
+        "embree: |d.x| < δ tested as |d.x| ≤ δ",
+        Benign::Always(
+            "the compare differs only at |d.x| = δ, where the replacement (+δ, or −δ = 0 − δ for a negative d.x) is d.x itself, bit for bit",
+        ),
+    ),
+    slab("slab.pdy_sign.stuck0", "pdy_sign", Kind::Stuck(false), "embree: the replacement's sign select tied to 0 (a small negative or −0 d.y becomes +δ)"),
 ];
 
 /// The fault named `name`.

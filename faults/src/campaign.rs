@@ -1,15 +1,17 @@
 //! A fault campaign: every fault of the bank for a unit, injected into the stage model, run on
-//! every input row of a vector set; a fault is detected when some vector's outputs (valid,
-//! hit, t, u, v), or with probes any stage signal, differ from the set's expected rows. The set
-//! must first match the fault-free model (else the campaign would measure another model).
+//! every input row of a vector set; a fault is detected when some vector's outputs (rti:
+//! valid, hit, t, u, v; slab: hit, t_near, t_far), or with probes any stage signal, differ from
+//! the set's expected rows. The set must first match the fault-free model (else the campaign
+//! would measure another model).
 
 use crate::bank::{Spec, BANK};
 use crate::inject::Injected;
-use datapath::fault::NoFault;
+use datapath::fault::{Fault, NoFault};
 use datapath::rti::Rti;
-use datapath::{with_format, AnyFormat};
+use datapath::slab::Slab;
+use datapath::{with_format, AnyFormat, Format};
 use serde::Serialize;
-use vectors::gen::{rti_case_of, rti_out_rows};
+use vectors::gen::{rti_case_of, rti_out_rows, slab_out_rows};
 use vectors::manifest::Manifest;
 
 /// What the campaign found for one fault.
@@ -21,8 +23,10 @@ pub struct Outcome {
     pub site: &'static str,
     /// The RTL bug it stands for.
     pub what: &'static str,
-    /// Its outputs equal the fault-free unit's on every input (the argument is in the bank).
+    /// Its outputs equal the fault-free unit's on every input of this configuration.
     pub benign: bool,
+    /// Why, when it is benign.
+    pub benign_why: Option<&'static str>,
     /// The fault applies: its site exists in this unit's configuration and the fault is
     /// modelled in this format.
     pub applicable: bool,
@@ -75,7 +79,26 @@ impl Campaign {
 }
 
 /// The units with fault models.
-pub const UNITS: [&str; 1] = ["rti"];
+pub const UNITS: [&str; 2] = ["rti", "slab"];
+
+/// The stage model of a set's unit.
+enum Model<F: Format> {
+    Rti(Rti<F>),
+    Slab(Slab<F>),
+}
+
+impl<F: Format> Model<F> {
+    /// The expected and stage rows of input row `bits` (without its class) with fault `x`.
+    fn rows<X: Fault<F>>(&self, bits: &[u64], x: &X) -> [Vec<u64>; 2] {
+        match self {
+            Model::Rti(rti) => {
+                let (ray, tri) = rti_case_of(&rti.fmt, bits);
+                rti_out_rows(rti, &ray, &tri, x)
+            }
+            Model::Slab(slab) => slab_out_rows(slab, bits, x),
+        }
+    }
+}
 
 /// Runs the bank of the set's unit over the set (`rows`: its files' rows in manifest order).
 pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<Campaign, String> {
@@ -83,7 +106,7 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
         return Err(format!("unit {} has no fault models yet (units with a bank: {})", m.unit, UNITS.join(", ")));
     }
     let any: AnyFormat = m.format.parse().map_err(|e| format!("manifest.json: field format: {e}"))?;
-    let cfg = vectors::gen::rti_config_from(m)?;
+    let variant = (m.unit == "slab").then(|| m.options.get("variant").map_or("plain", |v| v.as_str()));
     let bank: Vec<&Spec> = BANK.iter().filter(|s| s.unit == m.unit).collect();
     let (inputs, expected, stages) = match rows {
         [i, e, s, ..] => (i, e, s),
@@ -96,7 +119,8 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
             name: s.name,
             site: s.site,
             what: s.what,
-            benign: s.benign.is_some(),
+            benign: s.benign.and_then(|b| b.applies(variant)).is_some(),
+            benign_why: s.benign.and_then(|b| b.applies(variant)),
             applicable: true,
             not_applicable: None,
             detected: false,
@@ -108,13 +132,15 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
         })
         .collect();
     with_format!(any, |f| {
-        let rti = Rti::new(f, cfg);
+        let model = match m.unit.as_str() {
+            "rti" => Model::Rti(Rti::new(f, vectors::gen::rti_config_from(m)?)),
+            _ => Model::Slab(Slab::new(f, vectors::gen::slab_config_from(m)?)),
+        };
         let injected: Vec<Injected> = bank.iter().map(|s| Injected::new(s)).collect();
         for (i, input) in inputs.iter().enumerate() {
             let class = input[0];
-            let (ray, tri) = rti_case_of(&f, &input[1..]);
             // the set is the fault-free model's
-            if rti_out_rows(&rti, &ray, &tri, &NoFault) != [&expected[i][..], &stages[i][..]] {
+            if model.rows(&input[1..], &NoFault) != [&expected[i][..], &stages[i][..]] {
                 return Err(format!(
                     "vector {} (input row {}): the set's expected rows differ from this raypipe's model; check the set with `raypipe vectors --check`",
                     i,
@@ -123,7 +149,7 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
             }
             for (x, o) in injected.iter().zip(outcomes.iter_mut()) {
                 x.next_test();
-                let [fo, fp] = rti_out_rows(&rti, &ray, &tri, x);
+                let [fo, fp] = model.rows(&input[1..], x);
                 if fo != expected[i] || (!outputs_only && fp != stages[i]) {
                     o.vectors += 1;
                     o.catching.push(i);

@@ -77,7 +77,7 @@ impl<F: Format> Fault<F> for Injected {
                 FormatKind::Float(_) => r,
                 _ => self.hit(r, None),
             },
-            Kind::Strict | Kind::Loose | Kind::Stuck(_) => r,
+            _ => r,
         }
     }
     fn compare(&self, f: &F, site: &'static str, cmp: Cmp, a: F::V, b: F::V) -> bool {
@@ -90,6 +90,40 @@ impl<F: Format> Fault<F> for Injected {
             Kind::Strict => f.lt(a, b),
             Kind::Loose => f.le(a, b),
             Kind::Stuck(v) => v,
+            Kind::TieSwap => match cmp {
+                Cmp::Lt => f.le(a, b),
+                Cmp::Le => f.lt(a, b),
+            },
+            Kind::Unordered => r || f.is_nan(a) || f.is_nan(b),
+            _ => r,
+        }
+    }
+    fn flag(&self, site: &'static str, v: bool) -> bool {
+        if site != self.spec.site {
+            return v;
+        }
+        self.reached.set(true);
+        match self.spec.kind {
+            Kind::Stuck(s) => s,
+            _ => v,
+        }
+    }
+    fn step(&self, f: &F, site: &'static str, up: bool, v: F::V) -> F::V {
+        let r = if up { f.next_up(v) } else { f.next_down(v) };
+        if site != self.spec.site {
+            return r;
+        }
+        self.reached.set(true);
+        match self.spec.kind {
+            Kind::Bypass => v,
+            Kind::TwosStep => match f.kind() {
+                FormatKind::Float(_) => {
+                    let mask = u64::MAX >> (64 - f.width());
+                    let b = f.to_bits(v);
+                    f.from_bits(if up { b.wrapping_add(1) } else { b.wrapping_sub(1) } & mask)
+                }
+                _ => self.hit(r, None),
+            },
             _ => r,
         }
     }

@@ -3,8 +3,10 @@
 
 use datapath::fault::{Cmp, Fault, NoFault};
 use datapath::format::{F32Native, FpOpts, Ieee};
+use datapath::probe::NoProbe;
 use datapath::rng::SplitMix64;
 use datapath::rti::{Op, Ray, Rti, RtiConfig, Tri};
+use datapath::slab::{Aabb, Slab, SlabConfig};
 use datapath::Format;
 use faults::bank::{by_name, Kind, BANK};
 use faults::inject::Injected;
@@ -24,7 +26,39 @@ fn every_fault_has_a_unique_name_a_site_and_a_description() {
         assert!(s.name.starts_with(&format!("{}.{}.", s.unit, s.site)), "{}: name is unit.site.kind", s.name);
         assert!(!s.what.is_empty());
     }
-    assert!(BANK.len() >= 30);
+    assert!(BANK.len() >= 55);
+    for unit in ["rti", "slab"] {
+        assert!(BANK.iter().filter(|s| s.unit == unit).count() >= 20, "{unit}");
+    }
+}
+
+/// Slab outputs (hit, t_near bits, t_far bits) of one test with fault `x`.
+fn slab_out<F: Format, X: Fault<F>>(s: &Slab<F>, v: &[f64; 14], x: &X) -> (bool, u64, u64) {
+    let f = &s.fmt;
+    let q = |i: usize| f.from_f64(v[i]);
+    let ray = s.prepare_faulty([q(0), q(1), q(2)], [q(3), q(4), q(5)], q(6), q(7), &mut NoProbe, x);
+    let b = Aabb { min: [q(8), q(9), q(10)], max: [q(11), q(12), q(13)] };
+    let o = s.trace_faulty(&ray, &b, &mut NoProbe, x);
+    (o.hit, f.to_bits(o.t_near), f.to_bits(o.t_far))
+}
+
+/// A slab input of random values in [-2, 2] with one in four an edge value (zeros of both
+/// signs, ±1, ±inf, NaN, subnormal, huge), origins sometimes on a face plane.
+fn slab_input(r: &mut SplitMix64) -> [f64; 14] {
+    let edge = [0.0f64, -0.0, 1.0, -1.0, f64::INFINITY, f64::NEG_INFINITY, f64::NAN, 1e-40, -3e38, 6e-39];
+    let val = |r: &mut SplitMix64| if r.below(4) == 0 { edge[r.below(10) as usize] } else { r.range(-2.0, 2.0) };
+    let mut v: [f64; 14] = std::array::from_fn(|_| val(r));
+    for a in 0..3 {
+        if v[8 + a] > v[11 + a] {
+            v.swap(8 + a, 11 + a);
+        }
+        match r.below(4) {
+            0 => v[a] = v[8 + a],
+            1 => v[a] = v[11 + a],
+            _ => {}
+        }
+    }
+    v
 }
 
 /// The value of `a × b` in binary32 rounded toward zero, from the exact binary64 product.
@@ -114,4 +148,110 @@ fn faults_outside_the_exact_formats_say_so() {
     let r = Fault::arith(&x, &f, "pxa", Op::Mul, one, one);
     assert_eq!(f.to_bits(r), f.to_bits(f.mul(one, one)), "the fault-free value stands in");
     assert!(x.unmodelled());
+}
+
+/// The argument of `slab.inv_dz.rna`, checked on every binary16 and bfloat16 divisor and on
+/// 2^20 binary32 ones (random bits and every power of two): 1 ⊘ d rounded half away from zero
+/// (rustc_apfloat) equals the datapath's nearest-even reciprocal.
+#[test]
+fn a_reciprocal_is_never_a_tie() {
+    fn check<F: Format>(f: F, bits: impl Iterator<Item = u64>) {
+        let x = Injected::new(by_name("slab.inv_dz.rna").unwrap());
+        for b in bits {
+            let d = f.from_bits(b);
+            let got = Fault::arith(&x, &f, "inv_dz", Op::Div, f.one(), d);
+            assert_eq!(f.to_bits(got), f.to_bits(f.div(f.one(), d)), "{} d = {b:#x}", f.name());
+        }
+        assert!(!x.unmodelled());
+    }
+    let any = |n: &str| n.parse::<datapath::AnyFormat>().unwrap();
+    datapath::with_format!(any("fp16"), |f| check(f, 0..1 << 16));
+    datapath::with_format!(any("bf16"), |f| check(f, 0..1 << 16));
+    let mut r = SplitMix64::new(7);
+    let pow2 = (0..256u64).flat_map(|e| [e << 23, (e << 23) | 1 << 31]);
+    check(f32f(), (0..1 << 20).map(move |_| r.next_u64() & 0xffff_ffff).chain(pow2));
+}
+
+proptest! {
+    /// The zero-sign argument: the tie faults change t_near / t_far only by the sign of a zero,
+    /// which the conservative variant's widening erases (outputs identical there).
+    #[test]
+    fn slab_tie_faults_flip_only_zero_signs(seed in any::<u64>()) {
+        let f = f32f();
+        let mut r = SplitMix64::new(seed);
+        for name in ["slab.tn_x.tie", "slab.tf_xyz.tie"] {
+            let x = Injected::new(by_name(name).unwrap());
+            for variant in ["plain", "conservative", "take-on-false"] {
+                let s = Slab::new(f, SlabConfig::named(variant).unwrap());
+                for _ in 0..64 {
+                    let v = slab_input(&mut r);
+                    let (a, b) = (slab_out(&s, &v, &NoFault), slab_out(&s, &v, &x));
+                    if variant == "conservative" {
+                        prop_assert_eq!(a, b, "{} {:?}", name, v);
+                    } else {
+                        let zero_pair = |p: u64, q: u64| p == q || (p | q) & 0x7fff_ffff == 0;
+                        prop_assert!(a.0 == b.0 && zero_pair(a.1, b.1) && zero_pair(a.2, b.2), "{} {} {:?}", name, variant, v);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The guard argument of `slab.inv_dy.ftz` (conservative) and the equality argument of
+    /// `slab.pdx.loose` (embree): no output changes, with huge and tiny direction components
+    /// and |d.x| = δ among the inputs.
+    #[test]
+    fn the_conditionally_benign_slab_faults_change_no_output(seed in any::<u64>()) {
+        let f = f32f();
+        let mut r = SplitMix64::new(seed);
+        let flush = Injected::new(by_name("slab.inv_dy.ftz").unwrap());
+        let loose = Injected::new(by_name("slab.pdx.loose").unwrap());
+        let (cons, embree) = (Slab::new(f, SlabConfig::named("conservative").unwrap()), Slab::new(f, SlabConfig::named("embree").unwrap()));
+        let delta = f.to_f64(embree.delta());
+        for _ in 0..64 {
+            let mut v = slab_input(&mut r);
+            v[4] = [3e38, -2.9e38, 1e38, r.range(-2.0, 2.0)][r.below(4) as usize];
+            v[3] = [delta, -delta, f.to_f64(f.next_up(embree.delta())), r.range(-1.0, 1.0)][r.below(4) as usize];
+            prop_assert_eq!(slab_out(&cons, &v, &NoFault), slab_out(&cons, &v, &flush), "{:?}", v);
+            prop_assert_eq!(slab_out(&embree, &v, &NoFault), slab_out(&embree, &v, &loose), "{:?}", v);
+        }
+        prop_assert!(flush.reached() && loose.reached());
+    }
+}
+
+/// A plain slab test where the first near select ties: origin on the x entry face (near.x =
+/// +0) against tmin = -0; the tie fault takes +0.
+#[test]
+fn the_tie_fault_shows_outside_the_conservative_variant() {
+    let f = f32f();
+    let s = Slab::new(f, SlabConfig::named("plain").unwrap());
+    let v = [0.0, 0.5, 0.5, 1.0, 0.25, 0.25, -0.0, f64::INFINITY, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
+    let x = Injected::new(by_name("slab.tn_x.tie").unwrap());
+    assert_eq!(slab_out(&s, &v, &NoFault).1, (-0.0f32).to_bits() as u64);
+    assert_eq!(slab_out(&s, &v, &x).1, 0.0f32.to_bits() as u64);
+}
+
+#[test]
+fn step_select_and_nan_faults_do_what_they_say() {
+    let f = f32f();
+    // two's complement step: right for positive values, toward zero for negative ones
+    let twos = Injected::new(by_name("slab.t_far.twos").unwrap());
+    assert_eq!(Fault::step(&twos, &f, "t_far", true, 1.0f32), f.next_up(1.0f32));
+    assert_eq!(Fault::step(&twos, &f, "t_far", true, -1.0f32).to_bits(), (-1.0f32).to_bits() + 1);
+    assert!(Fault::step(&twos, &f, "t_far", true, -1.0f32) < -1.0);
+    assert!(Fault::step(&twos, &f, "t_far", true, f32::INFINITY).is_nan());
+    assert_eq!(Fault::step(&twos, &f, "t_near", false, -1.0f32), f.next_down(-1.0f32));
+    let bypass = Injected::new(by_name("slab.t_near.bypass").unwrap());
+    assert_eq!(Fault::step(&bypass, &f, "t_near", false, 2.0f32), 2.0);
+    assert_eq!(Fault::step(&bypass, &f, "t_far", true, 2.0f32), f.next_up(2.0f32));
+    let nan = Injected::new(by_name("slab.tn_xy.nan").unwrap());
+    assert!(Fault::compare(&nan, &f, "tn_xy", Cmp::Lt, 1.0f32, f32::NAN));
+    assert!(!Fault::compare(&nan, &f, "tn_x", Cmp::Lt, 1.0f32, f32::NAN));
+    assert!(!Fault::compare(&nan, &f, "tn_xy", Cmp::Lt, 2.0f32, 1.0));
+    let tie = Injected::new(by_name("slab.tn_x.tie").unwrap());
+    assert!(Fault::compare(&tie, &f, "tn_x", Cmp::Lt, 1.0f32, 1.0));
+    assert!(!Fault::compare(&tie, &f, "tn_x", Cmp::Le, 1.0f32, 1.0));
+    let sel = Injected::new(by_name("slab.negz.stuck1").unwrap());
+    assert!(Fault::<datapath::format::Ieee<F32Native>>::flag(&sel, "negz", false));
+    assert!(!Fault::<datapath::format::Ieee<F32Native>>::flag(&sel, "negx", false));
 }
