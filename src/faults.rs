@@ -32,10 +32,16 @@ pub fn render(c: &Campaign) -> String {
         c.set_command,
         if !c.outputs_only {
             "outputs and every stage probe"
-        } else if c.unit == "slab" {
-            "outputs only (hit, t_near, t_far)"
         } else {
-            "outputs only (valid, hit, t, u, v)"
+            match c.unit.as_str() {
+                "slab" => "outputs only (hit, t_near, t_far)",
+                "capture" => "outputs only (hit, t, u, v, id)",
+                "op" => "outputs (result, cmp; the unit has no stage probes)",
+                "traverse" => {
+                    "outputs only (count, leaves, final history; not the implementation-defined passes and box tests)"
+                }
+                _ => "outputs only (valid, hit, t, u, v)",
+            }
         }
     );
     s += &format!("{:<24} {:<10} {:>8}  {:<16} what\n", "fault", "detected", "vectors", "first class");

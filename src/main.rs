@@ -241,7 +241,7 @@ enum Cmd {
     },
     /// Write a self-describing vector set for RTL testbenches (or check one with --check).
     Vectors {
-        /// Unit: rti, slab, op or traverse.
+        /// Unit: rti, slab, op, traverse or capture (the min-capture unit).
         #[arg(long, default_value = "rti")]
         unit: String,
         /// Number format (default f32, or the plan's narrowest format within its budget).
@@ -289,9 +289,13 @@ enum Cmd {
     },
     /// Run the fault bank against a vector set: which hardware bugs the set detects.
     Faults {
-        /// Unit (units with a fault bank: rti, slab).
+        /// Unit (units with a fault bank: rti, slab, capture, traverse, op).
         #[arg(long, default_value = "rti")]
         unit: String,
+        /// OBJ scene whose BVH the generated traverse set uses (default: the built-in scene;
+        /// leaf size 4, first 8 leaves).
+        #[arg(long, conflicts_with = "set")]
+        scene: Option<PathBuf>,
         /// Slab variant of the generated set (unit slab): plain, conservative, take-on-false, embree.
         #[arg(long, default_value = "plain", conflicts_with = "set")]
         variant: String,
@@ -726,15 +730,37 @@ fn run() -> Result<Outcome, String> {
             );
             Ok(Outcome::Pass)
         }
-        Some(Cmd::Faults { unit, variant, format, level, count, seed, outputs_only, set, json, threads, rti }) => {
+        Some(Cmd::Faults {
+            unit,
+            scene,
+            variant,
+            format,
+            level,
+            count,
+            seed,
+            outputs_only,
+            set,
+            json,
+            threads,
+            rti,
+        }) => {
             let c = match set {
                 Some(dir) => raypipe::faults::on_dir(&dir, outputs_only)?,
                 None => {
                     limit("--count", count, MAX_VECTOR_COUNT, "a set is built in memory")?;
                     let unit: vectors::gen::Unit = unit.parse()?;
+                    let tree = if unit == vectors::gen::Unit::Traverse {
+                        let scene = load_scene(scene.as_deref())?;
+                        let b = raypipe::bvh::build(&scene, 4);
+                        Some(vectors::traverse::TreeInput { name: scene.name.clone(), nodes: b.nodes, root: 0 })
+                    } else if scene.is_some() {
+                        return Err(format!("--scene is for unit traverse; unit {unit:?} draws its own cases"));
+                    } else {
+                        None
+                    };
                     let req = vectors::gen::Request {
                         unit,
-                        tree: None,
+                        tree,
                         leaves: 8,
                         max_levels: 64,
                         threads: threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),

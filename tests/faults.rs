@@ -106,8 +106,8 @@ fn a_written_set_gives_the_verdicts_of_the_generated_one() {
 #[test]
 fn bad_requests_are_refused_with_exit_2() {
     for args in [
-        &["faults", "--unit", "op"][..],
-        &["faults", "--unit", "nope"],
+        &["faults", "--unit", "nope"][..],
+        &["faults", "--unit", "rti", "--scene", "/nonexistent.obj"],
         &["faults", "--unit", "slab", "--variant", "directed"],
         &["faults", "--unit", "slab", "--variant", "nope"],
         &["faults", "--set", "/nonexistent/raypipe-set"],
@@ -186,4 +186,90 @@ fn the_default_slab_sets_detect_the_whole_bank_from_the_outputs() {
     assert!(applies.len() >= 25);
     let never: Vec<_> = applies.iter().filter(|(_, &a)| !a).map(|(n, _)| n).collect();
     assert!(never.is_empty(), "slab faults no variant reaches: {never:?}");
+}
+
+/// The min-capture unit's default sets detect its whole bank from the outputs (hit, t, u, v,
+/// id) under either tie rule, in f32 and fp16.
+#[test]
+fn the_default_capture_sets_detect_the_whole_bank_from_the_outputs() {
+    for tie in ["first", "last"] {
+        for fmt in ["f32", "fp16"] {
+            for seed in ["1", "2"] {
+                let o = raypipe(&[
+                    "faults",
+                    "--unit",
+                    "capture",
+                    "--tie",
+                    tie,
+                    "--format",
+                    fmt,
+                    "--seed",
+                    seed,
+                    "--outputs-only",
+                    "--json",
+                ]);
+                let v = json(&o);
+                assert_eq!(o.status.code(), Some(0), "{tie} {fmt} {seed}");
+                assert_eq!(v["escaped"], 0);
+                let faults = v["faults"].as_array().unwrap();
+                assert!(faults.len() >= 6 && faults.iter().all(|f| f["applicable"] == true && f["detected"] == true));
+            }
+        }
+    }
+}
+
+/// The traverse unit's default sets (built-in scene) detect its whole bank from the compared
+/// outputs (count, leaves, final history; not the implementation-defined passes and box tests).
+#[test]
+fn the_default_traverse_sets_detect_the_whole_bank_from_the_outputs() {
+    for fmt in ["f32", "fp16"] {
+        let o = raypipe(&["faults", "--unit", "traverse", "--format", fmt, "--outputs-only", "--json"]);
+        let v = json(&o);
+        assert_eq!(o.status.code(), Some(0), "{fmt}");
+        let faults = v["faults"].as_array().unwrap();
+        assert!(faults.len() >= 8 && faults.iter().all(|f| f["applicable"] == true && f["detected"] == true), "{fmt}");
+    }
+}
+
+/// A fault seen only in a field the kit does not compare is not a detection: the RTI t, u, v
+/// only count where valid is 1 (care_when), so with outputs only the campaign cannot detect
+/// more than with the stage probes, and every catching vector of a t-only fault is valid.
+#[test]
+fn the_campaign_compares_what_the_testbench_compares() {
+    let v = json(&raypipe(&["faults", "--format", "f32", "--count", "16", "--outputs-only", "--json"]));
+    let f = v["faults"].as_array().unwrap().iter().find(|f| f["name"] == "rti.t.rz").unwrap().clone();
+    let dir = temp_dir("care");
+    let w = raypipe(&["vectors", "--unit", "rti", "--format", "f32", "--count", "16", "--out", dir.to_str().unwrap()]);
+    assert!(w.status.success());
+    let expected = std::fs::read_to_string(dir.join("rti_expected.hex")).unwrap();
+    let rows: Vec<&str> = expected.lines().collect();
+    // valid is the most significant bit of the expected row (valid, hit, t, u, v)
+    for k in f["catching"].as_array().unwrap() {
+        let row = rows[k.as_u64().unwrap() as usize];
+        let top = u8::from_str_radix(&row[..1], 16).unwrap();
+        let width = 2 + 3 * 32;
+        let valid_bit = (width - 1) % 4;
+        assert_eq!((top >> valid_bit) & 1, 1, "vector {k} catches rti.t.rz with valid = 0");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The op unit's default sets (every pair of special operands per op code plus random ones)
+/// detect its whole applicable bank, in the default (reciprocal-multiply, canonical NaN)
+/// formats, with a true divider, and with NaN propagation (where the other rounding modes are
+/// not modelled and say so).
+#[test]
+fn the_default_op_sets_detect_the_whole_bank() {
+    for fmt in ["f32", "fp16", "f32:divide", "bf16", "fp16:propagate"] {
+        let o = raypipe(&["faults", "--unit", "op", "--format", fmt, "--json"]);
+        let v = json(&o);
+        assert_eq!(o.status.code(), Some(0), "{fmt}");
+        let faults = v["faults"].as_array().unwrap();
+        assert!(faults.len() >= 14);
+        assert!(faults.iter().all(|f| f["detected"] == true || f["applicable"] == false), "{fmt}");
+        let nan = faults.iter().find(|f| f["name"] == "op.add.nan").unwrap();
+        assert_eq!(nan["applicable"], true, "{fmt}: the NaN rule fault applies in every float format");
+        let na = faults.iter().filter(|f| f["applicable"] == false).count();
+        assert_eq!(na, if fmt.ends_with("propagate") { 6 } else { 0 }, "{fmt}");
+    }
 }

@@ -39,7 +39,7 @@ fn tmp(name: &str) -> PathBuf {
 
 #[test]
 fn every_unit_and_format_round_trips() {
-    for unit in [Unit::Rti, Unit::Slab, Unit::Op, Unit::Traverse] {
+    for unit in [Unit::Rti, Unit::Slab, Unit::Op, Unit::Traverse, Unit::Capture] {
         for format in ["f32", "fp16", "bf16", "e8m16", "q8.24:divide", "fp16:ftz"] {
             let set = generate(&req(unit, format, 6)).unwrap();
             let dir = tmp(&format!("{unit:?}-{}", format.replace(':', "_")));
@@ -66,7 +66,7 @@ fn every_unit_and_format_round_trips() {
 
 #[test]
 fn the_same_request_writes_the_same_bytes() {
-    for unit in [Unit::Rti, Unit::Slab, Unit::Op, Unit::Traverse] {
+    for unit in [Unit::Rti, Unit::Slab, Unit::Op, Unit::Traverse, Unit::Capture] {
         let a = generate(&req(unit, "fp16", 5)).unwrap();
         let b = generate(&req(unit, "fp16", 5)).unwrap();
         assert_eq!(a.files, b.files);
@@ -280,7 +280,7 @@ fn traverse_sets_cover_every_class_and_catch_bad_images() {
 
 #[test]
 fn one_and_two_threads_write_the_same_bytes() {
-    for unit in [Unit::Rti, Unit::Slab, Unit::Op, Unit::Traverse] {
+    for unit in [Unit::Rti, Unit::Slab, Unit::Op, Unit::Traverse, Unit::Capture] {
         for level in [1, 2] {
             let one = generate(&Request { level, threads: 1, ..req(unit, "f32", 5) }).unwrap();
             let two = generate(&Request { level, threads: 2, ..req(unit, "f32", 5) }).unwrap();
@@ -399,4 +399,34 @@ fn check_names_the_first_difference_in_any_file() {
     // not JSON, or a manifest without a field
     std::fs::write(&p, "{\"schema\": 2}").unwrap();
     assert!(check_set(&dir).unwrap_err().contains("manifest.json"));
+}
+
+/// The capture unit on a hand-traced leaf: hits at t = 2 (id 5), 1 (id 6), a nearer miss at
+/// 0.5 (id 7) and a tie at 1 (id 8): the tie rule `first` keeps id 6, `last` takes id 8; the
+/// miss is never taken.
+#[test]
+fn the_capture_unit_follows_its_tie_rule_on_a_hand_traced_leaf() {
+    use datapath::fault::NoFault;
+    use datapath::rti::{Rti, TieRule};
+    let f = datapath::format::Ieee::new(datapath::format::F32Native, datapath::format::FpOpts::default());
+    let b = |x: f32| x.to_bits() as u64;
+    let row = [
+        [1, b(2.0), b(0.1), b(0.2), 5],
+        [1, b(1.0), b(0.3), b(0.4), 6],
+        [0, b(0.5), b(0.5), b(0.5), 7],
+        [1, b(1.0), b(0.6), b(0.7), 8],
+    ]
+    .concat();
+    for (tie, id, u, v, takes) in
+        [(TieRule::First, 6, 0.3, 0.4, [1, 1, 0, 0]), (TieRule::Last, 8, 0.6, 0.7, [1, 1, 0, 1])]
+    {
+        let rti = Rti::new(f, RtiConfig { tie, ..RtiConfig::default() });
+        let [out, stages] = vectors::capture::out_rows(&rti, &row, &NoFault);
+        assert_eq!(out, vec![1, b(1.0), b(u), b(v), id], "{tie:?}");
+        assert_eq!(stages.len(), 4 * 6);
+        assert_eq!([stages[0], stages[6], stages[12], stages[18]], takes.map(|x: u64| x), "{tie:?}");
+        // after slot 0 the state holds t = 2, id 5; after slot 2 (the miss) still slot 1's
+        assert_eq!(&stages[1..6], &[1, b(2.0), b(0.1), b(0.2), 5]);
+        assert_eq!(&stages[13..18], &[1, b(1.0), b(0.3), b(0.4), 6]);
+    }
 }

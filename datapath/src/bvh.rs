@@ -286,36 +286,67 @@ fn addr_of<B>(t: &HwTree<B>, level: usize, idx: u32, side: usize) -> u32 {
 ///
 /// A pass ends at a leaf (emitted) or at a level with no hit. The traversal ends after N
 /// leaves or when no level is in state 10 at the end of a pass.
-pub fn history_traverse<B>(t: &HwTree<B>, n: usize, mut test: impl FnMut(&B) -> Option<f64>) -> StacklessResult {
+pub fn history_traverse<B>(t: &HwTree<B>, n: usize, test: impl FnMut(&B) -> Option<f64>) -> StacklessResult {
+    history_traverse_faulty(t, n, test, &crate::fault::NoFault)
+}
+
+/// [`history_traverse`] with its control logic computed by `x` (a hardware fault;
+/// [`crate::fault::NoFault`] is the traversal itself). Sites: the ordering `near` (the right
+/// child is nearer when its entry t < the left's), the logic bits `mark_split` (a level where
+/// both children hit goes to 10), `mark_pass` (one child hit goes to 01), `resume` (the pass
+/// resumes at the deepest 10; false: the shallowest), `reset_deeper` (after 10 → 11 the deeper
+/// levels go to 00) and `more` (a level is in 10 after the pass, so another pass follows), and
+/// the limit `n_limit` (the traversal ends after this many leaves).
+pub fn history_traverse_faulty<B, X: crate::fault::Logic>(
+    t: &HwTree<B>,
+    n: usize,
+    mut test: impl FnMut(&B) -> Option<f64>,
+    x: &X,
+) -> StacklessResult {
     let mut r = StacklessResult { state: vec![hist::NEW; t.depth()], ..Default::default() };
     if !enter(t, n, &mut test, &mut r) {
         return r;
     }
+    let n_limit = x.limit("n_limit", n);
+    // (nearer, farther) side of a pair where both children hit
+    let near_far = |el: f64, er: f64| if x.less("near", er, el) { (1, 0) } else { (0, 1) };
     let h = &mut r.state;
     let mut prev_end: Option<usize> = None;
     loop {
         r.passes += 1;
-        let resume = h.iter().rposition(|&s| s == hist::SPLIT);
+        let resume = if x.flag("resume", true) {
+            h.iter().rposition(|&s| s == hist::SPLIT)
+        } else {
+            h.iter().position(|&s| s == hist::SPLIT)
+        };
         if let (Some(end), Some(k)) = (prev_end, resume) {
-            r.back_distances.push((end - k) as u32);
+            r.back_distances.push(end.abs_diff(k) as u32);
         }
         let end = pass(t, &mut test, &mut r.box_tests, &mut r.leaves, |level, el, er| {
             match (h[level], el, er) {
                 (hist::NEW, Some(a), Some(b)) => {
-                    h[level] = hist::SPLIT;
+                    if x.flag("mark_split", true) {
+                        h[level] = hist::SPLIT;
+                    }
                     Some(near_far(a, b).0)
                 }
                 (hist::NEW, Some(_), None) | (hist::PASS, Some(_), None) => {
-                    h[level] = hist::PASS;
+                    if x.flag("mark_pass", true) {
+                        h[level] = hist::PASS;
+                    }
                     Some(0)
                 }
                 (hist::NEW, None, Some(_)) | (hist::PASS, None, Some(_)) => {
-                    h[level] = hist::PASS;
+                    if x.flag("mark_pass", true) {
+                        h[level] = hist::PASS;
+                    }
                     Some(1)
                 }
                 (hist::SPLIT, Some(a), Some(b)) if resume == Some(level) => {
                     h[level] = hist::DONE;
-                    h[level + 1..].fill(hist::NEW);
+                    if x.flag("reset_deeper", true) {
+                        h[level + 1..].fill(hist::NEW);
+                    }
                     Some(near_far(a, b).1)
                 }
                 (hist::SPLIT, Some(a), Some(b)) => Some(near_far(a, b).0),
@@ -326,7 +357,7 @@ pub fn history_traverse<B>(t: &HwTree<B>, n: usize, mut test: impl FnMut(&B) -> 
             }
         });
         prev_end = Some(end);
-        if r.leaves.len() == n || !h.contains(&hist::SPLIT) {
+        if r.leaves.len() >= n_limit || !x.flag("more", h.contains(&hist::SPLIT)) {
             break;
         }
     }

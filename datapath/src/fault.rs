@@ -3,7 +3,8 @@
 //! `e1x`, `pxa`, `det_xy`, `inv_det`, `t`, …) and every compare site (`det_ok`, `pos`, `u_ok`,
 //! `v_ok`, `uv_ok`, `t_ok`, `tmin_ok`, `tmax_ok`, and the min-capture unit's `take`), every
 //! logic bit that steers the datapath (the slab unit's sign selects `negx`…, its guard
-//! decisions) and every grid step (the slab unit's widening); with [`NoFault`]
+//! decisions, the traversal's history updates, [`Logic`]) and every grid step (the slab unit's
+//! widening); with [`NoFault`]
 //! (`ON == false`) each call is the format's own operation and the model's code is what it
 //! was without the hook. The fault models themselves (which site, which bug) live
 //! in the `faults` crate.
@@ -44,8 +45,30 @@ pub fn fault_free<F: Format>(f: &F, op: Op, a: F::V, b: F::V) -> F::V {
     }
 }
 
+/// What a unit's control logic computes: the bits that steer it, the orderings of the
+/// distances it holds, the limits it counts to; fault-free, or with a bug. Every method's
+/// default is the fault-free logic.
+pub trait Logic {
+    /// The bit logic site `site` produces where the fault-free logic produces `v`.
+    #[inline(always)]
+    fn flag(&self, _site: &'static str, v: bool) -> bool {
+        v
+    }
+    /// The ordering site `site`: `a < b` on distances held as binary64 (false when either is
+    /// NaN).
+    #[inline(always)]
+    fn less(&self, _site: &'static str, a: f64, b: f64) -> bool {
+        a < b
+    }
+    /// The limit counting site `site` compares with, where the fault-free logic uses `v`.
+    #[inline(always)]
+    fn limit(&self, _site: &'static str, v: usize) -> usize {
+        v
+    }
+}
+
 /// What a model's sites compute: the fault-free datapath, or one with a bug.
-pub trait Fault<F: Format> {
+pub trait Fault<F: Format>: Logic {
     /// False for [`NoFault`].
     const ON: bool;
     /// The value arithmetic site `site` produces from its operands (`op` names the
@@ -53,11 +76,6 @@ pub trait Fault<F: Format> {
     fn arith(&self, f: &F, site: &'static str, op: Op, a: F::V, b: F::V) -> F::V;
     /// The bit compare site `site` produces (fault-free: `cmp.eval(f, a, b)`).
     fn compare(&self, f: &F, site: &'static str, cmp: Cmp, a: F::V, b: F::V) -> bool;
-    /// The bit logic site `site` produces where the fault-free datapath produces `v`.
-    #[inline(always)]
-    fn flag(&self, _site: &'static str, v: bool) -> bool {
-        v
-    }
     /// The grid step site `site` produces from `v`: fault-free, IEEE nextUp (`up`) or
     /// nextDown of `v` in format `f` (see `slab::STEP_RULES`).
     #[inline(always)]
@@ -73,6 +91,8 @@ pub trait Fault<F: Format> {
 /// The fault-free datapath: every site is the format's own operation.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoFault;
+
+impl Logic for NoFault {}
 
 impl<F: Format> Fault<F> for NoFault {
     const ON: bool = false;

@@ -405,16 +405,20 @@ impl<F: Format> Rti<F> {
     /// held hit (`t < best` under [`TieRule::First`], `t <= best` under [`TieRule::Last`]).
     #[inline(always)]
     pub fn capture(&self, c: &mut Capture<F::V>, out: &RtiOut<F::V>, id: u32) {
-        self.capture_faulty(c, out, id, &NoFault)
+        self.capture_faulty(c, out, id, &NoFault);
     }
 
-    /// [`Rti::capture`] with its compare site `take` computed by `x`.
+    /// [`Rti::capture`] with its sites computed by `x`: the logic sites `hit` (the result's hit
+    /// bit gating the unit) and `held` (a hit is held; the first hit is taken without a
+    /// compare) and the compare site `take` (`t < best`, or `t <= best` under
+    /// [`TieRule::Last`]).
     #[inline(always)]
-    pub fn capture_faulty<X: Fault<F>>(&self, c: &mut Capture<F::V>, out: &RtiOut<F::V>, id: u32, x: &X) {
-        if !out.hit {
-            return;
+    /// Returns whether it took `out`.
+    pub fn capture_faulty<X: Fault<F>>(&self, c: &mut Capture<F::V>, out: &RtiOut<F::V>, id: u32, x: &X) -> bool {
+        if !x.flag("hit", out.hit) {
+            return false;
         }
-        let take = !c.hit
+        let take = !x.flag("held", c.hit)
             || match self.tie {
                 TieRule::First => x.compare(&self.fmt, "take", Cmp::Lt, out.t, c.t),
                 TieRule::Last => x.compare(&self.fmt, "take", Cmp::Le, out.t, c.t),
@@ -422,6 +426,7 @@ impl<F: Format> Rti<F> {
         if take {
             *c = Capture { hit: true, t: out.t, u: out.u, v: out.v, id };
         }
+        take
     }
 
     /// One ray against a stream of triangles (a leaf), ids `first_id..`: the nearest hit.

@@ -18,7 +18,8 @@ pub enum Mode {
 /// How a fault changes its site.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
-    /// The arithmetic site's operands are swapped (a − b computed as b − a).
+    /// The arithmetic or compare site's operands are swapped (a − b computed as b − a,
+    /// a < b as b < a).
     Swap,
     /// The arithmetic site's second operand is replaced by its first (a wrong mux select).
     FirstTwice,
@@ -51,6 +52,13 @@ pub enum Kind {
     Unordered,
     /// The grid-step site passes its input through (the widening stage bypassed).
     Bypass,
+    /// The arithmetic site follows the other NaN rule: a NaN result is the first NaN operand,
+    /// quieted, in a canonical-NaN format (propagation where the contract says canonical), or
+    /// the canonical NaN in a propagating one.
+    NanRule,
+    /// The limit site counts to one more than it should (`==` where `<` was meant, or a
+    /// counter compared before its increment).
+    OffByOne,
     /// The grid-step site adds (nextUp) or subtracts (nextDown) one on the encoding as an
     /// unsigned integer, wrapping in the format's width: right for positive numbers, the wrong
     /// way for negative ones, ±0 and ±∞ step into the other sign or a NaN.
@@ -82,7 +90,7 @@ impl Benign {
 pub struct Spec {
     /// Unique name: `unit.site.kind`.
     pub name: &'static str,
-    /// The unit it is injected into (`rti`, `slab`).
+    /// The unit it is injected into (`rti`, `slab`, `capture`, `traverse`, `op`).
     pub unit: &'static str,
     /// The site it changes (a signal name of the unit's stage table).
     pub site: &'static str,
@@ -102,6 +110,18 @@ const fn rti(name: &'static str, site: &'static str, kind: Kind, what: &'static 
 
 const fn slab(name: &'static str, site: &'static str, kind: Kind, what: &'static str) -> Spec {
     Spec { name, unit: "slab", site, kind, what, benign: None }
+}
+
+const fn capture(name: &'static str, site: &'static str, kind: Kind, what: &'static str) -> Spec {
+    Spec { name, unit: "capture", site, kind, what, benign: None }
+}
+
+const fn traverse(name: &'static str, site: &'static str, kind: Kind, what: &'static str) -> Spec {
+    Spec { name, unit: "traverse", site, kind, what, benign: None }
+}
+
+const fn op(name: &'static str, site: &'static str, kind: Kind, what: &'static str) -> Spec {
+    Spec { name, unit: "op", site, kind, what, benign: None }
 }
 
 const fn slab_benign(name: &'static str, site: &'static str, kind: Kind, what: &'static str, b: Benign) -> Spec {
@@ -272,6 +292,34 @@ pub const BANK: &[Spec] = &[
         ),
     ),
     slab("slab.pdy_sign.stuck0", "pdy_sign", Kind::Stuck(false), "embree: the replacement's sign select tied to 0 (a small negative or −0 d.y becomes +δ)"),
+    capture("capture.take.tie", "take", Kind::TieSwap, "min-capture: equal t decided by the other tie rule (t < best for t ≤ best, or the reverse)"),
+    capture("capture.take.swap", "take", Kind::Swap, "min-capture: the compare's operands swapped (the farthest hit kept)"),
+    capture("capture.take.stuck1", "take", Kind::Stuck(true), "min-capture: the compare left out (every hit taken: the last hit wins)"),
+    capture("capture.take.stuck0", "take", Kind::Stuck(false), "min-capture: the compare tied to 0 (the first hit kept)"),
+    capture("capture.hit.stuck1", "hit", Kind::Stuck(true), "min-capture: the result's hit bit not gating the unit (a nearer miss is taken)"),
+    capture("capture.held.stuck1", "held", Kind::Stuck(true), "min-capture: the held-hit bit tied to 1 (the first hit compared against the reset t = +0)"),
+    traverse("traverse.near.tie", "near", Kind::TieSwap, "traversal: equal entry t sends the ray to the right child first (t_r ≤ t_l for t_r < t_l)"),
+    traverse("traverse.near.swap", "near", Kind::Swap, "traversal: the nearer/farther select inverted (the farther child first)"),
+    traverse("traverse.mark_split.stuck0", "mark_split", Kind::Stuck(false), "traversal: a level where both children hit is not set to 10 (the farther child never visited)"),
+    traverse("traverse.mark_pass.stuck0", "mark_pass", Kind::Stuck(false), "traversal: a level where one child hits is not set to 01 (its history stays 00)"),
+    traverse("traverse.resume.stuck0", "resume", Kind::Stuck(false), "traversal: the restart resumes at the shallowest 10 instead of the deepest (priority encoder reversed)"),
+    traverse("traverse.reset_deeper.stuck0", "reset_deeper", Kind::Stuck(false), "traversal: after 10 → 11 the deeper levels keep their history (no reset to 00)"),
+    traverse("traverse.more.stuck0", "more", Kind::Stuck(false), "traversal: the restart check tied to 0 (one pass only)"),
+    traverse("traverse.n_limit.plus1", "n_limit", Kind::OffByOne, "traversal: the N-leaf limit counts one leaf too many"),
+    op("op.add.rz", "add", Kind::Round(Mode::TowardZero), "adder truncates (rounds toward zero)"),
+    op("op.add.rna", "add", Kind::Round(Mode::NearestTiesToAway), "adder rounds half away from zero"),
+    op("op.sub.rdn", "sub", Kind::Round(Mode::TowardNegative), "subtractor rounds toward −∞"),
+    op("op.sub.swap", "sub", Kind::Swap, "subtractor computes b − a"),
+    op("op.mul.rup", "mul", Kind::Round(Mode::TowardPositive), "multiplier rounds toward +∞"),
+    op("op.mul.rna", "mul", Kind::Round(Mode::NearestTiesToAway), "multiplier rounds half away from zero"),
+    op("op.mul.ftz", "mul", Kind::Flush, "multiplier flushes a subnormal product to zero"),
+    op("op.add.ftz", "add", Kind::Flush, "adder flushes a subnormal sum to zero"),
+    op("op.div.rz", "div", Kind::Round(Mode::TowardZero), "divider (the reciprocal unit of a ⊗ (1 ⊘ b) datapaths) truncates"),
+    op("op.add.nan", "add", Kind::NanRule, "adder follows the other NaN rule (propagates a payload where the contract says canonical, or the reverse)"),
+    op("op.mul.nan", "mul", Kind::NanRule, "multiplier follows the other NaN rule"),
+    op("op.lt.loose", "lt", Kind::Loose, "a < b computed as a ≤ b"),
+    op("op.le.strict", "le", Kind::Strict, "a ≤ b computed as a < b"),
+    op("op.lt.nan", "lt", Kind::Unordered, "a < b true when an operand is NaN"),
 ];
 
 /// The fault named `name`.

@@ -5,8 +5,8 @@
 //! formats such a fault is not modelled (and a campaign says so).
 
 use crate::bank::{Kind, Mode, Spec};
-use datapath::fault::{fault_free, Cmp, Fault};
-use datapath::format::FormatKind;
+use datapath::fault::{fault_free, Cmp, Fault, Logic};
+use datapath::format::{DivMode, FormatKind};
 use datapath::rti::Op;
 use datapath::Format;
 use rustc_apfloat::ieee::{BFloat, Half, Single};
@@ -49,6 +49,40 @@ impl Injected {
     }
 }
 
+impl Logic for Injected {
+    fn flag(&self, site: &'static str, v: bool) -> bool {
+        if site != self.spec.site {
+            return v;
+        }
+        self.reached.set(true);
+        match self.spec.kind {
+            Kind::Stuck(s) => s,
+            _ => v,
+        }
+    }
+    fn less(&self, site: &'static str, a: f64, b: f64) -> bool {
+        if site != self.spec.site {
+            return a < b;
+        }
+        self.reached.set(true);
+        match self.spec.kind {
+            Kind::TieSwap => a <= b,
+            Kind::Swap => b < a,
+            _ => a < b,
+        }
+    }
+    fn limit(&self, site: &'static str, v: usize) -> usize {
+        if site != self.spec.site {
+            return v;
+        }
+        self.reached.set(true);
+        match self.spec.kind {
+            Kind::OffByOne => v.saturating_add(1),
+            _ => v,
+        }
+    }
+}
+
 impl<F: Format> Fault<F> for Injected {
     const ON: bool = true;
     fn arith(&self, f: &F, site: &'static str, op: Op, a: F::V, b: F::V) -> F::V {
@@ -65,7 +99,25 @@ impl<F: Format> Fault<F> for Injected {
         match self.spec.kind {
             Kind::Swap => fault_free(f, op, b, a),
             Kind::FirstTwice => fault_free(f, op, a, a),
+            // a ⊗ (1 ⊘ b) datapaths: the fault is the reciprocal unit's rounding
+            Kind::Round(m) if op == Op::Div && f.div_mode() == DivMode::RecipMul => {
+                let rec = exact(f, Op::Div, f.one(), b, None, m);
+                self.hit(r, rec.map(|q| f.mul(a, q)))
+            }
             Kind::Round(m) => self.hit(r, exact(f, op, a, b, None, m)),
+            Kind::NanRule => match f.kind() {
+                FormatKind::Float(l) if f.is_nan(r) => {
+                    let first = [a, b].into_iter().find(|&v| f.is_nan(v));
+                    let quiet = 1u64 << (l.man_bits - 1);
+                    match (f.nan_propagates(), first) {
+                        (true, _) => f.from_bits(l.canonical_nan()),
+                        (false, Some(v)) => f.from_bits(f.to_bits(v) | quiet),
+                        (false, None) => r,
+                    }
+                }
+                FormatKind::Float(_) => r,
+                _ => self.hit(r, None),
+            },
             Kind::Fused { first, .. } => {
                 let p = self.operands.get();
                 let addend = if first { b } else { a };
@@ -95,17 +147,8 @@ impl<F: Format> Fault<F> for Injected {
                 Cmp::Le => f.lt(a, b),
             },
             Kind::Unordered => r || f.is_nan(a) || f.is_nan(b),
+            Kind::Swap => cmp.eval(f, b, a),
             _ => r,
-        }
-    }
-    fn flag(&self, site: &'static str, v: bool) -> bool {
-        if site != self.spec.site {
-            return v;
-        }
-        self.reached.set(true);
-        match self.spec.kind {
-            Kind::Stuck(s) => s,
-            _ => v,
         }
     }
     fn step(&self, f: &F, site: &'static str, up: bool, v: F::V) -> F::V {

@@ -1,7 +1,7 @@
 //! The fault bank and its injector: the names, the exactness of the rounding faults against an
 //! independent computation, the benign argument, and the campaign's verdicts.
 
-use datapath::fault::{Cmp, Fault, NoFault};
+use datapath::fault::{Cmp, Fault, Logic, NoFault};
 use datapath::format::{F32Native, FpOpts, Ieee};
 use datapath::probe::NoProbe;
 use datapath::rng::SplitMix64;
@@ -252,6 +252,58 @@ fn step_select_and_nan_faults_do_what_they_say() {
     assert!(Fault::compare(&tie, &f, "tn_x", Cmp::Lt, 1.0f32, 1.0));
     assert!(!Fault::compare(&tie, &f, "tn_x", Cmp::Le, 1.0f32, 1.0));
     let sel = Injected::new(by_name("slab.negz.stuck1").unwrap());
-    assert!(Fault::<datapath::format::Ieee<F32Native>>::flag(&sel, "negz", false));
-    assert!(!Fault::<datapath::format::Ieee<F32Native>>::flag(&sel, "negx", false));
+    assert!(Logic::flag(&sel, "negz", false));
+    assert!(!Logic::flag(&sel, "negx", false));
+}
+
+/// A two-leaf tree: the root's children are leaves 10 (left, entry t = `tl`) and 11 (right,
+/// entry `tr`); boxes are their entry distances (NaN: a miss).
+fn two_leaves(tl: f64, tr: f64) -> datapath::bvh::HwTree<f64> {
+    use datapath::bvh::{Bank, HwTree, Level, LEAF_FLAG};
+    HwTree {
+        root_box: 0.0,
+        root_addr: 0,
+        levels: vec![Level {
+            left: Bank { boxes: vec![tl], addr: vec![LEAF_FLAG | 10] },
+            right: Bank { boxes: vec![tr], addr: vec![LEAF_FLAG | 11] },
+        }],
+    }
+}
+
+/// The traversal faults change the leaf order or count the way their RTL bug does, on a tree
+/// traced by hand.
+#[test]
+fn traversal_faults_do_what_they_say() {
+    let leaves = |tl: f64, tr: f64, n: usize, fault: Option<&str>| {
+        let t = two_leaves(tl, tr);
+        let test = |b: &f64| (!b.is_nan()).then_some(*b);
+        match fault {
+            None => datapath::bvh::history_traverse_faulty(&t, n, test, &NoFault).leaves,
+            Some(name) => {
+                let x = Injected::new(by_name(name).unwrap());
+                let r = datapath::bvh::history_traverse_faulty(&t, n, test, &x).leaves;
+                assert!(x.reached(), "{name}");
+                r
+            }
+        }
+    };
+    // a tie goes left first; the tie fault sends it right
+    assert_eq!(leaves(1.0, 1.0, 2, None), [10, 11]);
+    assert_eq!(leaves(1.0, 1.0, 2, Some("traverse.near.tie")), [11, 10]);
+    assert_eq!(leaves(1.0, 2.0, 2, Some("traverse.near.tie")), [10, 11]);
+    // the nearer child first; swapped: the farther
+    assert_eq!(leaves(2.0, 1.0, 2, None), [11, 10]);
+    assert_eq!(leaves(2.0, 1.0, 2, Some("traverse.near.swap")), [10, 11]);
+    // one pass only: the farther child is never visited
+    assert_eq!(leaves(1.0, 2.0, 2, Some("traverse.more.stuck0")), [10]);
+    assert_eq!(leaves(1.0, 2.0, 2, Some("traverse.mark_split.stuck0")), [10]);
+    // the N limit: one leaf asked, two given
+    assert_eq!(leaves(1.0, 2.0, 1, None), [10]);
+    assert_eq!(leaves(1.0, 2.0, 1, Some("traverse.n_limit.plus1")), [10, 11]);
+    // one child hit: the history says 01; without the mark it stays 00
+    let t = two_leaves(1.0, f64::NAN);
+    let test = |b: &f64| (!b.is_nan()).then_some(*b);
+    assert_eq!(datapath::bvh::history_traverse_faulty(&t, 2, test, &NoFault).state, [datapath::bvh::hist::PASS]);
+    let x = Injected::new(by_name("traverse.mark_pass.stuck0").unwrap());
+    assert_eq!(datapath::bvh::history_traverse_faulty(&t, 2, test, &x).state, [datapath::bvh::hist::NEW]);
 }

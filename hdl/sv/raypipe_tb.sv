@@ -5,8 +5,11 @@
 // default 5; +gap=0 streams back to back), and expects each vector's result exactly LATENCY
 // clock edges after the edge that captured it, in order. It compares every output field and,
 // unless +nostages, every stage signal, names the first field that differs (earliest stage
-// first), and prints `N passed, M failed`. Any failure, a missing result or a result at the
-// wrong cycle ends the run with $fatal (non-zero exit status).
+// first) and the vector's class, and prints `N passed, M failed`. The valid timing is checked
+// cycle by cycle: an out_valid pulse where no vector is due is reported as an extra pulse at
+// that cycle (no vector is consumed), a due vector without out_valid as a missing pulse for
+// that vector at that cycle; every vector is counted once. Any failure ends the run with
+// $fatal (non-zero exit status).
 //
 // The DUT is the module named by the DUT macro (default: the reference model of the unit),
 // with this port list (widths from raypipe_set_pkg; rows are packed exactly as the .hex lines):
@@ -52,7 +55,7 @@ module raypipe_tb;
   int got = 0;
   int passed = 0;
   int failed = 0;
-  int late = 0;
+  int extra = 0;
 
 
   always @(posedge clk) cycle <= cycle + 1;
@@ -90,35 +93,46 @@ module raypipe_tb;
     in_row = '0;
     repeat (lat + 4) @(negedge clk);
     if (got < N) begin
-      $display("FAIL: %0d vectors gave no result (the first: vector %0d, line %0d)", N - got, got, got + 1);
+      $display("FAIL: %0d vectors were never driven or due (the first: vector %0d, line %0d)", N - got, got, got + 1);
       failed += N - got;
     end
+    if (extra > 0) $display("%0d extra out_valid pulses", extra);
     $display("%0d passed, %0d failed", passed, failed);
     if (failed > 0) $fatal(1, "raypipe_tb: %0d of %0d vectors failed", failed, N);
     $finish;
   end
 
-  // compare at the negative edge what the last positive edge produced
+  // compare at the negative edge what the last positive edge produced; vector `got` is due at
+  // edge sent_at[got] + lat
+  logic due;
   always @(negedge clk) begin
-    if (rst_n && out_valid) begin
-      if (got >= N) begin
-        $display("FAIL: out_valid with no vector outstanding at cycle %0d", cycle);
+    if (rst_n) begin
+      due = got < sent && cycle == sent_at[got] + lat;
+      if (out_valid && !due) begin
         failed++;
-      end else begin
-        if (cycle != sent_at[got] + lat) begin
-          failed++;
-          if (failed <= max_errors)
-            $display("FAIL vector %0d (line %0d, class %0d): result at edge %0d, expected at edge %0d (latency %0d)",
-                     got, got + 1, ins[got][IN_W-1 -: 8], cycle, sent_at[got] + lat, lat);
-        end else if (diff_out(out_row, outs[got], strict) != "none" || (check_stages && diff_stg(stg_row, stgs[got], outs[got], strict) != "none"))
+        extra++;
+        if (failed <= max_errors && got < sent)
+          $display("FAIL: extra out_valid pulse at edge %0d: no vector is due (next due: vector %0d at edge %0d)", cycle,
+                   got, sent_at[got] + lat);
+        else if (failed <= max_errors)
+          $display("FAIL: extra out_valid pulse at edge %0d: no vector is due (none outstanding)", cycle);
+      end else if (due && !out_valid) begin
+        failed++;
+        if (failed <= max_errors)
+          $display("FAIL vector %0d (line %0d, class %0d %0s): missing out_valid pulse at edge %0d (%0d edges after the edge that captured it)",
+                   got, got + 1, ins[got][IN_W-1 -: 8], class_name(ins[got][IN_W-1 -: 8]), cycle, lat);
+        got++;
+      end else if (due) begin
+        if (diff_out(out_row, outs[got], strict) != "none" || (check_stages && diff_stg(stg_row, stgs[got], outs[got], strict) != "none"))
         begin
           failed++;
           if (failed <= max_errors && check_stages)
-            $display("FAIL vector %0d (line %0d, class %0d): first output to differ: %0s; first stage signal to differ: %0s",
-                     got, got + 1, ins[got][IN_W-1 -: 8], diff_out(out_row, outs[got], strict), diff_stg(stg_row, stgs[got], outs[got], strict));
+            $display("FAIL vector %0d (line %0d, class %0d %0s): first output to differ: %0s; first stage signal to differ: %0s",
+                     got, got + 1, ins[got][IN_W-1 -: 8], class_name(ins[got][IN_W-1 -: 8]), diff_out(out_row, outs[got], strict),
+                     diff_stg(stg_row, stgs[got], outs[got], strict));
           else if (failed <= max_errors)
-            $display("FAIL vector %0d (line %0d, class %0d): first output to differ: %0s (stages not checked)",
-                     got, got + 1, ins[got][IN_W-1 -: 8], diff_out(out_row, outs[got], strict));
+            $display("FAIL vector %0d (line %0d, class %0d %0s): first output to differ: %0s (stages not checked)",
+                     got, got + 1, ins[got][IN_W-1 -: 8], class_name(ins[got][IN_W-1 -: 8]), diff_out(out_row, outs[got], strict));
         end else passed++;
         got++;
       end

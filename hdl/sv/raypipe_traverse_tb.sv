@@ -4,7 +4,9 @@
 // its write port, streams the rays of traverse_rays.hex with a valid/ready handshake, and
 // compares each result (in ray order) with traverse_expected.hex: the first-N leaf ids, their
 // count, the passes, the box tests and each level's final history state. Prints
-// `N passed, M failed`; any failure or a missing result ends the run with $fatal.
+// `N passed, M failed`; any failure ends the run with $fatal. A ray with no result within
+// +timeout cycles is reported as a hang (ray, class and cycle), counted failed, and the DUT is
+// reset and given its tree again; the rays after it are still driven and checked.
 // The DUT is the module named by the DUT macro (default raypipe_traverse_ref), with the ports
 // of hdl/sv/ref/traverse_ref.sv. Plusargs: +set=DIR, +maxerrors=K, +timeout=CYCLES (per ray).
 `ifndef DUT
@@ -45,7 +47,11 @@ module raypipe_traverse_tb;
   int passed = 0;
   int failed = 0;
   int idle = 0;
+  int cycle = 0;
+  int hangs = 0;
   logic took = 1'b0;
+
+  always @(posedge clk) cycle <= cycle + 1;
 
   task automatic write_entry(input logic [7:0] level, input logic right, input int row, input logic [ENTRY_W-1:0] e);
     @(negedge clk);
@@ -54,6 +60,20 @@ module raypipe_traverse_tb;
     wr_right = right;
     wr_row = row;
     wr_data = e;
+  endtask
+
+  // writes the set's tree images through the DUT's write port
+  task automatic load_tree();
+    $readmemh($sformatf("%0s/tree_root.hex", dir), img, 0, 0);
+    write_entry(8'hff, 1'b0, 0, img[0]);
+    for (int l = 0; l < int'(LEVELS); l++) begin
+      for (int side = 0; side < 2; side++) begin
+        $readmemh($sformatf("%0s/tree_l%0d_%0s.hex", dir, l, side ? "right" : "left"), img, 0, level_rows(l) - 1);
+        for (int k = 0; k < level_rows(l); k++) write_entry(l[7:0], side[0], k, img[k]);
+      end
+    end
+    @(negedge clk);
+    wr_en = 1'b0;
   endtask
 
   initial begin
@@ -67,30 +87,39 @@ module raypipe_traverse_tb;
     $display("raypipe_traverse_tb: %0d rays from %0s, %0d levels, first %0d leaves", N, dir, LEVELS, LEAVES);
     repeat (2) @(negedge clk);
     rst_n = 1'b1;
-    $readmemh($sformatf("%0s/tree_root.hex", dir), img, 0, 0);
-    write_entry(8'hff, 1'b0, 0, img[0]);
-    for (int l = 0; l < int'(LEVELS); l++) begin
-      for (int side = 0; side < 2; side++) begin
-        $readmemh($sformatf("%0s/tree_l%0d_%0s.hex", dir, l, side ? "right" : "left"), img, 0, level_rows(l) - 1);
-        for (int k = 0; k < level_rows(l); k++) write_entry(l[7:0], side[0], k, img[k]);
+    load_tree();
+    // stream the rays from `got` on: a ray driven while ray_ready is high is taken at the next
+    // rising edge; a ray with no result within the timeout is a hang: report it, reset the
+    // DUT, load its tree again and go on from the next ray
+    while (got < N) begin
+      sent = got;
+      took = 1'b0;
+      ray_valid = 1'b0;
+      idle = 0;
+      while (got < N && idle < timeout) begin
+        if (ray_valid && took) sent = sent + 1;
+        if (sent < N) begin
+          ray_valid = 1'b1;
+          ray_row = ins[sent];
+          took = ray_ready;
+        end else ray_valid = 1'b0;
+        @(negedge clk);
+      end
+      if (got < N) begin
+        failed++;
+        hangs++;
+        if (failed <= max_errors)
+          $display("FAIL ray %0d (line %0d, class %0d %0s): no result within %0d cycles, a hang (at edge %0d); the DUT is reset and the next rays are checked",
+                   got, got + 1, ins[got][IN_W-1 -: 8], class_name(ins[got][IN_W-1 -: 8]), timeout, cycle);
+        got++;
+        ray_valid = 1'b0;
+        rst_n = 1'b0;
+        repeat (2) @(negedge clk);
+        rst_n = 1'b1;
+        load_tree();
       end
     end
-    @(negedge clk);
-    wr_en = 1'b0;
-    // stream the rays: a ray driven while ray_ready is high is taken at the next rising edge
-    while (got < N && idle < timeout) begin
-      if (ray_valid && took) sent = sent + 1;
-      if (sent < N) begin
-        ray_valid = 1'b1;
-        ray_row = ins[sent];
-        took = ray_ready;
-      end else ray_valid = 1'b0;
-      @(negedge clk);
-    end
-    if (got < N) begin
-      $display("FAIL: no result for ray %0d (line %0d) within %0d cycles", got, got + 1, timeout);
-      failed += N - got;
-    end
+    if (hangs > 0) $display("%0d rays hung", hangs);
     $display("%0d passed, %0d failed", passed, failed);
     if (failed > 0) $fatal(1, "raypipe_traverse_tb: %0d of %0d rays failed", failed, N);
     $finish;
@@ -107,8 +136,8 @@ module raypipe_traverse_tb;
         if (diff_out(res_row, outs[got], strict) != "none") begin
           failed++;
           if (failed <= max_errors)
-            $display("FAIL ray %0d (line %0d, class %0d): first field to differ: %0s", got, got + 1,
-                     ins[got][IN_W-1 -: 8], diff_out(res_row, outs[got], strict));
+            $display("FAIL ray %0d (line %0d, class %0d %0s): first field to differ: %0s", got, got + 1,
+                     ins[got][IN_W-1 -: 8], class_name(ins[got][IN_W-1 -: 8]), diff_out(res_row, outs[got], strict));
         end else passed++;
         got++;
       end

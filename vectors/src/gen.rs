@@ -30,6 +30,8 @@ pub enum Unit {
     Op,
     /// BVH traversal (2-bit ray history) with the slab unit as box tester.
     Traverse,
+    /// The min-capture unit over one leaf of RTI results.
+    Capture,
 }
 
 impl FromStr for Unit {
@@ -40,7 +42,8 @@ impl FromStr for Unit {
             "slab" => Ok(Unit::Slab),
             "op" => Ok(Unit::Op),
             "traverse" => Ok(Unit::Traverse),
-            other => Err(format!("unknown unit '{other}' (units: rti, slab, op, traverse)")),
+            "capture" => Ok(Unit::Capture),
+            other => Err(format!("unknown unit '{other}' (units: rti, slab, op, traverse, capture)")),
         }
     }
 }
@@ -52,6 +55,7 @@ impl Unit {
             Unit::Slab => "slab",
             Unit::Op => "op",
             Unit::Traverse => "traverse",
+            Unit::Capture => "capture",
         }
     }
 }
@@ -490,37 +494,45 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                     let mut x = rti_case(cross, r);
                     match (cross.geom, f.kind()) {
                         (14, FormatKind::Float(l)) => {
-                            let p = l.man_bits as i32 + 1;
-                            let a = (p + 1) / 2;
-                            let bd = (p + 2 - a) / 2;
-                            let be = p + 2 - a - bd;
-                            // ± an odd integer of n bits, over 2^n
-                            let mut odd = |n: i32| {
-                                let v = ((1u64 << (n - 1)) + r.below(1u64 << (n - 1))) | 1;
-                                let s = if r.below(2) == 0 { 1.0 } else { -1.0 };
-                                s * v as f64 / (n as f64).exp2()
-                            };
-                            let (o, e1) = ([odd(a), odd(a), odd(a)], [odd(a), odd(a), odd(a)]);
-                            let (dx, dy, e2x, e2z) = (odd(bd), odd(bd), odd(be), odd(be));
-                            x = [
-                                o[0],
-                                o[1],
-                                o[2],
-                                dx,
-                                dy,
-                                0.0,
-                                0.0,
-                                f64::INFINITY,
-                                0.0,
-                                0.0,
-                                0.0,
-                                e1[0],
-                                e1[1],
-                                e1[2],
-                                e2x,
-                                0.0,
-                                e2z,
-                            ];
+                            // draws until the model finds the ray valid (at most 64): the tie
+                            // must reach t, u, v, which a testbench compares only when valid
+                            for _ in 0..64 {
+                                let p = l.man_bits as i32 + 1;
+                                let a = (p + 1) / 2;
+                                let bd = (p + 2 - a) / 2;
+                                let be = p + 2 - a - bd;
+                                // ± an odd integer of n bits, over 2^n
+                                let mut odd = |n: i32| {
+                                    let v = ((1u64 << (n - 1)) + r.below(1u64 << (n - 1))) | 1;
+                                    let s = if r.below(2) == 0 { 1.0 } else { -1.0 };
+                                    s * v as f64 / (n as f64).exp2()
+                                };
+                                let (o, e1) = ([odd(a), odd(a), odd(a)], [odd(a), odd(a), odd(a)]);
+                                let (dx, dy, e2x, e2z) = (odd(bd), odd(bd), odd(be), odd(be));
+                                x = [
+                                    o[0],
+                                    o[1],
+                                    o[2],
+                                    dx,
+                                    dy,
+                                    0.0,
+                                    0.0,
+                                    f64::INFINITY,
+                                    0.0,
+                                    0.0,
+                                    0.0,
+                                    e1[0],
+                                    e1[1],
+                                    e1[2],
+                                    e2x,
+                                    0.0,
+                                    e2z,
+                                ];
+                                let (ray, tri) = rti_inputs(&f, &x);
+                                if rti.test(&ray, &tri).valid {
+                                    break;
+                                }
+                            }
                         }
                         (15 | 16, FormatKind::Float(l)) => {
                             let (lv, dv) = if cross.geom == 15 {
@@ -685,6 +697,29 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                         _ => {}
                     }
                     Ok(Some(slab_rows(&slab, c as u64, &bits).to_vec()))
+                })
+            })?;
+            counts = push_rows(&mut files, per_class);
+        }
+        Unit::Capture => {
+            let rti = Rti::new(f, RtiConfig { tie: req.rti.tie, ..RtiConfig::default() });
+            options.insert("tie".into(), format!("{:?}", req.rti.tie));
+            params.insert("tie_last".into(), (req.rti.tie == datapath::rti::TieRule::Last) as u64);
+            params.insert("slots".into(), crate::capture::SLOTS as u64);
+            classes = crate::capture::CLASSES.iter().map(|(n, c)| (n.to_string(), c.to_string())).collect();
+            latency = crate::capture::SLOTS as u32;
+            stages =
+                crate::capture::stage_table().into_iter().map(|(stage, name, op)| Stage { stage, name, op }).collect();
+            files.push(Rows::new("capture_inputs.hex", "inputs", crate::capture::input_layout(&k, w)));
+            files.push(Rows::new("capture_expected.hex", "expected outputs", crate::capture::output_layout(&k, w)));
+            files.push(Rows::new("capture_stages.hex", crate::hdl::STAGE_ROLE, crate::capture::stage_layout(&k, w)));
+            let per_class = pool.install(|| {
+                per_class_rows(req.seed, classes.len(), req.count, |c, r| {
+                    let bits = crate::capture::case(&f, c, r);
+                    let [expected, stages] = crate::capture::out_rows(&rti, &bits, &NoFault);
+                    let mut inputs = vec![c as u64];
+                    inputs.extend(bits);
+                    Ok(Some(vec![inputs, expected, stages]))
                 })
             })?;
             counts = push_rows(&mut files, per_class);
@@ -880,14 +915,28 @@ fn op_text(op: Op, a: &str, b: &str, note: &str) -> String {
 }
 
 fn op_eval<F: Format>(f: &F, op: u64, x: F::V, y: F::V) -> (u64, u64) {
+    op_eval_faulty(f, op, x, y, &NoFault)
+}
+
+/// One op-unit vector with its site (the op code's name: `add`, `sub`, `mul`, `div`, `lt`,
+/// `le`) computed by `x`: (result, cmp).
+fn op_eval_faulty<F: Format, X: Fault<F>>(f: &F, op: u64, a: F::V, b: F::V, x: &X) -> (u64, u64) {
+    use datapath::fault::Cmp;
     match op {
-        0 => (f.to_bits(f.add(x, y)), 0),
-        1 => (f.to_bits(f.sub(x, y)), 0),
-        2 => (f.to_bits(f.mul(x, y)), 0),
-        3 => (f.to_bits(f.div(x, y)), 0),
-        4 => (0, f.lt(x, y) as u64),
-        _ => (0, f.le(x, y) as u64),
+        0 => (f.to_bits(x.arith(f, "add", Op::Add, a, b)), 0),
+        1 => (f.to_bits(x.arith(f, "sub", Op::Sub, a, b)), 0),
+        2 => (f.to_bits(x.arith(f, "mul", Op::Mul, a, b)), 0),
+        3 => (f.to_bits(x.arith(f, "div", Op::Div, a, b)), 0),
+        4 => (0, x.compare(f, "lt", Cmp::Lt, a, b) as u64),
+        _ => (0, x.compare(f, "le", Cmp::Le, a, b) as u64),
     }
+}
+
+/// The expected row (result, cmp) of one op vector (`bits`: op code, a, b) with its site
+/// computed by `x` (`NoFault`: the row a set holds); the op unit has no stage file.
+pub fn op_out_rows<F: Format, X: Fault<F>>(f: &F, bits: &[u64], x: &X) -> [Vec<u64>; 2] {
+    let (res, cmp) = op_eval_faulty(f, bits[0], f.from_bits(bits[1]), f.from_bits(bits[2]), x);
+    [vec![res, cmp], Vec::new()]
 }
 
 /// Model rows for one RTI vector: inputs, expected outputs, stage signals.
@@ -1384,6 +1433,7 @@ pub(crate) fn check_rows(
                     rti_rows(&rti, class, bits)[1..].to_vec()
                 }
                 Unit::Slab => slab_rows(&Slab::new(f, slab_config_from(m)?), class, bits)[1..].to_vec(),
+                Unit::Capture => crate::capture::out_rows(&capture_rti_from(f, m), bits, &NoFault).to_vec(),
                 Unit::Op => {
                     let (res, cmp) = op_eval(&f, bits[0], f.from_bits(bits[1]), f.from_bits(bits[2]));
                     vec![vec![res, cmp]]
@@ -1413,10 +1463,10 @@ pub(crate) fn check_rows(
 }
 
 /// One level's left and right bank rows.
-pub(crate) type BankImages<'a> = (&'a Vec<Vec<u64>>, &'a Vec<Vec<u64>>);
+pub type BankImages<'a> = (&'a Vec<Vec<u64>>, &'a Vec<Vec<u64>>);
 
 /// A traverse set's BRAM images: the root entry row and each level's two banks, by file name.
-pub(crate) fn tree_images<'a>(
+pub fn tree_images<'a>(
     m: &Manifest,
     contents: &'a [Vec<Vec<u64>>],
 ) -> Result<(&'a [u64], Vec<BankImages<'a>>), String> {
@@ -1465,17 +1515,28 @@ pub fn slab_config_from(m: &Manifest) -> Result<SlabConfig, String> {
     SlabConfig::named(m.options.get("variant").map_or("plain", |s| s.as_str()))
 }
 
+/// The min-capture tie rule a set's manifest names (`first` when it names none).
+fn tie_from(m: &Manifest) -> datapath::rti::TieRule {
+    match m.options.get("tie").map(String::as_str) {
+        Some("Last") => datapath::rti::TieRule::Last,
+        _ => datapath::rti::TieRule::First,
+    }
+}
+
+/// The unit a capture set's manifest names: an RTI unit of format `f` with its tie rule (the
+/// min-capture unit reads nothing else of it).
+pub fn capture_rti_from<F: Format>(f: F, m: &Manifest) -> Rti<F> {
+    Rti::new(f, RtiConfig { tie: tie_from(m), ..RtiConfig::default() })
+}
+
 /// The RTI unit's configuration a set's manifest names (cull, det threshold, tie rule).
 pub fn rti_config_from(m: &Manifest) -> Result<RtiConfig, String> {
-    use datapath::rti::{Cull, TieRule};
+    use datapath::rti::Cull;
     let cull = match m.options.get("cull").map(String::as_str) {
         Some("Backface") => Cull::Backface,
         _ => Cull::TwoSided,
     };
-    let tie = match m.options.get("tie").map(String::as_str) {
-        Some("Last") => TieRule::Last,
-        _ => TieRule::First,
-    };
+    let tie = tie_from(m);
     let det_threshold = m
         .options
         .get("det_threshold")

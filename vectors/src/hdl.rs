@@ -80,6 +80,12 @@ fn sv_set_package(m: &crate::manifest::Manifest) -> String {
         s += &format!("  localparam int {tag}_W = {w};\n  localparam {tag}_FILE = \"{name}\";\n");
     }
     s += &format!("  localparam bit HAS_STAGES = {};\n", u8::from(stage_file.is_some()));
+    s += "  // the name of coverage class `id` (manifest.json \"classes\")\n";
+    s += "  function automatic string class_name(int id);\n    case (id)\n";
+    for c in &m.classes {
+        s += &format!("      {}: return \"{}\";\n", c.id, c.name);
+    }
+    s += "      default: return \"(not a class of this set)\";\n    endcase\n  endfunction\n";
     if let Some(root) = m.files.iter().find(|f| f.name == "tree_root.hex") {
         // the traverse unit's BRAM images: entry width and rows per level (both banks alike)
         let levels = m.params.get("levels").copied().unwrap_or(0) as usize;
@@ -196,6 +202,12 @@ pub fn vhdl_package(m: &Manifest) -> String {
         );
     }
     s += &format!("  constant N_VECTORS : natural := {};\n", m.files.first().map_or(0, |f| f.rows));
+    s += "  -- the name of coverage class `id` (manifest.json \"classes\")\n  function class_name(id : natural) return string;\n";
+    body += "  function class_name(id : natural) return string is\n  begin\n    case id is\n";
+    for c in &m.classes {
+        body += &format!("      when {} => return \"{}\";\n", c.id, c.name);
+    }
+    body += "      when others => return \"(not a class of this set)\";\n    end case;\n  end function;\n";
     s += "  -- the contract and unit options (manifest.json \"params\"), as 64-bit words\n";
     for (k, v) in &m.params {
         s += &format!("  constant P_{} : std_logic_vector(63 downto 0) := x\"{v:016x}\";\n", k.to_uppercase());

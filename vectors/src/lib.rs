@@ -3,6 +3,7 @@
 //! atomically and deterministically, and read back to re-check every bit.
 #![warn(missing_docs)]
 
+pub mod capture;
 pub mod check;
 pub mod gen;
 pub mod hdl;

@@ -9,7 +9,8 @@
 
 use crate::manifest::Kind;
 use crate::rows::{is_float, Layout, Rows};
-use datapath::bvh::{hist, history_traverse, HwTree, Level, NodeDesc, StacklessResult, LEAF_FLAG};
+use datapath::bvh::{hist, history_traverse_faulty, HwTree, Level, NodeDesc, StacklessResult, LEAF_FLAG};
+use datapath::fault::{Logic, NoFault};
 use datapath::rng::SplitMix64;
 use datapath::slab::{Aabb, Slab, SlabConfig};
 use datapath::Format;
@@ -102,32 +103,39 @@ struct Observed {
     deepest: bool,
 }
 
-/// Runs one ray (format bits of o, d, tmin, tmax) through the history traversal.
-fn run<F: Format>(
+/// Runs one ray (format bits of o, d, tmin, tmax) through the history traversal, its control
+/// logic computed by `x`.
+fn run<F: Format, X: Logic>(
     s: &Slab<F>,
     hw: &HwTree<Aabb<F::V>>,
     n: usize,
     bits: &[u64],
     leaf_depth: &BTreeMap<u32, u32>,
     deepest: u32,
+    x: &X,
 ) -> Observed {
     let f = &s.fmt;
-    let x = |i: usize| f.to_f64(f.from_bits(bits[i]));
-    let ray = s.prepare([x(0), x(1), x(2)], [x(3), x(4), x(5)], x(6), x(7));
+    let q = |i: usize| f.to_f64(f.from_bits(bits[i]));
+    let ray = s.prepare([q(0), q(1), q(2)], [q(3), q(4), q(5)], q(6), q(7));
     let mut tie = false;
     let mut calls = 0usize; // call 0 tests the root, then (left, right) pairs
     let mut left: Option<F::V> = None;
-    let result = history_traverse(hw, n, |b| {
-        let o = s.test(&ray, b);
-        let t = o.hit.then_some(o.t_near);
-        if calls > 0 && calls % 2 == 1 {
-            left = t;
-        } else if let (true, Some(a), Some(b)) = (calls > 0, left, t) {
-            tie |= f.le(a, b) && f.le(b, a);
-        }
-        calls += 1;
-        t.map(|v| f.to_f64(v))
-    });
+    let result = history_traverse_faulty(
+        hw,
+        n,
+        |b| {
+            let o = s.test(&ray, b);
+            let t = o.hit.then_some(o.t_near);
+            if calls > 0 && calls % 2 == 1 {
+                left = t;
+            } else if let (true, Some(a), Some(b)) = (calls > 0, left, t) {
+                tie |= f.le(a, b) && f.le(b, a);
+            }
+            calls += 1;
+            t.map(|v| f.to_f64(v))
+        },
+        x,
+    );
     let deep = result.leaves.iter().any(|l| leaf_depth.get(l) == Some(&deepest));
     Observed { result, tie, deepest: deep }
 }
@@ -309,7 +317,7 @@ pub(crate) fn generate<F: Format>(
         for _ in 0..400 {
             let x = candidate(gen, r, root.min, root.max, deep_box);
             let bits: Vec<u64> = x.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
-            let o = run(&s, &hw, n, &bits, &leaf_depth, deepest);
+            let o = run(&s, &hw, n, &bits, &leaf_depth, deepest, &NoFault);
             if !keeps(gen, &o, n) || !keep.is_none_or(|k| keeps(k, &o, n)) {
                 continue;
             }
@@ -379,7 +387,7 @@ pub fn golden_tree(nodes: &[NodeDesc], root: u32) -> golden::bvh::Tree {
 }
 
 /// The unpacked rows of one level's (left, right) bank images.
-pub(crate) type BankRows = (Vec<Vec<u64>>, Vec<Vec<u64>>);
+pub type BankRows = (Vec<Vec<u64>>, Vec<Vec<u64>>);
 
 /// Rebuilds the tree from a set's BRAM images (rows of unpacked fields) and re-runs every ray:
 /// the expected rows.
@@ -392,6 +400,18 @@ pub(crate) fn recheck<F: Format>(
     rays: &[Vec<u64>],
 ) -> Result<Vec<Vec<u64>>, String> {
     let s = Slab::new(f, SlabConfig::named(variant)?);
+    let hw = tree_from_images(&s, root, banks)?;
+    Ok(rays.iter().map(|ray| ray_row(&s, &hw, n, &ray[1..], &NoFault)).collect())
+}
+
+/// The tree a set's BRAM images hold (rows of unpacked fields: the root entry, then per level
+/// the left and right banks), every address word checked to point at a row of the next level.
+pub fn tree_from_images<F: Format>(
+    s: &Slab<F>,
+    root: &[u64],
+    banks: &[BankRows],
+) -> Result<HwTree<Aabb<F::V>>, String> {
+    let f = &s.fmt;
     let entry = |row: &[u64]| -> (Aabb<F::V>, u32) {
         let v = |i: usize| f.from_bits(row[i]);
         (Aabb { min: [v(0), v(1), v(2)], max: [v(3), v(4), v(5)] }, row[6] as u32)
@@ -424,11 +444,14 @@ pub(crate) fn recheck<F: Format>(
             }
         }
     }
+    Ok(hw)
+}
+
+/// The expected row of one ray (`bits`: o, d, tmin, tmax encodings) on `hw`, first `n`
+/// leaves, with the traversal's control logic computed by `x` (`NoFault`: the rows a set holds).
+pub fn ray_row<F: Format, X: Logic>(s: &Slab<F>, hw: &HwTree<Aabb<F::V>>, n: usize, bits: &[u64], x: &X) -> Vec<u64> {
     let empty = BTreeMap::new();
-    Ok(rays
-        .iter()
-        .map(|ray| expected_row(&run(&s, &hw, n, &ray[1..], &empty, u32::MAX).result, n, hw.depth()))
-        .collect())
+    expected_row(&run(s, hw, n, bits, &empty, u32::MAX, x).result, n, hw.depth())
 }
 
 /// The expected `traverse_expected.hex` fields of one f64 ray on `tree` in format `f`: count,
@@ -446,5 +469,5 @@ pub fn expected_for<F: Format>(
         .map_err(|e| e.to_string())?;
     let bits: Vec<u64> = ray.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
     let empty = BTreeMap::new();
-    Ok(expected_row(&run(&s, &hw, n, &bits, &empty, u32::MAX).result, n, hw.depth()))
+    Ok(expected_row(&run(&s, &hw, n, &bits, &empty, u32::MAX, &NoFault).result, n, hw.depth()))
 }

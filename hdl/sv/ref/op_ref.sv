@@ -30,17 +30,33 @@ module raypipe_op_ref
     return r;
   endfunction
 
+  // the kit's valid-timing negative checks: RAYPIPE_EXTRA_PULSE raises out_valid for one more
+  // cycle (the first idle one after the 10th result); RAYPIPE_DROP_PULSE leaves out the 10th result's pulse
+  int results;
+  logic extra_done;
   logic v0;
   op_inputs_t s0;
   always_ff @(posedge clk) begin
     if (!rst_n) begin
       v0 <= 1'b0;
       out_valid <= 1'b0;
+      results <= 0;
+      extra_done <= 1'b0;
     end else begin
       v0 <= in_valid;
       s0 <= in_row;
       out_valid <= v0;
       out_row <= eval(s0);
+      if (v0) results <= results + 1;
+`ifdef RAYPIPE_DROP_PULSE
+      if (v0 && results == 9) out_valid <= 1'b0;
+`endif
+`ifdef RAYPIPE_EXTRA_PULSE
+      if (!v0 && results >= 10 && !extra_done) begin
+        out_valid <= 1'b1;
+        extra_done <= 1'b1;
+      end
+`endif
     end
   end
   assign stg_row = '0;

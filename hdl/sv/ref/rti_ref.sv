@@ -8,6 +8,11 @@
 // Define RAYPIPE_SKIP_DIVIDE to zero the divide's signals when valid = 0 (a DUT that skips the
 // divide; the testbench must still pass). Define RAYPIPE_INJECT_FAULT to make the detx multiplier truncate instead of rounding to
 // nearest (the kit's negative check: the testbench must fail, naming stage signal detx).
+// Bank faults (docs/faults.md) this DUT can carry, one define each (hdl/selftest checks that
+// the testbench fails and that `raypipe faults` detects the same fault on the same set):
+//   RAYPIPE_FAULT_RTI_E1X_SWAP      rti.e1x.swap: e1.x = v0.x - v1.x
+//   RAYPIPE_FAULT_RTI_UV_OK_STRICT  rti.uv_ok.strict: u' + v' <= det tested as <
+//   RAYPIPE_FAULT_RTI_T_OK_STUCK1   rti.t_ok.stuck1: the t' >= 0 check left out
 module raypipe_rti_ref
   import raypipe_fp::*;
   import raypipe_set_pkg::*;
@@ -53,7 +58,11 @@ module raypipe_rti_ref
     logic pos;
     case (k)
       1: begin
+`ifdef RAYPIPE_FAULT_RTI_E1X_SWAP
+        y.s.e1x = fsub(F, x.i.v0x, x.i.v1x);
+`else
         y.s.e1x = fsub(F, x.i.v1x, x.i.v0x);
+`endif
         y.s.e1y = fsub(F, x.i.v1y, x.i.v0y);
         y.s.e1z = fsub(F, x.i.v1z, x.i.v0z);
         y.s.e2x = fsub(F, x.i.v2x, x.i.v0x);
@@ -118,7 +127,13 @@ module raypipe_rti_ref
         y.s.u_ok = between(pos, zero_of(F, 1'b0), x.s.up);
         y.s.v_ok = between(pos, zero_of(F, 1'b0), x.s.vp);
         y.s.uv_ok = between(pos, y.s.uv, x.s.det);
+`ifdef RAYPIPE_FAULT_RTI_UV_OK_STRICT
+        y.s.uv_ok = pos ? flt(F, y.s.uv, x.s.det) : flt(F, x.s.det, y.s.uv);
+`endif
         y.s.t_ok = between(pos, zero_of(F, 1'b0), x.s.tp);
+`ifdef RAYPIPE_FAULT_RTI_T_OK_STUCK1
+        y.s.t_ok = 1'b1;
+`endif
         y.s.valid = y.s.det_ok & y.s.u_ok & y.s.v_ok & y.s.uv_ok & y.s.t_ok;
       end
 `ifdef RAYPIPE_RECIP_MUL

@@ -7,6 +7,11 @@
 // Every stage signal is carried to the end of the pipeline and presented on stg_row.
 // Define RAYPIPE_INJECT_FAULT to make the tlox multiplier truncate instead of rounding to
 // nearest (the kit's negative check: the testbench must fail, naming stage signal tlox).
+// Bank faults (docs/faults.md) this DUT can carry, one define each (hdl/selftest checks that
+// the testbench fails and that `raypipe faults` detects the same fault on the same set):
+//   RAYPIPE_FAULT_SLAB_LOX_SWAP     slab.lox.swap: lo.x = o.x - min.x
+//   RAYPIPE_FAULT_SLAB_NEGX_STUCK0  slab.negx.stuck0: the x near/far select tied to 0
+//   RAYPIPE_FAULT_SLAB_HIT_STRICT   slab.hit.strict: t_near <= t_far tested as <
 module raypipe_slab_ref
   import raypipe_fp::*;
   import raypipe_box::*;
@@ -58,7 +63,11 @@ module raypipe_slab_ref
         y.s.inv_dz = recip(y.s.pdz);
       end
       1: begin
+`ifdef RAYPIPE_FAULT_SLAB_LOX_SWAP
+        y.s.lox = gsub(x.i.ox, x.i.minx);
+`else
         y.s.lox = gsub(x.i.minx, x.i.ox);
+`endif
         y.s.hix = gsub(x.i.maxx, x.i.ox);
         y.s.loy = gsub(x.i.miny, x.i.oy);
         y.s.hiy = gsub(x.i.maxy, x.i.oy);
@@ -74,7 +83,11 @@ module raypipe_slab_ref
         y.s.thiz = fmul(F, x.s.hiz, x.s.inv_dz);
       end
       3: begin
+`ifdef RAYPIPE_FAULT_SLAB_NEGX_STUCK0
+        y.s.negx = 1'b0;
+`else
         y.s.negx = sign_of(F, x.s.inv_dx);
+`endif
         y.s.negy = sign_of(F, x.s.inv_dy);
         y.s.negz = sign_of(F, x.s.inv_dz);
         y.s.nearx = y.s.negx ? x.s.thix : x.s.tlox;
@@ -96,7 +109,11 @@ module raypipe_slab_ref
         y.s.t_near = widen(x.s.tn_xyz, 1'b0);
         y.s.t_far = widen(x.s.tf_xyz, 1'b1);
       end
+`ifdef RAYPIPE_FAULT_SLAB_HIT_STRICT
+      default: y.s.hit = flt(F, x.s.t_near, x.s.t_far);
+`else
       default: y.s.hit = fle(F, x.s.t_near, x.s.t_far);
+`endif
     endcase
     return y;
   endfunction

@@ -12,8 +12,10 @@
 // 11 the farther taken): new & both hit -> nearer, 10; one hit -> it, 01; 10 & the deepest 10
 // at pass start -> farther, 11, deeper levels 00; 10 otherwise -> nearer; 11 -> farther; no
 // hit -> the pass ends. The right child is nearer only when its t_near < the left's.
-// Define RAYPIPE_INJECT_FAULT to send ties to the right child (the negative check), and
-// RAYPIPE_COUNT_PAIRS_TWICE to count box tests otherwise (passes; fails with +strict).
+// Define RAYPIPE_INJECT_FAULT (or RAYPIPE_FAULT_TRAVERSE_NEAR_TIE, the bank fault
+// traverse.near.tie) to send ties to the right child (the negative check), and
+// RAYPIPE_COUNT_PAIRS_TWICE to count box tests otherwise (passes; fails with +strict), and
+// RAYPIPE_INJECT_HANG to never finish a ray of class 2 (the testbench reports each hang).
 module raypipe_traverse_ref
   import raypipe_fp::*;
   import raypipe_box::*;
@@ -63,6 +65,7 @@ module raypipe_traverse_ref
 
   typedef enum logic [1:0] {IDLE, ROOT, LEVEL, DONE} state_e;
   state_e state;
+  logic [7:0] ray_class;
   ray_t ray;
   logic [1:0] hist [0:HD-1];
   logic [31:0] leaves [0:NL-1];
@@ -78,8 +81,10 @@ module raypipe_traverse_ref
 
   // near / far side when both hit: right (1) only when its entry is less than the left's
   function automatic logic right_nearer(word_t tl, word_t tr);
-`ifdef RAYPIPE_INJECT_FAULT
+`ifdef RAYPIPE_FAULT_TRAVERSE_NEAR_TIE
     return fle(F, tr, tl);  // injected fault: ties go right
+`elsif RAYPIPE_INJECT_FAULT
+    return fle(F, tr, tl);  // the same fault under the kit's older name
 `else
     return flt(F, tr, tl);
 `endif
@@ -110,6 +115,7 @@ module raypipe_traverse_ref
         if (ray_valid) begin
           ray = setup(rf(ray_row, 0), rf(ray_row, 1), rf(ray_row, 2), rf(ray_row, 3), rf(ray_row, 4), rf(ray_row, 5),
                       rf(ray_row, 6), rf(ray_row, 7));
+          ray_class = ray_row[IN_W-1 -: 8];
           for (int l = 0; l < HD; l++) hist[l] = 2'b00;
           for (int i = 0; i < NL; i++) leaves[i] = 0;
           count = 0;
@@ -170,6 +176,11 @@ module raypipe_traverse_ref
           end
         end
         DONE: begin
+`ifdef RAYPIPE_INJECT_HANG
+          // the kit's hang check: a ray of class 2 (miss) never finishes
+          if (ray_class == 8'd2) state = DONE;
+          else begin
+`endif
           res_row = '0;
           res_row[2 * D + 48 + 32 * NL +: 8] = count[7:0];
           for (int i = 0; i < NL; i++) res_row[2 * D + 48 + 32 * (NL - 1 - i) +: 32] = leaves[i];
@@ -178,6 +189,9 @@ module raypipe_traverse_ref
           for (int l = 0; l < D; l++) res_row[2 * (D - 1 - l) +: 2] = hist[l];
           res_valid = 1'b1;
           state = IDLE;
+`ifdef RAYPIPE_INJECT_HANG
+          end
+`endif
         end
       endcase
     end
