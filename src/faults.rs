@@ -13,6 +13,30 @@ pub fn on_dir(dir: &Path, outputs_only: bool) -> Result<Campaign, String> {
     faults::run(&m, &rows, outputs_only)
 }
 
+/// For a minimal set (its manifest says so): the campaign over it, which must detect every
+/// fault the manifest names; the number of them. `None` for a full set.
+pub fn check_minimal(dir: &Path) -> Result<Option<usize>, String> {
+    let path = dir.join("manifest.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let m: vectors::manifest::Manifest = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let Some(min) = &m.minimal else { return Ok(None) };
+    let c = on_dir(dir, min.outputs_only)?;
+    let missed: Vec<&str> = min
+        .detects
+        .iter()
+        .filter(|name| !c.faults.iter().any(|o| o.name == name.as_str() && o.detected))
+        .map(|s| s.as_str())
+        .collect();
+    if !missed.is_empty() {
+        return Err(format!(
+            "{}: a minimal set that no longer detects {} (its manifest says it does)",
+            dir.display(),
+            missed.join(", ")
+        ));
+    }
+    Ok(Some(min.detects.len()))
+}
+
 /// The campaign over the set `req` generates (in memory).
 pub fn on_request(req: &vectors::gen::Request, outputs_only: bool) -> Result<Campaign, String> {
     let set = vectors::gen::generate(req)?;

@@ -268,9 +268,14 @@ enum Cmd {
         /// Slab variant (units slab and traverse): plain, conservative, take-on-false, embree.
         #[arg(long, default_value = "plain")]
         variant: String,
-        /// Re-check an existing set against the models instead of writing one.
+        /// Re-check an existing set against the models instead of writing one (a minimal set:
+        /// also that it still detects every fault its manifest names).
         #[arg(long)]
         check: Option<PathBuf>,
+        /// Write the minimal set: the fewest vectors of the default set (greedy set cover over
+        /// the fault bank) that still detect every fault it detects from the outputs.
+        #[arg(long, conflicts_with = "check")]
+        minimal: bool,
         /// OBJ scene whose BVH the traverse unit uses (default: the built-in scene).
         #[arg(long)]
         scene: Option<PathBuf>,
@@ -650,6 +655,7 @@ fn run() -> Result<Outcome, String> {
             threads,
             variant,
             check,
+            minimal,
             scene,
             leaves,
             leaf_size,
@@ -662,6 +668,12 @@ fn run() -> Result<Outcome, String> {
                     "{}: {n} vectors; the manifest, the HDL packages and every input, expected and stage row are what this raypipe writes",
                     dir.display()
                 );
+                if let Some(detects) = raypipe::faults::check_minimal(&dir)? {
+                    println!(
+                        "{}: a minimal set; it still detects all {detects} faults its manifest names",
+                        dir.display()
+                    );
+                }
                 return Ok(Outcome::Pass);
             }
             let out = out.ok_or("--out is required")?;
@@ -717,6 +729,22 @@ fn run() -> Result<Outcome, String> {
                 slab_variant: variant,
             };
             let set = vectors::gen::generate(&req)?;
+            let set = if minimal {
+                let (cut, c) = faults::minimal::minimal(&set, &command_without_threads())?;
+                let m = cut.manifest.minimal.as_ref().expect("a minimal set says so");
+                println!(
+                    "minimal set: {} of {} vectors ({:.1} %) detect the {} faults of the {} bank the default set detects from the outputs ({} escape both; see raypipe faults)",
+                    cut.manifest.files[0].rows,
+                    m.from_vectors,
+                    100.0 * cut.manifest.files[0].rows as f64 / m.from_vectors.max(1) as f64,
+                    m.detects.len(),
+                    cut.manifest.unit,
+                    c.escaped
+                );
+                cut
+            } else {
+                set
+            };
             vectors::gen::write_set(&set, &out)?;
             let m = &set.manifest;
             println!(

@@ -273,3 +273,73 @@ fn the_default_op_sets_detect_the_whole_bank() {
         assert_eq!(na, if fmt.ends_with("propagate") { 6 } else { 0 }, "{fmt}");
     }
 }
+
+/// `vectors --minimal`: a set far smaller than the default one that detects every fault the
+/// default set detects; `vectors --check` accepts it, and refuses it once its manifest claims a
+/// fault it does not detect.
+#[test]
+fn a_minimal_set_keeps_the_detections_and_check_holds_it_to_them() {
+    for unit in ["rti", "slab", "capture", "op"] {
+        let dir = temp_dir(&format!("min-{unit}"));
+        let o = raypipe(&[
+            "vectors",
+            "--unit",
+            unit,
+            "--format",
+            "fp16",
+            "--count",
+            "16",
+            "--minimal",
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{unit}: {}", String::from_utf8_lossy(&o.stderr));
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+        let kept = m["files"][0]["rows"].as_u64().unwrap();
+        let from = m["minimal"]["from_vectors"].as_u64().unwrap();
+        assert!(kept > 0 && kept * 10 < from, "{unit}: {kept} of {from}");
+        // the class counts add up to the rows kept
+        assert_eq!(m["classes"].as_array().unwrap().iter().map(|c| c["count"].as_u64().unwrap()).sum::<u64>(), kept);
+        // it detects what the full set detects
+        let full = json(&raypipe(&[
+            "faults",
+            "--unit",
+            unit,
+            "--format",
+            "fp16",
+            "--count",
+            "16",
+            "--outputs-only",
+            "--json",
+        ]));
+        let cut = json(&raypipe(&["faults", "--set", dir.to_str().unwrap(), "--outputs-only", "--json"]));
+        let detected = |v: &serde_json::Value| -> Vec<String> {
+            v["faults"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|f| f["detected"] == true)
+                .map(|f| f["name"].as_str().unwrap().to_string())
+                .collect()
+        };
+        assert_eq!(detected(&full), detected(&cut), "{unit}");
+        let c = raypipe(&["vectors", "--check", dir.to_str().unwrap()]);
+        assert!(c.status.success(), "{unit}: {}", String::from_utf8_lossy(&c.stderr));
+        assert!(String::from_utf8_lossy(&c.stdout).contains("a minimal set"));
+        // a claim it cannot keep: a benign fault (never detected from the outputs)
+        if unit == "rti" {
+            let mut m2 = m.clone();
+            m2["minimal"]["detects"].as_array_mut().unwrap().push("rti.pos.loose".into());
+            std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&m2).unwrap()).unwrap();
+            let c = raypipe(&["vectors", "--check", dir.to_str().unwrap()]);
+            assert_eq!(c.status.code(), Some(2));
+            assert!(
+                String::from_utf8_lossy(&c.stderr).contains("rti.pos.loose"),
+                "{}",
+                String::from_utf8_lossy(&c.stderr)
+            );
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -2,12 +2,14 @@
 //! catches. [`bank`] names each fault (the one-line RTL bug it stands for, the site it
 //! changes, whether it is provably benign on the outputs), [`inject`] makes it a
 //! [`datapath::fault::Fault`] the stage models run with, and [`campaign`] runs the bank over a
-//! vector set and says which faults the set detects, by which vectors and classes.
+//! vector set and says which faults the set detects, by which vectors and classes;
+//! [`minimal`] cuts a set to the fewest vectors that still detect what it detects.
 #![warn(missing_docs)]
 
 pub mod bank;
 pub mod campaign;
 pub mod inject;
+pub mod minimal;
 
 pub use bank::{Kind, Mode, Spec, BANK};
 pub use campaign::{run, Campaign, Outcome};

@@ -849,6 +849,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             .enumerate()
             .map(|(i, (n, c))| Class { id: i as u32, name: n.clone(), covers: c.clone(), count: counts[i] })
             .collect(),
+        minimal: None,
     };
     Ok(VectorSet { manifest, files: files.into_iter().map(|fr| (fr.name, fr.lines.join("\n") + "\n")).collect() })
 }

@@ -139,4 +139,19 @@ pub struct Manifest {
     pub files: Vec<File>,
     /// Coverage classes with counts.
     pub classes: Vec<Class>,
+    /// A minimal set (`raypipe vectors --minimal`): the subset of the default set that still
+    /// detects every fault of the bank the default set detects; absent for a full set.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub minimal: Option<Minimal>,
+}
+
+/// What a minimal set was cut from and what it keeps detecting.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Minimal {
+    /// Vectors of the default set it was cut from (the same request without `--minimal`).
+    pub from_vectors: usize,
+    /// The bank faults (`raypipe faults` names) the set detects, every one of them.
+    pub detects: Vec<String>,
+    /// Detection is judged on the outputs alone (no stage probes).
+    pub outputs_only: bool,
 }
