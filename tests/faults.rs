@@ -12,6 +12,26 @@ fn json(o: &Output) -> serde_json::Value {
     serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&o.stdout)))
 }
 
+/// The applicable non-benign faults a campaign's JSON says no vector detects.
+fn escaped(v: &serde_json::Value) -> Vec<String> {
+    v["faults"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["applicable"] == true && f["benign"] == false && f["detected"] == false)
+        .map(|f| f["name"].as_str().unwrap().to_string())
+        .collect()
+}
+
+/// `raypipe faults ARGS --outputs-only --json`: exit code and JSON.
+fn campaign(args: &[&str]) -> (Option<i32>, serde_json::Value) {
+    let mut all = vec!["faults"];
+    all.extend_from_slice(args);
+    all.extend(["--outputs-only", "--json"]);
+    let o = raypipe(&all);
+    (o.status.code(), json(&o))
+}
+
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("raypipe-faults-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
@@ -126,17 +146,10 @@ fn bad_requests_are_refused_with_exit_2() {
 fn the_default_rti_sets_detect_the_whole_bank_from_the_outputs() {
     for fmt in ["f32", "fp16"] {
         for seed in ["1", "2", "3"] {
-            let o = raypipe(&["faults", "--format", fmt, "--seed", seed, "--outputs-only", "--json"]);
-            let v = json(&o);
-            let escaped: Vec<_> = v["faults"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .filter(|f| f["applicable"] == true && f["benign"] == false && f["detected"] == false)
-                .map(|f| f["name"].as_str().unwrap().to_string())
-                .collect();
+            let (code, v) = campaign(&["--format", fmt, "--seed", seed]);
+            let escaped = escaped(&v);
             assert!(escaped.is_empty(), "{fmt} seed {seed}: {escaped:?} escape");
-            assert_eq!(o.status.code(), Some(0));
+            assert_eq!(code, Some(0));
             assert!(v["detected"].as_u64().unwrap() >= 32);
         }
     }
@@ -151,28 +164,11 @@ fn the_default_slab_sets_detect_the_whole_bank_from_the_outputs() {
     for variant in ["plain", "conservative", "take-on-false", "embree"] {
         for fmt in ["f32", "fp16"] {
             for seed in ["1", "2", "3"] {
-                let o = raypipe(&[
-                    "faults",
-                    "--unit",
-                    "slab",
-                    "--variant",
-                    variant,
-                    "--format",
-                    fmt,
-                    "--seed",
-                    seed,
-                    "--outputs-only",
-                    "--json",
-                ]);
-                let v = json(&o);
+                let (code, v) = campaign(&["--unit", "slab", "--variant", variant, "--format", fmt, "--seed", seed]);
                 let faults = v["faults"].as_array().unwrap();
-                let escaped: Vec<_> = faults
-                    .iter()
-                    .filter(|f| f["applicable"] == true && f["benign"] == false && f["detected"] == false)
-                    .map(|f| f["name"].as_str().unwrap().to_string())
-                    .collect();
+                let escaped = escaped(&v);
                 assert!(escaped.is_empty(), "{variant} {fmt} seed {seed}: {escaped:?} escape");
-                assert_eq!(o.status.code(), Some(0));
+                assert_eq!(code, Some(0));
                 assert!(v["detected"].as_u64().unwrap() >= 20, "{variant} {fmt}");
                 for f in faults {
                     assert!(f["name"].as_str().unwrap().starts_with("slab."));
@@ -195,21 +191,8 @@ fn the_default_capture_sets_detect_the_whole_bank_from_the_outputs() {
     for tie in ["first", "last"] {
         for fmt in ["f32", "fp16"] {
             for seed in ["1", "2"] {
-                let o = raypipe(&[
-                    "faults",
-                    "--unit",
-                    "capture",
-                    "--tie",
-                    tie,
-                    "--format",
-                    fmt,
-                    "--seed",
-                    seed,
-                    "--outputs-only",
-                    "--json",
-                ]);
-                let v = json(&o);
-                assert_eq!(o.status.code(), Some(0), "{tie} {fmt} {seed}");
+                let (code, v) = campaign(&["--unit", "capture", "--tie", tie, "--format", fmt, "--seed", seed]);
+                assert_eq!(code, Some(0), "{tie} {fmt} {seed}");
                 assert_eq!(v["escaped"], 0);
                 let faults = v["faults"].as_array().unwrap();
                 assert!(faults.len() >= 6 && faults.iter().all(|f| f["applicable"] == true && f["detected"] == true));
@@ -223,9 +206,8 @@ fn the_default_capture_sets_detect_the_whole_bank_from_the_outputs() {
 #[test]
 fn the_default_traverse_sets_detect_the_whole_bank_from_the_outputs() {
     for fmt in ["f32", "fp16"] {
-        let o = raypipe(&["faults", "--unit", "traverse", "--format", fmt, "--outputs-only", "--json"]);
-        let v = json(&o);
-        assert_eq!(o.status.code(), Some(0), "{fmt}");
+        let (code, v) = campaign(&["--unit", "traverse", "--format", fmt]);
+        assert_eq!(code, Some(0), "{fmt}");
         let faults = v["faults"].as_array().unwrap();
         assert!(faults.len() >= 8 && faults.iter().all(|f| f["applicable"] == true && f["detected"] == true), "{fmt}");
     }

@@ -25,15 +25,7 @@ module raypipe_capture_ref
   localparam int L = raypipe_set_pkg::LATENCY;
   localparam int W = WIDTH[7:0];
 
-  typedef struct packed {
-    logic take;
-    logic hit;
-    logic [W-1:0] t;
-    logic [W-1:0] u;
-    logic [W-1:0] v;
-    logic [31:0] id;
-  } slot_state_t;
-
+  // one slot of an input row, as it is packed there (and the held state's layout)
   typedef struct packed {
     logic hit;
     logic [W-1:0] t;
@@ -41,6 +33,12 @@ module raypipe_capture_ref
     logic [W-1:0] v;
     logic [31:0] id;
   } result_t;
+
+  // a slot's take bit and the state after it, as packed in capture_stages.hex
+  typedef struct packed {
+    logic take;
+    result_t c;
+  } slot_state_t;
 
   localparam int S = $bits(slot_state_t);
 
@@ -59,7 +57,7 @@ module raypipe_capture_ref
   endfunction
 
   // the decision: take r over the held state h
-  function automatic logic take_of(result_t r, slot_state_t h);
+  function automatic logic take_of(result_t r, result_t h);
     logic hit, held, cmp;
     hit = r.hit;
     held = h.hit;
@@ -86,15 +84,9 @@ module raypipe_capture_ref
     all = x.s;
     h = (k == 0) ? '0 : all[(L - k) * S +: S];
     r = slot(x.i, k);
-    n = h;
-    n.take = take_of(r, h);
-    if (n.take) begin
-      n.hit = 1'b1;
-      n.t = r.t;
-      n.u = r.u;
-      n.v = r.v;
-      n.id = r.id;
-    end
+    n.take = take_of(r, h.c);
+    n.c = n.take ? r : h.c;
+    if (n.take) n.c.hit = 1'b1;
     all[(L - 1 - k) * S +: S] = n;
     y.s = all;
     return y;
@@ -120,13 +112,7 @@ module raypipe_capture_ref
   end
 
   slot_state_t fin;
-  capture_expected_t o;
   assign fin = last.s[S-1:0];
-  assign o.hit = fin.hit;
-  assign o.t = fin.t;
-  assign o.u = fin.u;
-  assign o.v = fin.v;
-  assign o.id = fin.id;
-  assign out_row = o;
+  assign out_row = fin.c;
   assign stg_row = last.s;
 endmodule
