@@ -325,3 +325,20 @@ fn a_minimal_set_keeps_the_detections_and_check_holds_it_to_them() {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
+
+/// NaN inputs are random NaN encodings (sign, quiet or signaling, payload), so a NaN-rule bug
+/// in one subtractor shows on its stage probe, in a canonical and a propagating format; on the
+/// compared outputs it is benign (the bank's argument), so outputs-only campaigns say benign.
+#[test]
+fn nan_payload_inputs_expose_the_nan_rule_on_the_probes() {
+    for fmt in ["f32", "fp16:propagate"] {
+        let v = json(&raypipe(&["faults", "--format", fmt, "--json"]));
+        let f = v["faults"].as_array().unwrap().iter().find(|f| f["name"] == "rti.e1x.nan").unwrap().clone();
+        assert_eq!(f["detected"], true, "{fmt}");
+        assert_eq!(f["benign"], true);
+        assert_eq!(f["first_class"], "inf_nan", "{fmt}");
+        let (_, o) = campaign(&["--format", fmt]);
+        let f = o["faults"].as_array().unwrap().iter().find(|f| f["name"] == "rti.e1x.nan").unwrap().clone();
+        assert_eq!(f["detected"], false, "{fmt}: benign on the compared outputs");
+    }
+}

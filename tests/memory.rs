@@ -43,9 +43,14 @@ fn peak_of(rays: usize) -> usize {
 
 #[test]
 fn peak_memory_is_flat_in_rays() {
-    let small = peak_of(64);
-    let large = peak_of(4096);
-    // the materialising engine held ~160 bytes per test: 4096 rays x 368 tests would be ~240 MB
-    assert!(large <= small + small / 2 + (256 << 10), "peak heap {small} B at 64 rays, {large} B at 4096 rays");
+    // both runs span more chunks (512 rays) than threads, so both hold as many chunks in
+    // flight as the scheduler allows; only the number of chunks differs
+    let small = peak_of(2048);
+    let large = peak_of(16384);
+    eprintln!("peak heap {small} B at 2048 rays, {large} B at 16384 rays");
+    // the materialising engine held ~160 bytes per test: 16384 rays x 368 tests would be ~1 GB;
+    // what still grows is the error histograms' distinct buckets (2026-12-03, Intel Xeon:
+    // 0.36 MB at 2048 rays, 0.55 MB at 16384, 0.77 MB at 131072; at most 2^21 buckets each)
+    assert!(large <= small + small / 2 + (256 << 10), "peak heap {small} B at 2048 rays, {large} B at 16384 rays");
     assert!(large < 16 << 20, "peak heap {large} B");
 }

@@ -430,3 +430,51 @@ fn the_capture_unit_follows_its_tie_rule_on_a_hand_traced_leaf() {
         assert_eq!(&stages[13..18], &[1, b(1.0), b(0.3), b(0.4), 6]);
     }
 }
+
+/// The slab unit's input conversion: a NaN ray input of any sign and payload gives the rows of
+/// the canonical NaN, and under FTZ a subnormal ray input the rows of zero of its sign (the
+/// reference DUTs' `conv`); the stored box is not converted.
+#[test]
+fn the_slab_input_conversion_canonicalizes_nans_and_flushes_ftz_subnormals() {
+    use datapath::fault::NoFault;
+    use datapath::slab::{Slab, SlabConfig};
+    let rows = |fmt: &str, bits: &[u64]| {
+        let any: datapath::AnyFormat = fmt.parse().unwrap();
+        datapath::with_format!(any, |f| {
+            let s = Slab::new(f, SlabConfig::named("plain").unwrap());
+            vectors::gen::slab_out_rows(&s, bits, &NoFault)
+        })
+    };
+    let b = |x: f32| x.to_bits() as u64;
+    let base = [
+        b(0.5),
+        b(0.1),
+        b(-0.2),
+        b(1.0),
+        b(0.25),
+        b(0.5),
+        b(0.0),
+        b(f32::INFINITY),
+        b(-1.0),
+        b(-1.0),
+        b(-1.0),
+        b(1.0),
+        b(1.0),
+        b(1.0),
+    ];
+    for fmt in ["f32", "f32:propagate"] {
+        let mut canon = base;
+        canon[1] = 0x7fc0_0000;
+        for payload in [0xffc0_1234u64, 0x7f80_0001, 0xff80_0042] {
+            let mut p = base;
+            p[1] = payload;
+            assert_eq!(rows(fmt, &p), rows(fmt, &canon), "{fmt} {payload:#x}");
+        }
+    }
+    let mut sub = base;
+    sub[3] = 0x8000_0003; // -3 least steps
+    let mut zero = base;
+    zero[3] = 0x8000_0000;
+    assert_eq!(rows("f32:ftz", &sub), rows("f32:ftz", &zero));
+    assert_ne!(rows("f32", &sub), rows("f32", &zero));
+}

@@ -331,7 +331,8 @@ impl<F: Format> Slab<F> {
         self.prepare_faulty(o.map(q), d.map(q), q(tmin), q(tmax), p, &NoFault)
     }
 
-    /// Stage 0 on a ray already in the format, with every site computed by `x` (a hardware
+    /// Stage 0 on a ray of format encodings (converted first: NaN to the canonical NaN, FTZ
+    /// subnormals to zero), with every site computed by `x` (a hardware
     /// fault; [`NoFault`] is the datapath itself). Sites: the arithmetic sites `inv_dx`,
     /// `inv_dy`, `inv_dz`; the compare sites `pdx`, `pdy`, `pdz` (Embree: `|d| < δ`); the
     /// logic sites `pdx_sign`, `pdy_sign`, `pdz_sign` (Embree: the replacement's sign, d's sign
@@ -347,6 +348,11 @@ impl<F: Format> Slab<F> {
     ) -> SlabRay<F::V> {
         let f = &self.fmt;
         let one = f.one();
+        // the input conversion of every ray input (the stage table's dx, dy, dz): a NaN
+        // becomes the canonical NaN, under FTZ a subnormal becomes zero of its sign; numbers
+        // are unchanged (the format's own value through binary64 and back)
+        let conv = |v: F::V| f.from_f64(f.to_f64(v));
+        let (o, d, tmin, tmax) = (o.map(conv), d.map(conv), conv(tmin), conv(tmax));
         let [dx, dy, dz] = d;
         let prep = |site, sign_site, v: F::V| match self.cfg.prep {
             DirPrep::Plain => v,

@@ -5,7 +5,8 @@
 
 use std::collections::BTreeMap;
 
-/// An accumulator: `Default` is the empty result, `merge` adds another chunk's result.
+/// An accumulator: `Default` is the empty result, `merge` adds another chunk's result. `merge`
+/// must be associative and commutative: a run merges chunks in the order they complete.
 pub trait Merge: Default + Send {
     /// Adds `other`'s results to `self`.
     fn merge(&mut self, other: Self);

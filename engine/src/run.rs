@@ -1,6 +1,8 @@
 //! Running a chunk space: chunks in parallel on a pool of `threads`, each chunk's accumulator
-//! merged in chunk order by a parallel reduction (so at most O(threads · log chunks)
-//! accumulators are alive at once).
+//! merged into the run's one accumulator as the chunk completes (so at most `threads` chunk
+//! accumulators and the run's are alive at once, whatever the number of chunks). The merge
+//! order is the completion order; `Merge` is commutative and associative, so the result does
+//! not depend on it.
 
 use crate::{Merge, Progress};
 use rayon::prelude::*;
@@ -41,23 +43,21 @@ pub fn run<S, A: Merge>(
 ) -> A {
     let chunk = engine.chunk.max(1);
     let chunks = items.div_ceil(chunk);
+    let total = std::sync::Mutex::new(A::default());
     let body = || {
         // one task per chunk (rayon's adaptive splitting alone leaves a run of slow chunks on
         // one thread)
         (0..usize::try_from(chunks).expect("the chunk count fits in usize"))
             .into_par_iter()
             .with_max_len(1)
-            .map_init(&init, |s, c| {
+            .for_each_init(&init, |s, c| {
                 let c = c as u64;
                 let r = c * chunk..((c + 1) * chunk).min(items);
                 let n = r.end - r.start;
                 let a = work(s, r);
+                // a poisoned lock only means another chunk panicked (the run then panics too)
+                total.lock().unwrap_or_else(|e| e.into_inner()).merge(a);
                 progress.inc(n);
-                a
-            })
-            .reduce(A::default, |mut a, b| {
-                a.merge(b);
-                a
             })
     };
     match rayon::ThreadPoolBuilder::new().num_threads(engine.threads.max(1)).build() {
@@ -65,6 +65,7 @@ pub fn run<S, A: Merge>(
         // no pool could be made (thread limit): run on the caller's pool
         Err(_) => body(),
     }
+    total.into_inner().unwrap_or_else(|e| e.into_inner())
 }
 
 #[cfg(test)]

@@ -223,6 +223,16 @@ pub const BANK: &[Spec] = &[
              give, and t, u, v do not read them; the u_ok, v_ok, uv_ok, t_ok probes do show it",
         )),
     },
+    Spec {
+        name: "rti.e1x.nan",
+        unit: "rti",
+        site: "e1x",
+        kind: Kind::NanRule,
+        what: "stage 1: subtractor e1.x follows the other NaN rule (a payload propagated where the contract says canonical, or the reverse)",
+        benign: Some(Benign::Always(
+            "the fault changes only which NaN e1.x is, and a NaN e1.x makes detx, det_xy and det NaN, so det_ok is false (thr < |NaN| and thr < NaN are false), valid and hit are 0, and t, u, v are compared only where valid is 1 (care_when); the e1x stage probe, compared always, shows it",
+        )),
+    },
     rti("rti.t_ok.stuck1", "t_ok", Kind::Stuck(true), "stage 7: the t' ≥ 0 check left out (hits behind the origin)"),
     rti("rti.uv_ok.stuck1", "uv_ok", Kind::Stuck(true), "stage 7: the u' + v' ≤ det check left out"),
     rti("rti.det_ok.stuck1", "det_ok", Kind::Stuck(true), "stage 7: the det threshold check left out"),

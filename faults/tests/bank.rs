@@ -27,8 +27,8 @@ fn every_fault_has_a_unique_name_a_site_and_a_description() {
         assert!(!s.what.is_empty());
     }
     // at least 40 faults over every unit, each unit with its own
-    assert!(BANK.len() >= 88);
-    for (unit, n) in [("rti", 33), ("slab", 27), ("capture", 6), ("traverse", 8), ("op", 14)] {
+    assert!(BANK.len() >= 89);
+    for (unit, n) in [("rti", 34), ("slab", 27), ("capture", 6), ("traverse", 8), ("op", 14)] {
         assert_eq!(BANK.iter().filter(|s| s.unit == unit).count(), n, "{unit}");
     }
 }
@@ -307,4 +307,40 @@ fn traversal_faults_do_what_they_say() {
     assert_eq!(datapath::bvh::history_traverse_faulty(&t, 2, test, &NoFault).state, [datapath::bvh::hist::PASS]);
     let x = Injected::new(by_name("traverse.mark_pass.stuck0").unwrap());
     assert_eq!(datapath::bvh::history_traverse_faulty(&t, 2, test, &x).state, [datapath::bvh::hist::NEW]);
+}
+
+proptest! {
+    /// The argument of `rti.e1x.nan`: with NaN inputs of every sign and payload, in a canonical
+    /// and a propagating format, valid and hit never change, and t, u, v change only where
+    /// valid is 0 (not compared there); the e1x probe does change when v0.x or v1.x is a NaN
+    /// with a payload the canonical rule would drop.
+    #[test]
+    fn the_nan_rule_fault_changes_no_compared_rti_output(seed in any::<u64>()) {
+        let mut r = SplitMix64::new(seed);
+        for name in ["fp16", "fp16:propagate"] {
+            let any: datapath::AnyFormat = name.parse().unwrap();
+            datapath::with_format!(any, |f| {
+                let spec = by_name("rti.e1x.nan").unwrap();
+                let rti = Rti::new(f, RtiConfig::default());
+                let mut shown = false;
+                for _ in 0..64 {
+                    let val = |r: &mut SplitMix64| match r.below(4) {
+                        0 => f.from_bits(0x7c00 | (r.next_u64() & 0x3ff).max(1) | (r.below(2) << 15)),
+                        _ => f.from_f64(r.range(-2.0, 2.0)),
+                    };
+                    let ray = Ray { o: [val(&mut r), val(&mut r), val(&mut r)], d: [val(&mut r), val(&mut r), val(&mut r)], tmin: f.zero(), tmax: f.from_f64(f64::INFINITY) };
+                    let tri = Tri { v: [[val(&mut r), val(&mut r), val(&mut r)], [val(&mut r), val(&mut r), val(&mut r)], [val(&mut r), val(&mut r), val(&mut r)]] };
+                    let x = Injected::new(spec);
+                    let (a, b) = (rti.trace_faulty(&ray, &tri, &mut NoProbe, &NoFault), rti.trace_faulty(&ray, &tri, &mut NoProbe, &x));
+                    prop_assert_eq!((a.valid, a.hit), (b.valid, b.hit));
+                    if a.valid {
+                        prop_assert_eq!([f.to_bits(a.t), f.to_bits(a.u), f.to_bits(a.v)], [f.to_bits(b.t), f.to_bits(b.u), f.to_bits(b.v)]);
+                    }
+                    shown |= f.to_bits(Fault::arith(&x, &f, "e1x", Op::Sub, tri.v[1][0], tri.v[0][0])) != f.to_bits(f.sub(tri.v[1][0], tri.v[0][0]));
+                }
+                prop_assert!(shown, "{}: the fault never showed on the e1x site", name);
+                Ok::<(), TestCaseError>(())
+            })?;
+        }
+    }
 }

@@ -152,7 +152,7 @@ const RTI_MODIFIERS: [(usize, &str, &str); 5] = [
     (7, "tiny", "coordinates scaled by 2^-12"),
     (9, "signed_zero", "some coordinates +0 or -0"),
     (10, "subnormal", "some inputs the format's smallest subnormals (floats only)"),
-    (11, "inf_nan", "some inputs +inf, -inf or NaN (floats only)"),
+    (11, "inf_nan", "some inputs +inf, -inf or NaN (floats only; a NaN is a random NaN encoding: either sign, quiet or signaling, random payload)"),
 ];
 
 /// Special input values injected into a case.
@@ -239,7 +239,8 @@ const SLAB_RAYS: [(&str, &str); 11] = [
     ("subnormal_gap", "floats: one axis with both planes and the origin small subnormal encodings (1 to 16 least steps, either sign; written as raw encodings also in FTZ formats), d on it +-1 (t subnormal) or 1 to 8 least normals (t near 1); the other axes hold the origin inside with small d"),
 ];
 const SLAB_ZERO: (&str, &str) = ("zero_extent", "box of zero extent on one or more axes");
-const SLAB_SPECIAL: (&str, &str) = ("inf_nan", "ray inputs +inf, -inf or NaN (floats only)");
+const SLAB_SPECIAL: (&str, &str) =
+    ("inf_nan", "ray inputs +inf, -inf or NaN (floats only; a NaN is a random NaN encoding: either sign, quiet or signaling, random payload)");
 
 /// One slab coverage class: a ray placement, a zero-extent box, special inputs.
 #[derive(Clone, Copy, Debug)]
@@ -578,6 +579,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                         }
                     }
                     let mut bits: Vec<u64> = x.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
+                    any_nans(&f, r, &x, &mut bits);
                     if cross.geom == 12 {
                         let (ray, tri) = rti_inputs(&f, &x);
                         let o = rti.test(&ray, &tri);
@@ -667,6 +669,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                             slab.store_box([x[8], x[9], x[10]], [x[11], x[12], x[13]]).map_err(|e| e.to_string())?;
                         let mut bits: Vec<u64> = x[..8].iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
                         bits.extend(b.min.iter().chain(b.max.iter()).map(|&v| f.to_bits(v)));
+                        any_nans(&f, r, &x[..8], &mut bits);
                         // an origin placed on a face plane stays on it once the box is stored
                         // (outward-rounded)
                         for a in 0..3 {
@@ -1110,6 +1113,20 @@ fn slab_case(cross: SlabCross, r: &mut SplitMix64, e: datapath::format::Edges) -
     }
     let tmax = if r.below(4) == 0 { r.range(0.0, 3.0) } else { f64::INFINITY };
     [o[0], o[1], o[2], d[0], d[1], d[2], 0.0, tmax, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]]
+}
+
+/// Every NaN the f64 case holds becomes a random NaN encoding of the float format (either
+/// sign, quiet or signaling, a random nonzero payload), so the sets exercise NaN sign and
+/// payload paths; fixed-point formats have no NaN (their cases hold none).
+fn any_nans<F: Format>(f: &F, r: &mut SplitMix64, x: &[f64], bits: &mut [u64]) {
+    let FormatKind::Float(l) = f.kind() else { return };
+    for (b, v) in bits.iter_mut().zip(x) {
+        if v.is_nan() {
+            let payload = (r.next_u64() & l.man_mask()).max(1);
+            let sign = if r.below(2) == 0 { 0 } else { l.sign_mask() };
+            *b = sign | (((1u64 << l.exp_bits) - 1) << l.man_bits) | payload;
+        }
+    }
 }
 
 /// The t_at_limits class on a placement's encodings: when the unwidened unit hits with number
