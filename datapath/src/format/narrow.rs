@@ -56,7 +56,9 @@
 //! with one of the twelve) ℓ³·2^−M; stages 5, 6 and u + v (sums) ℓ³·2^−2M, ℓ³·2^−3M,
 //! ℓ³·2^−4M; and, with u = 2^−p the unit roundoff, at most H², 2H²(1+u)², 2H³(1+u)³, 4H³(1+u)⁴,
 //! 6H³(1+u)⁵ and 12H³(1+u)⁶ ≤ 64H³ (u ≤ 1/4). If every lane has L ≥ `fast_lo` =
-//! 2^⌈max((emin + 4M)/3, (emin + M)/2)⌉ and H ≤ `fast_hi` = 2^⌊(emax − 6)/3⌋, every result of
+//! 2^⌈(emin + 4M)/3⌉ (which implies the stage-2 and stage-3 bounds ℓ ≥ 2^⌈(emin + M)/2⌉, since
+//! (emin + M)/2 ≤ (emin + 4M)/3 ⟺ emin ≤ 5M, and emin ≤ 0) and H ≤ `fast_hi` =
+//! 2^⌊(emax − 6)/3⌋, every result of
 //! stages 2–7 is ±0 or in [2^emin, max], where the split is the target rounding: the vector
 //! computes stages 2–7 without the check (for e8m16: nonzero stage-1 results and direction
 //! components in [2^−20, 2^40]). Otherwise stages 1–6 are recomputed with the full
@@ -134,12 +136,47 @@ impl Narrow {
             split: super::layout::pow2(52 - m) + 1.0,
             sub_grid: super::layout::pow2(lay.emin() - m + 52),
             overflow_at: lay.max_finite() + super::layout::pow2(lay.emax() - m - 1),
-            fast_lo: super::layout::pow2(
-                (((lay.emin() + 4 * m) as f64 / 3.0).ceil() as i32).max(((lay.emin() + m) as f64 / 2.0).ceil() as i32),
-            ),
+            fast_lo: super::layout::pow2(((lay.emin() + 4 * m) as f64 / 3.0).ceil() as i32),
             fast_hi: super::layout::pow2((lay.emax() - 6).div_euclid(3)),
             e8: lay.exp_bits == 8 && m <= 23,
             e8_shift: (23 - m).max(0) as u32,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Narrow;
+    use crate::format::{FloatLayout, FpOpts};
+
+    fn of(e: u32, m: u32) -> Narrow {
+        Narrow::of(FloatLayout::validate(e, m).unwrap(), FpOpts::default()).expect("a narrow layout")
+    }
+
+    /// The constants are the documented ones, worked by hand from the formulas in the module
+    /// docs: split 2^(52 − M) + 1, fast_lo 2^⌈(emin + 4M)/3⌉, fast_hi 2^⌊(emax − 6)/3⌋, e8 for
+    /// E = 8 and M ≤ 23 with shift 23 − M.
+    #[test]
+    fn the_constants_are_the_documented_ones() {
+        let x = |v: f64, k: i32| assert_eq!(v, (k as f64).exp2(), "2^{k}");
+        // e8m16: emin −126, emax 127: ⌈−62/3⌉ = −20, ⌊121/3⌋ = 40
+        let n = of(8, 16);
+        assert_eq!(n.split, 68_719_476_737.0); // 2^36 + 1
+        x(n.fast_lo, -20);
+        x(n.fast_hi, 40);
+        assert!(n.e8 && n.e8_shift == 7);
+        // e10m24: emin −510, emax 511: ⌈−414/3⌉ = −138, ⌊505/3⌋ = 168
+        let n = of(10, 24);
+        assert_eq!(n.split, 268_435_457.0); // 2^28 + 1
+        x(n.fast_lo, -138);
+        x(n.fast_hi, 168);
+        assert!(!n.e8);
+        // e5m10: emin −14, emax 15: ⌈26/3⌉ = 9, ⌊9/3⌋ = 3 (the filter never passes: full road)
+        let n = of(5, 10);
+        x(n.fast_lo, 9);
+        x(n.fast_hi, 3);
+        // binary32's own width is e8's limit; one bit more is not e8
+        assert!(of(8, 23).e8 && of(8, 23).e8_shift == 0);
+        assert!(!of(8, 24).e8);
     }
 }
