@@ -891,6 +891,13 @@ fn command_without_threads() -> String {
 }
 
 fn main() -> ExitCode {
+    // a closed stdout pipe (`raypipe … | head`) ends the process quietly, as it does any Unix
+    // tool, instead of failing a print (Rust ignores SIGPIPE by default, so println! panics)
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of one signal before any thread starts
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     // an interrupted run removes its temporary files and directories (exit 130, as a shell does)
     let _ = ctrlc::set_handler(|| {
         vectors::outdir::remove_partials();

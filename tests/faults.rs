@@ -342,3 +342,31 @@ fn nan_payload_inputs_expose_the_nan_rule_on_the_probes() {
         assert_eq!(f["detected"], false, "{fmt}: benign on the compared outputs");
     }
 }
+
+/// A reader that closes the pipe early (`raypipe … | head`) ends raypipe quietly: no panic
+/// message, killed by SIGPIPE as any Unix tool is.
+#[cfg(unix)]
+#[test]
+fn a_closed_stdout_pipe_is_not_a_panic() {
+    use std::io::Read;
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .args(["faults", "--unit", "op", "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run raypipe");
+    let mut first = [0u8; 16];
+    child.stdout.take().unwrap().read_exact(&mut first).unwrap(); // then the pipe closes
+    let mut err = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    let status = child.wait().unwrap();
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(status.signal(), Some(libc_sigpipe()), "{status:?}");
+}
+
+#[cfg(unix)]
+fn libc_sigpipe() -> i32 {
+    13 // SIGPIPE on Linux and the BSDs
+}
