@@ -242,7 +242,7 @@ fn the_campaign_compares_what_the_testbench_compares() {
 /// not modelled and say so).
 #[test]
 fn the_default_op_sets_detect_the_whole_bank() {
-    for fmt in ["f32", "fp16", "f32:divide", "bf16", "fp16:propagate"] {
+    for fmt in ["f32", "fp16", "f32:divide", "bf16", "fp16:propagate", "f32:ftz", "fp16:ftz"] {
         let o = raypipe(&["faults", "--unit", "op", "--format", fmt, "--json"]);
         let v = json(&o);
         assert_eq!(o.status.code(), Some(0), "{fmt}");
@@ -252,7 +252,16 @@ fn the_default_op_sets_detect_the_whole_bank() {
         let nan = faults.iter().find(|f| f["name"] == "op.add.nan").unwrap();
         assert_eq!(nan["applicable"], true, "{fmt}: the NaN rule fault applies in every float format");
         let na = faults.iter().filter(|f| f["applicable"] == false).count();
-        assert_eq!(na, if fmt.ends_with("propagate") { 6 } else { 0 }, "{fmt}");
+        // propagate: the six rounding faults are not modelled; FTZ: the two flush faults are the
+        // datapath itself
+        let want = if fmt.ends_with("propagate") {
+            6
+        } else if fmt.ends_with("ftz") {
+            2
+        } else {
+            0
+        };
+        assert_eq!(na, want, "{fmt}");
     }
 }
 
@@ -369,4 +378,17 @@ fn a_closed_stdout_pipe_is_not_a_panic() {
 #[cfg(unix)]
 fn libc_sigpipe() -> i32 {
     13 // SIGPIPE on Linux and the BSDs
+}
+
+/// Under FTZ the default RTI sets detect the whole applicable bank from the outputs too; the
+/// flush faults are the FTZ datapath itself and say so.
+#[test]
+fn ftz_rti_sets_detect_the_applicable_bank() {
+    for fmt in ["f32:ftz", "fp16:ftz"] {
+        let (code, v) = campaign(&["--format", fmt]);
+        assert_eq!(code, Some(0), "{fmt}: {:?}", escaped(&v));
+        let na: Vec<_> = v["faults"].as_array().unwrap().iter().filter(|f| f["applicable"] == false).collect();
+        assert_eq!(na.len(), 2, "{fmt}");
+        assert!(na.iter().all(|f| f["not_applicable"].as_str().unwrap().contains("the fault is the datapath")));
+    }
 }

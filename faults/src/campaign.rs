@@ -230,6 +230,10 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
             if !x.reached() {
                 o.applicable = false;
                 o.not_applicable = Some("the site is not in this configuration's datapath".into());
+            } else if x.inherent() {
+                o.applicable = false;
+                o.not_applicable =
+                    Some(format!("{} flushes every subnormal result already: the fault is the datapath", m.format));
             } else if x.unmodelled() {
                 o.applicable = false;
                 o.not_applicable = Some(format!("not modelled in {}", m.format));

@@ -151,7 +151,7 @@ const RTI_MODIFIERS: [(usize, &str, &str); 5] = [
     (6, "huge", "coordinates scaled by 2^12"),
     (7, "tiny", "coordinates scaled by 2^-12"),
     (9, "signed_zero", "some coordinates +0 or -0"),
-    (10, "subnormal", "some inputs the format's smallest subnormals (floats only)"),
+    (10, "subnormal", "some inputs the format's smallest subnormals, written as raw encodings also in FTZ formats (floats only)"),
     (11, "inf_nan", "some inputs +inf, -inf or NaN (floats only; a NaN is a random NaN encoding: either sign, quiet or signaling, random payload)"),
 ];
 
@@ -291,9 +291,10 @@ fn slab_crosses(level: u32) -> Vec<SlabCross> {
     v
 }
 
-const OP_CLASSES: [(&str, &str); 3] = [
+const OP_CLASSES: [(&str, &str); 4] = [
     ("special", "TestFloat level 1: every pair of special operands (zeros, subnormals, min/max normal, one, all-ones significands, inf, NaN; fixed: extremes and one)"),
     ("random", "uniform random operand bits"),
+    ("ties", "floats, add, sub and mul: operand pairs whose exact result lies exactly halfway between two format values (add / sub: a random value in [1, 2) and an odd multiple of its half step below 2^-4; mul: odd significands of na = floor((p + 2) / 2) and p + 2 - na bits whose product has p + 1 bits), found by drawing and checking the exact result in binary64 (p <= 24)"),
     ("special_x_random", "level 2: each special operand against random operands, on either side"),
 ];
 
@@ -563,22 +564,35 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                         }
                         x = rti_case(cross, r);
                     }
+                    // subnormal inputs as raw encodings (also in FTZ formats, whose reads flush
+                    // them: a DUT without the input flush fails)
+                    let mut raw: Vec<(usize, u64)> = Vec::new();
                     if let Some(sp) = cross.special {
                         for _ in 0..1 + r.below(3) {
                             let i = r.below(17) as usize;
                             x[i] = if sp == Special::Subnormal {
-                                let sub = f.to_f64(f.from_bits(1 + r.below(3)));
-                                if r.below(2) == 0 {
-                                    sub
-                                } else {
+                                let k = 1 + r.below(3);
+                                let sub = f.to_f64(f.from_bits(k));
+                                let neg = r.below(2) != 0;
+                                if let FormatKind::Float(l) = f.kind() {
+                                    raw.retain(|&(j, _)| j != i);
+                                    raw.push((i, if neg { l.sign_mask() | k } else { k }));
+                                }
+                                if neg {
                                     -sub
+                                } else {
+                                    sub
                                 }
                             } else {
+                                raw.retain(|&(j, _)| j != i);
                                 [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][r.below(3) as usize]
                             };
                         }
                     }
                     let mut bits: Vec<u64> = x.iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
+                    for (i, b) in raw {
+                        bits[i] = b;
+                    }
                     any_nans(&f, r, &x, &mut bits);
                     if cross.geom == 12 {
                         let (ray, tri) = rti_inputs(&f, &x);
@@ -728,7 +742,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             counts = push_rows(&mut files, per_class);
         }
         Unit::Op => {
-            classes = OP_CLASSES[..if req.level >= 2 { 3 } else { 2 }]
+            classes = OP_CLASSES[..if req.level >= 2 { 4 } else { 3 }]
                 .iter()
                 .map(|(n, c)| (n.to_string(), c.to_string()))
                 .collect();
@@ -772,11 +786,16 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                 for _ in 0..req.count {
                     pairs.push((1, r.next_u64() & mask, (r.next_u64() & mask) | (op << 60)));
                 }
+                if op <= 2 {
+                    for (a, b) in op_ties(&f, op, req.count, &mut r) {
+                        pairs.push((2, a, b | (op << 60)));
+                    }
+                }
                 if req.level >= 2 {
                     for &s in &sp {
                         for _ in 0..req.count.div_ceil(8) {
-                            pairs.push((2, s, (r.next_u64() & mask) | (op << 60)));
-                            pairs.push((2, r.next_u64() & mask, s | (op << 60)));
+                            pairs.push((3, s, (r.next_u64() & mask) | (op << 60)));
+                            pairs.push((3, r.next_u64() & mask, s | (op << 60)));
                         }
                     }
                 }
@@ -1127,6 +1146,58 @@ fn any_nans<F: Format>(f: &F, r: &mut SplitMix64, x: &[f64], bits: &mut [u64]) {
             *b = sign | (((1u64 << l.exp_bits) - 1) << l.man_bits) | payload;
         }
     }
+}
+
+/// Up to `count` operand pairs (encodings) of op code `op` (0 add, 1 sub, 2 mul) whose exact
+/// result lies exactly halfway between two values of float format `f` (p ≤ 24: the exact
+/// result is a binary64 value), each checked: the exact result differs from its rounding by
+/// exactly half the rounded value's step. None for other formats (at most 64 draws per pair).
+fn op_ties<F: Format>(f: &F, op: u64, count: usize, r: &mut SplitMix64) -> Vec<(u64, u64)> {
+    let FormatKind::Float(l) = f.kind() else { return Vec::new() };
+    if l.man_bits > 23 {
+        return Vec::new();
+    }
+    let p = l.man_bits as i32 + 1;
+    // ± an odd integer of n bits over 2^(n-1): in [1, 2)
+    let odd = |n: i32, r: &mut SplitMix64| {
+        let v = ((1u64 << (n - 1)) + r.below(1u64 << (n - 1))) | 1;
+        let s = if r.below(2) == 0 { 1.0 } else { -1.0 };
+        s * v as f64 / ((n - 1) as f64).exp2()
+    };
+    let mut out = Vec::new();
+    for _ in 0..count * 64 {
+        if out.len() == count {
+            break;
+        }
+        let (a, b) = match op {
+            2 => {
+                // odd significands of na and nb bits, na + nb = p + 2: a product of p + 1 bits
+                // (about half the draws) is odd, so exactly halfway
+                let na = (p + 2) / 2;
+                (odd(na, r), odd(p + 2 - na, r))
+            }
+            _ => {
+                let a = f.to_f64(f.from_f64(r.range(1.0, 2.0)));
+                let half = (-(p as f64)).exp2();
+                let k = (2 * r.below(1u64 << (p - 4).clamp(1, 8)) + 1) as f64;
+                (a, if r.below(2) == 0 { k * half } else { -k * half })
+            }
+        };
+        let (fa, fb) = (f.from_f64(a), f.from_f64(b));
+        if f.to_f64(fa) != a || f.to_f64(fb) != b {
+            continue;
+        }
+        let exact = match op {
+            0 => a + b,
+            1 => a - b,
+            _ => a * b,
+        };
+        let rounded = f.to_f64(f.from_f64(exact));
+        if exact.is_finite() && rounded != 0.0 && (exact - rounded).abs() == f.ulp(rounded) / 2.0 {
+            out.push((f.to_bits(fa), f.to_bits(fb)));
+        }
+    }
+    out
 }
 
 /// The t_at_limits class on a placement's encodings: when the unwidened unit hits with number
