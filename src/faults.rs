@@ -4,23 +4,30 @@
 use faults::Campaign;
 use std::path::Path;
 
-/// The campaign over the set in `dir` (its manifest and rows, checked against their hashes).
-pub fn on_dir(dir: &Path, outputs_only: bool) -> Result<Campaign, String> {
+/// The manifest of the set in `dir`.
+fn manifest_of(dir: &Path) -> Result<vectors::manifest::Manifest, String> {
     let path = dir.join("manifest.json");
     let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let m: vectors::manifest::Manifest = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-    let rows = vectors::gen::read_files(dir, &m)?;
-    faults::run(&m, &rows, outputs_only)
+    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The campaign over the set in `dir` with manifest `m` (rows checked against their hashes).
+fn on_set(dir: &Path, m: &vectors::manifest::Manifest, outputs_only: bool) -> Result<Campaign, String> {
+    let rows = vectors::gen::read_files(dir, m)?;
+    faults::run(m, &rows, outputs_only)
+}
+
+/// The campaign over the set in `dir` (its manifest and rows, checked against their hashes).
+pub fn on_dir(dir: &Path, outputs_only: bool) -> Result<Campaign, String> {
+    on_set(dir, &manifest_of(dir)?, outputs_only)
 }
 
 /// For a minimal set (its manifest says so): the campaign over it, which must detect every
 /// fault the manifest names; the number of them. `None` for a full set.
 pub fn check_minimal(dir: &Path) -> Result<Option<usize>, String> {
-    let path = dir.join("manifest.json");
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let m: vectors::manifest::Manifest = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let m = manifest_of(dir)?;
     let Some(min) = &m.minimal else { return Ok(None) };
-    let c = on_dir(dir, min.outputs_only)?;
+    let c = on_set(dir, &m, min.outputs_only)?;
     let missed: Vec<&str> = min
         .detects
         .iter()

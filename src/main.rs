@@ -702,18 +702,7 @@ fn run() -> Result<Outcome, String> {
                 }
                 None => (leaf_size.unwrap_or(4), levels.unwrap_or(64)),
             };
-            let tree = if unit == vectors::gen::Unit::Traverse {
-                let scene = load_scene(scene.as_deref())?;
-                if let Some(p) = &plan {
-                    p.check_scene(&scene)?;
-                }
-                let b = raypipe::bvh::build(&scene, leaf_size);
-                Some(vectors::traverse::TreeInput { name: scene.name.clone(), nodes: b.nodes, root: 0 })
-            } else if scene.is_some() {
-                return Err(format!("--scene is for unit traverse; unit {unit:?} draws its own cases"));
-            } else {
-                None
-            };
+            let tree = traverse_tree(unit, scene.as_deref(), leaf_size, plan.as_ref())?;
             let req = vectors::gen::Request {
                 unit,
                 tree,
@@ -777,15 +766,7 @@ fn run() -> Result<Outcome, String> {
                 None => {
                     limit("--count", count, MAX_VECTOR_COUNT, "a set is built in memory")?;
                     let unit: vectors::gen::Unit = unit.parse()?;
-                    let tree = if unit == vectors::gen::Unit::Traverse {
-                        let scene = load_scene(scene.as_deref())?;
-                        let b = raypipe::bvh::build(&scene, 4);
-                        Some(vectors::traverse::TreeInput { name: scene.name.clone(), nodes: b.nodes, root: 0 })
-                    } else if scene.is_some() {
-                        return Err(format!("--scene is for unit traverse; unit {unit:?} draws its own cases"));
-                    } else {
-                        None
-                    };
+                    let tree = traverse_tree(unit, scene.as_deref(), 4, None)?;
                     let req = vectors::gen::Request {
                         unit,
                         tree,
@@ -888,6 +869,29 @@ fn command_without_threads() -> String {
         }
     }
     out.join(" ")
+}
+
+/// The BVH a traverse vector set uses: the scene's (default: the built-in one) built with
+/// `leaf_size` triangles per leaf, checked against the plan when there is one; `None` for the
+/// other units, which refuse `--scene`.
+fn traverse_tree(
+    unit: vectors::gen::Unit,
+    scene: Option<&std::path::Path>,
+    leaf_size: u32,
+    plan: Option<&raypipe::plan::Plan>,
+) -> Result<Option<vectors::traverse::TreeInput>, String> {
+    if unit != vectors::gen::Unit::Traverse {
+        return match scene {
+            Some(_) => Err(format!("--scene is for unit traverse; unit {unit:?} draws its own cases")),
+            None => Ok(None),
+        };
+    }
+    let scene = load_scene(scene)?;
+    if let Some(p) = plan {
+        p.check_scene(&scene)?;
+    }
+    let b = raypipe::bvh::build(&scene, leaf_size);
+    Ok(Some(vectors::traverse::TreeInput { name: scene.name.clone(), nodes: b.nodes, root: 0 }))
 }
 
 fn main() -> ExitCode {

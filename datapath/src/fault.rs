@@ -45,6 +45,17 @@ pub fn fault_free<F: Format>(f: &F, op: Op, a: F::V, b: F::V) -> F::V {
     }
 }
 
+/// One grid step of `v` in format `f`, as the fault-free datapath takes it: IEEE nextUp when
+/// `up`, else nextDown.
+#[inline(always)]
+pub fn step_free<F: Format>(f: &F, up: bool, v: F::V) -> F::V {
+    if up {
+        f.next_up(v)
+    } else {
+        f.next_down(v)
+    }
+}
+
 /// What a unit's control logic computes: the bits that steer it, the orderings of the
 /// distances it holds, the limits it counts to; fault-free, or with a bug. Every method's
 /// default is the fault-free logic.
@@ -80,11 +91,7 @@ pub trait Fault<F: Format>: Logic {
     /// nextDown of `v` in format `f` (see `slab::STEP_RULES`).
     #[inline(always)]
     fn step(&self, f: &F, _site: &'static str, up: bool, v: F::V) -> F::V {
-        if up {
-            f.next_up(v)
-        } else {
-            f.next_down(v)
-        }
+        step_free(f, up, v)
     }
 }
 

@@ -166,12 +166,13 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
     let class_name = |id: u64| m.classes.iter().find(|c| c.id as u64 == id).map_or(format!("{id}"), |c| c.name.clone());
     let mut outcomes: Vec<Outcome> = bank
         .iter()
-        .map(|s| Outcome {
+        .map(|s| (s, s.benign.and_then(|b| b.applies(variant))))
+        .map(|(s, why)| Outcome {
             name: s.name,
             site: s.site,
             what: s.what,
-            benign: s.benign.and_then(|b| b.applies(variant)).is_some(),
-            benign_why: s.benign.and_then(|b| b.applies(variant)),
+            benign: why.is_some(),
+            benign_why: why,
             applicable: true,
             not_applicable: None,
             detected: false,

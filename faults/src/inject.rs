@@ -5,7 +5,7 @@
 //! formats such a fault is not modelled (and a campaign says so).
 
 use crate::bank::{Kind, Mode, Spec};
-use datapath::fault::{fault_free, Cmp, Fault, Logic};
+use datapath::fault::{fault_free, step_free, Cmp, Fault, Logic};
 use datapath::format::{DivMode, FormatKind};
 use datapath::rti::Op;
 use datapath::Format;
@@ -169,7 +169,7 @@ impl<F: Format> Fault<F> for Injected {
         }
     }
     fn step(&self, f: &F, site: &'static str, up: bool, v: F::V) -> F::V {
-        let r = if up { f.next_up(v) } else { f.next_down(v) };
+        let r = step_free(f, up, v);
         if site != self.spec.site {
             return r;
         }

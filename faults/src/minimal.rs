@@ -43,8 +43,7 @@ pub fn minimal(set: &VectorSet, command: &str) -> Result<(VectorSet, Campaign), 
         keep.push(best);
     }
     keep.sort_unstable();
-    let cut = subset(set, &keep, command)?;
-    let mut cut = cut;
+    let mut cut = subset(set, &rows[0], &keep, command)?;
     cut.manifest.minimal = Some(Minimal {
         from_vectors: n,
         detects: target.iter().map(|&k| full.faults[k].name.to_string()).collect(),
@@ -66,8 +65,9 @@ pub fn minimal(set: &VectorSet, command: &str) -> Result<(VectorSet, Campaign), 
 }
 
 /// The rows `keep` (ascending) of `set`'s per-vector files (inputs, expected outputs, stage
-/// signals), the other files (a traverse set's tree images) whole; class counts recounted.
-fn subset(set: &VectorSet, keep: &[usize], command: &str) -> Result<VectorSet, String> {
+/// signals), the other files (a traverse set's tree images) whole; class counts recounted from
+/// `inputs` (the set's input rows, unpacked).
+fn subset(set: &VectorSet, inputs: &[Vec<u64>], keep: &[usize], command: &str) -> Result<VectorSet, String> {
     let mut out = set.clone();
     let m = &mut out.manifest;
     m.command = command.to_string();
@@ -86,7 +86,6 @@ fn subset(set: &VectorSet, keep: &[usize], command: &str) -> Result<VectorSet, S
         *text = kept.join("\n") + "\n";
         m.files[i].rows = keep.len();
     }
-    let inputs = set_rows(set)?.swap_remove(0);
     for c in m.classes.iter_mut() {
         c.count = keep.iter().filter(|&&k| inputs[k].first() == Some(&(c.id as u64))).count();
     }

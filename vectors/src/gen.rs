@@ -570,12 +570,13 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                     if let Some(sp) = cross.special {
                         for _ in 0..1 + r.below(3) {
                             let i = r.below(17) as usize;
+                            // a later draw at the same input replaces an earlier one
+                            raw.retain(|&(j, _)| j != i);
                             x[i] = if sp == Special::Subnormal {
                                 let k = 1 + r.below(3);
                                 let sub = f.to_f64(f.from_bits(k));
                                 let neg = r.below(2) != 0;
                                 if let FormatKind::Float(l) = f.kind() {
-                                    raw.retain(|&(j, _)| j != i);
                                     raw.push((i, if neg { l.sign_mask() | k } else { k }));
                                 }
                                 if neg {
@@ -584,7 +585,6 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
                                     sub
                                 }
                             } else {
-                                raw.retain(|&(j, _)| j != i);
                                 [f64::INFINITY, f64::NEG_INFINITY, f64::NAN][r.below(3) as usize]
                             };
                         }
