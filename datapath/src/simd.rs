@@ -1732,7 +1732,11 @@ mod isa {
         #[target_feature(enable = "avx512f")]
         pub unsafe fn load_e8(p: *const u64, i: usize, n: &Narrow) -> __m512d {
             let b = unsafe { _mm512_loadu_si512(p.add(i) as *const __m512i) };
-            _mm512_cvtps_pd(_mm256_castsi256_ps(_mm256_sll_epi32(_mm512_cvtepi64_epi32(b), count(n.e8_shift))))
+            // the low halves of the 8 lanes to the low 256 bits: one `vpermd` (a `vpmovqd`
+            // is two shuffle uops); the encodings fit 32 bits
+            let idx = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 0, 0, 0, 0, 0, 0, 0, 0);
+            let low = _mm512_castsi512_si256(_mm512_permutexvar_epi32(idx, b));
+            _mm512_cvtps_pd(_mm256_castsi256_ps(_mm256_sll_epi32(low, count(n.e8_shift))))
         }
         /// [`store_soft`] for `e8mM` with M ≤ 23 (`n.e8`): the lanes hold target values, which
         /// binary32 holds exactly, so narrowing is exact and the binary32 encoding shifted
