@@ -55,6 +55,26 @@ mod tests {
     }
 
     #[test]
+    fn unit_range_and_below_are_the_documented_maps_of_the_bits() {
+        // the reference outputs above, mapped by hand: unit = (x >> 11) · 2^−53 (53 bits,
+        // exact), range(lo, hi) = lo + (hi − lo) · unit, below(n) = ⌊x · n / 2^64⌋
+        let u: f64 = 3153236189995295.0 / 9007199254740992.0;
+        assert_eq!(SplitMix64::new(1234567).unit().to_bits(), u.to_bits());
+        assert_eq!(SplitMix64::new(1234567).range(-2.0, 4.0).to_bits(), (-2.0 + 6.0 * u).to_bits());
+        assert_eq!(SplitMix64::new(1234567).below(1000), 350);
+        let mut r = SplitMix64::new(1234567);
+        r.next_u64();
+        assert_eq!(r.below(10), 1);
+        // every unit is in [0, 1) and every below(n) in 0..n
+        let mut r = SplitMix64::new(7);
+        for _ in 0..1000 {
+            let x = r.unit();
+            assert!((0.0..1.0).contains(&x));
+            assert!(r.below(3) < 3);
+        }
+    }
+
+    #[test]
     fn item_streams_follow_their_definition() {
         let base = SplitMix64::new(5 ^ 9).next_u64();
         let mut want = SplitMix64::new(base.wrapping_add(3));
