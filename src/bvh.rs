@@ -35,6 +35,45 @@ impl SceneBvh {
     }
 }
 
+/// The work a ray does in traversal order up to the leaf holding its nearest hit (every leaf
+/// it reaches when it hits nothing): the thesis's experiments count this work.
+#[derive(Clone, Debug)]
+pub struct NearestWork {
+    /// Leaves visited, in traversal order, up to and including the nearest hit's.
+    pub leaves: Vec<u32>,
+    /// A triangle was hit.
+    pub hit: bool,
+    /// The 2-bit history traversal of those leaves (passes, box tests, back distances).
+    pub history: datapath::bvh::StacklessResult,
+}
+
+impl SceneBvh {
+    /// [`NearestWork`] of `ray`, boxes and triangles tested by the golden f64 tests.
+    pub fn nearest_work(&self, hw: &datapath::bvh::HwTree<u32>, scene: &Scene, ray: &golden::Ray64) -> NearestWork {
+        let test = |i: u32| {
+            let n = &self.nodes[i as usize];
+            let r = golden::slab_f64(ray.o, ray.d, ray.tmin, ray.tmax, n.min, n.max);
+            r.hit.then_some(r.t_near)
+        };
+        let all = datapath::bvh::history_traverse(hw, usize::MAX, |&i| test(i));
+        // the nearest hit over every leaf reached, and the position of its leaf
+        let mut best: Option<(usize, f64)> = None;
+        for (k, &leaf) in all.leaves.iter().enumerate() {
+            for &t in &self.leaf_tris[leaf as usize] {
+                let r = golden::intersect(ray, &scene.tris[t as usize], golden::Faces::default());
+                if r.hit && best.is_none_or(|(_, bt)| r.t < bt) {
+                    best = Some((k, r.t));
+                }
+            }
+        }
+        let upto = best.map_or(all.leaves.len(), |(k, _)| k + 1);
+        let history = datapath::bvh::history_traverse(hw, upto.max(1), |&i| test(i));
+        let mut leaves = all.leaves;
+        leaves.truncate(upto);
+        NearestWork { leaves, hit: best.is_some(), history }
+    }
+}
+
 fn bounds(tris: &[golden::Tri64], ids: &[u32]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];

@@ -4,6 +4,7 @@
 //! (`golden`) and the error bounds ([`judge`]) → report ([`verify`], [`explain`]).
 #![warn(missing_docs)]
 
+pub mod arch;
 pub mod bvh;
 pub mod explain;
 pub mod faults;

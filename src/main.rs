@@ -84,6 +84,78 @@ impl EngineArgs {
     }
 }
 
+/// The thesis hardware's parameters (`raypipe arch`, `raypipe plan`); defaults are the thesis's
+/// values where it gives one (docs/arch.md).
+#[derive(clap::Args, Clone)]
+struct ArchArgs {
+    /// Ray packet buffers interleaved on the RTI pipelines (thesis: 4).
+    #[arg(long, default_value_t = 4)]
+    buffers: u32,
+    /// Cycles to assemble a triangle from DRAM (thesis: 3).
+    #[arg(long, default_value_t = 3)]
+    tri_assemble: u32,
+    /// Cycles to broadcast a triangle (thesis: 1).
+    #[arg(long, default_value_t = 1)]
+    tri_broadcast: u32,
+    /// RTI pipeline latency in cycles.
+    #[arg(long, default_value_t = 7)]
+    rti_latency: u32,
+    /// RTI clock in MHz (thesis: 100).
+    #[arg(long, default_value_t = 100.0)]
+    rti_mhz: f64,
+    /// DRAM bytes per RTI cycle for rays and results.
+    #[arg(long, default_value_t = 12)]
+    dram_bytes: u32,
+    /// Bytes per ray in DRAM.
+    #[arg(long, default_value_t = 36)]
+    ray_bytes: u32,
+    /// Bytes per result in DRAM.
+    #[arg(long, default_value_t = 16)]
+    result_bytes: u32,
+    /// Overlap ray loads and result stores with the triangle stream.
+    #[arg(long)]
+    overlap_io: bool,
+    /// Rays entering the traversal core per cycle (2: dual-port BRAM).
+    #[arg(long, default_value_t = 1)]
+    ports: u32,
+    /// Cycles per level pipeline.
+    #[arg(long, default_value_t = 16)]
+    level_latency: u32,
+    /// Traversal clock in MHz (thesis: 200).
+    #[arg(long, default_value_t = 200.0)]
+    trav_mhz: f64,
+    /// BRAM bits per stored box.
+    #[arg(long, default_value_t = 192)]
+    box_bits: u32,
+    /// BRAM bits per child address word.
+    #[arg(long, default_value_t = 32)]
+    addr_bits: u32,
+}
+
+impl ArchArgs {
+    /// The parameters, with the RTI pipelines and the traversal core's level pipelines.
+    fn params(&self, pipelines: u32, levels: u32) -> raypipe::arch::ArchParams {
+        raypipe::arch::ArchParams {
+            pipelines,
+            buffers: self.buffers,
+            tri_assemble: self.tri_assemble,
+            tri_broadcast: self.tri_broadcast,
+            rti_latency: self.rti_latency,
+            rti_mhz: self.rti_mhz,
+            dram_bytes_per_cycle: self.dram_bytes,
+            ray_bytes: self.ray_bytes,
+            result_bytes: self.result_bytes,
+            overlap_io: self.overlap_io,
+            levels,
+            ports: self.ports,
+            level_latency: self.level_latency,
+            trav_mhz: self.trav_mhz,
+            box_bits: self.box_bits,
+            addr_bits: self.addr_bits,
+        }
+    }
+}
+
 #[derive(clap::Args, Clone)]
 struct VerifyArgs {
     /// OBJ scene (default: the built-in Cornell box + icosphere + needles).
@@ -183,6 +255,40 @@ enum Cmd {
         /// Level pipelines available (the history holds 2 bits per level).
         #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
         levels: u64,
+        /// Print the results as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        run: EngineArgs,
+    },
+    /// The thesis hardware as a throughput model: figure 3-3 (time against leaf size per pipeline count) and its calibration.
+    Arch {
+        /// OBJ scene (default: the built-in scene).
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Rays (half primary, half random incoherent, as `stats`).
+        #[arg(long, default_value_t = 20000, value_parser = clap::value_parser!(u64).range(1..))]
+        rays: u64,
+        /// Random-ray seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Leaf sizes to sweep (1..=255), comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,2,3,4,6,8,12,16,24,32,48,64", value_parser = clap::value_parser!(u32).range(1..=255))]
+        leaf_sizes: Vec<u32>,
+        /// RTI pipeline counts of the figure, comma-separated.
+        #[arg(long = "sweep-pipelines", value_delimiter = ',', default_value = "4,8,16,32", value_parser = clap::value_parser!(u32).range(1..=4096))]
+        sweep: Vec<u32>,
+        /// RTI pipelines of the calibration.
+        #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
+        pipelines: u32,
+        /// Level pipelines of the traversal core (default 32: the thesis's 25 to 32 levels).
+        #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=256))]
+        levels: u32,
+        #[command(flatten)]
+        hw: ArchArgs,
+        /// Write figure 3-3 as SVG into this directory.
+        #[arg(long)]
+        svg: Option<PathBuf>,
         /// Print the results as JSON.
         #[arg(long)]
         json: bool,
@@ -340,7 +446,7 @@ enum Cmd {
         /// Candidate formats, comma-separated.
         #[arg(long, value_delimiter = ',', value_parser = parse_format, default_value = "fp16,bf16,e8m16,f32,q8.24:divide")]
         format: Vec<AnyFormat>,
-        /// RTI pipelines of the design (the recommended leaf size follows from it).
+        /// RTI pipelines at most (the plan chooses the count and the leaf size from the throughput model).
         #[arg(long, default_value_t = 4)]
         pipelines: u32,
         /// Largest acceptable rate of hit/miss disagreements with the golden, per test.
@@ -353,8 +459,19 @@ enum Cmd {
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// Level pipelines the hardware has.
-        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..))]
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..=256))]
         levels: u64,
+        /// BRAM bits the traversal core has for the tree (default: unlimited).
+        #[arg(long)]
+        bram_bits: Option<u64>,
+        /// Rays of the throughput model's traversals.
+        #[arg(long, default_value_t = 20000, value_parser = clap::value_parser!(u64).range(1..))]
+        model_rays: u64,
+        /// Leaf sizes the model considers (1..=255), comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,2,3,4,6,8,12,16,24,32,48,64,128", value_parser = clap::value_parser!(u32).range(1..=255))]
+        leaf_sizes: Vec<u32>,
+        #[command(flatten)]
+        hw: ArchArgs,
         /// Print the plan as JSON.
         #[arg(long)]
         json: bool,
@@ -615,6 +732,23 @@ fn run() -> Result<Outcome, String> {
             emit(json, &rep, raypipe::traverse::render)?;
             Ok(Outcome::from(rep.passed))
         }
+        Some(Cmd::Arch { scene, rays, seed, leaf_sizes, sweep, pipelines, levels, hw, svg, json, run }) => {
+            check_rays(rays)?;
+            let params = hw.params(pipelines, levels);
+            params.check()?;
+            let out = svg.as_deref().map(|d| OutDir::check(d, &raypipe::arch::SVG_FILES)).transpose()?;
+            let scene = load_scene(scene.as_deref())?;
+            let eng = run.engine(raypipe::traverse::CHUNK_RAYS);
+            let cfg = raypipe::arch::ArchConfig { params, pipelines: sweep, leaf_sizes, rays, seed };
+            let rep = raypipe::arch::arch(&eng, &cfg, &scene)?;
+            emit(json, &rep, raypipe::arch::render)?;
+            if let Some(out) = out {
+                for p in raypipe::arch::write_svgs(&rep, &out)? {
+                    eprintln!("wrote {}", p.display());
+                }
+            }
+            Ok(Outcome::Pass)
+        }
         Some(Cmd::Stats { scene, rays, seed, leaf_sizes, svg, json, run }) => {
             check_rays(rays)?;
             let out = svg.as_deref().map(|d| OutDir::check(d, &raypipe::stats::SVG_FILES)).transpose()?;
@@ -787,9 +921,23 @@ fn run() -> Result<Outcome, String> {
             emit(json, &c, raypipe::faults::render)?;
             Ok(Outcome::from(c.complete()))
         }
-        Some(Cmd::Plan { scene, format, pipelines, budget, rays, seed, levels, json }) => {
+        Some(Cmd::Plan {
+            scene,
+            format,
+            pipelines,
+            budget,
+            rays,
+            seed,
+            levels,
+            bram_bits,
+            model_rays,
+            leaf_sizes,
+            hw,
+            json,
+        }) => {
             let scene = load_scene(scene.as_deref())?;
             check_tests(rays, &scene, 512)?;
+            check_rays(model_rays)?;
             let cfg = raypipe::plan::PlanConfig {
                 formats: format,
                 pipelines,
@@ -797,6 +945,10 @@ fn run() -> Result<Outcome, String> {
                 rays: rays as usize,
                 seed,
                 max_levels: levels as usize,
+                arch: hw.params(pipelines.max(1), levels as u32),
+                model_rays,
+                bram_bits,
+                leaf_sizes,
             };
             let p = raypipe::plan::plan(&cfg, &scene)?;
             emit(json, &p, raypipe::plan::render)?;

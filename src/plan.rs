@@ -1,8 +1,11 @@
-//! `raypipe plan`: what a scene needs from the hardware — tree depth (level pipelines and
-//! history bits) at the thesis's recommended leaf size, whether back-face culling applies,
-//! and per candidate format how many triangles collapse when stored and what disagreement
-//! with the golden it costs, with the smallest format meeting an error budget.
+//! `raypipe plan`: what a scene needs from the hardware — the leaf size and RTI pipeline count
+//! with the least modelled time (the thesis hardware's throughput model, [`crate::arch`])
+//! within a budget of pipelines, level pipelines and BRAM bits, beside the thesis's rule of
+//! thumb; tree depth (level pipelines and history bits) at that leaf size; whether back-face
+//! culling applies; and per candidate format how many triangles collapse when stored and what
+//! disagreement with the golden it costs, with the smallest format meeting an error budget.
 
+use crate::arch::{estimate, ArchParams};
 use crate::scene::Scene;
 use crate::verify::{verify, VerifyConfig};
 use datapath::{with_format, AnyFormat, Format};
@@ -14,7 +17,8 @@ use std::collections::HashMap;
 pub struct PlanConfig {
     /// Candidate formats.
     pub formats: Vec<AnyFormat>,
-    /// RTI pipelines of the design (the thesis: leaf size between half and one times this).
+    /// RTI pipelines at most (the plan chooses 1..=this; the thesis's rule of thumb: leaf size
+    /// between half and one times the pipelines).
     pub pipelines: u32,
     /// Largest acceptable rate of hit/miss disagreements with the golden, per test.
     pub budget: f64,
@@ -24,7 +28,19 @@ pub struct PlanConfig {
     pub seed: u64,
     /// Level pipelines the hardware has.
     pub max_levels: usize,
+    /// The throughput model's parameters (its pipelines and levels are the candidates' and
+    /// `max_levels`).
+    pub arch: ArchParams,
+    /// Rays of the model's traversals (half primary, half random, as `raypipe arch`).
+    pub model_rays: u64,
+    /// BRAM bits the traversal core has for the tree, if limited.
+    pub bram_bits: Option<u64>,
+    /// Leaf sizes the model considers (1..=255).
+    pub leaf_sizes: Vec<u32>,
 }
+
+/// The leaf sizes `plan` considers by default.
+pub const LEAF_SIZES: [u32; 13] = [1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64, 128];
 
 /// One candidate format.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -58,12 +74,37 @@ pub struct Plan {
     pub triangles: usize,
     /// Power of two the coordinates were scaled by into [-1, 1]^3.
     pub scale: f64,
-    /// RTI pipelines assumed.
+    /// RTI pipelines chosen (the least modelled time; the fewer on a tie).
     pub pipelines: u32,
-    /// Recommended leaf sizes (half to one times the pipelines).
+    /// The thesis's recommended leaf sizes for those pipelines (half to one times them).
     pub leaf_size_range: [u32; 2],
-    /// Leaf size planned (the top of the range).
+    /// Leaf size chosen (the least modelled time; the smaller on a tie).
     pub leaf_size: u32,
+    /// The budget: RTI pipelines at most.
+    #[serde(default)]
+    pub max_pipelines: u32,
+    /// Modelled time of the chosen design in seconds (traversal + RTI, the model's rays);
+    /// `None` when no candidate fits the budget.
+    #[serde(default)]
+    pub modelled_s: Option<f64>,
+    /// The rule of thumb at the budget: leaf size = pipelines = the budget's pipelines.
+    #[serde(default)]
+    pub rule_leaf_size: u32,
+    /// Its modelled time in seconds (`None` when its tree does not fit the budget).
+    #[serde(default)]
+    pub rule_modelled_s: Option<f64>,
+    /// BRAM bits of the chosen tree (boxes and address words).
+    #[serde(default)]
+    pub bram_bits: u64,
+    /// The BRAM budget, if any.
+    #[serde(default)]
+    pub bram_budget: Option<u64>,
+    /// Rays of the model's traversals.
+    #[serde(default)]
+    pub model_rays: u64,
+    /// The model's parameters (pipelines and levels as chosen).
+    #[serde(default)]
+    pub arch: ArchParams,
     /// Tree levels below the root at that leaf size: the level pipelines needed.
     pub level_pipelines: usize,
     /// Ray history bits (2 per level).
@@ -158,16 +199,80 @@ fn collapsed<F: Format>(f: F, scene: &Scene) -> usize {
         .count()
 }
 
+/// The design the model chooses.
+struct Choice {
+    pipelines: u32,
+    leaf_size: u32,
+    modelled_s: Option<f64>,
+    rule_modelled_s: Option<f64>,
+    bram_bits: u64,
+    arch: ArchParams,
+}
+
+/// The (pipelines, leaf size) with the least modelled time within the budget: pipelines
+/// 1..=`cfg.pipelines`, trees that fit `cfg.max_levels` level pipelines and `cfg.bram_bits`.
+/// Ties go to fewer pipelines, then to the smaller leaf size. When no candidate tree fits, the
+/// rule of thumb (leaf size = pipelines = the budget) is planned and reported as not fitting.
+fn choose(cfg: &PlanConfig, scene: &Scene) -> Result<Choice, String> {
+    let rule = cfg.pipelines.min(255);
+    let mut sizes: Vec<u32> = cfg.leaf_sizes.iter().copied().chain([rule]).filter(|l| (1..=255).contains(l)).collect();
+    sizes.sort_unstable();
+    sizes.dedup();
+    let base = ArchParams { levels: cfg.max_levels.clamp(1, u32::MAX as usize) as u32, ..cfg.arch.clone() };
+    base.check()?;
+    let eng = engine::Engine::new(crate::traverse::CHUNK_RAYS);
+    let gen = crate::traverse::CameraRays::new(scene, cfg.model_rays as usize, cfg.seed);
+    // (time, pipelines, leaf size, bram bits): the order of the comparison is the tie rule
+    let mut best: Option<(f64, u32, u32, u64)> = None;
+    let mut rule_s = None;
+    for &ls in &sizes {
+        let b = crate::bvh::build(scene, ls);
+        if b.depth > cfg.max_levels {
+            continue;
+        }
+        let e = crate::arch::gather(&eng, scene, &b, ls, cfg.model_rays, |k| gen.ray(k))?;
+        for n in 1..=cfg.pipelines {
+            let est = estimate(&ArchParams { pipelines: n, ..base.clone() }, &e);
+            if cfg.bram_bits.is_some_and(|budget| est.bram_bits > budget) {
+                continue;
+            }
+            if n == cfg.pipelines && ls == rule {
+                rule_s = Some(est.total_s);
+            }
+            let cand = (est.total_s, n, ls, est.bram_bits);
+            if best.is_none_or(|b| (cand.0, cand.1, cand.2) < (b.0, b.1, b.2)) {
+                best = Some(cand);
+            }
+        }
+    }
+    let (modelled_s, pipelines, leaf_size, bram_bits) = match best {
+        Some((s, n, l, bits)) => (Some(s), n, l, bits),
+        None => (None, cfg.pipelines, rule, 0),
+    };
+    Ok(Choice {
+        pipelines,
+        leaf_size,
+        modelled_s,
+        rule_modelled_s: rule_s,
+        bram_bits,
+        arch: ArchParams { pipelines, ..base },
+    })
+}
+
 /// Plans the hardware for a scene.
 pub fn plan(cfg: &PlanConfig, scene: &Scene) -> Result<Plan, String> {
     if cfg.pipelines == 0 || cfg.pipelines > 255 {
         return Err(format!("--pipelines must be 1..=255, got {}", cfg.pipelines));
     }
+    if cfg.model_rays == 0 {
+        return Err("--model-rays must be at least 1".into());
+    }
     if cfg.budget.is_nan() || cfg.budget < 0.0 {
         return Err(format!("--budget must be a rate >= 0, got {}", cfg.budget));
     }
-    let leaf_size_range = [cfg.pipelines.div_ceil(2), cfg.pipelines];
-    let leaf_size = cfg.pipelines;
+    let choice = choose(cfg, scene)?;
+    let leaf_size = choice.leaf_size;
+    let leaf_size_range = [choice.pipelines.div_ceil(2), choice.pipelines];
     let b = crate::bvh::build(scene, leaf_size);
     let (closed, oriented) = topology(scene);
     let vcfg = VerifyConfig::new(cfg.formats.clone(), cfg.rays, cfg.seed, Default::default(), 512);
@@ -206,9 +311,17 @@ pub fn plan(cfg: &PlanConfig, scene: &Scene) -> Result<Plan, String> {
         scene: scene.name.clone(),
         triangles: scene.tris.len(),
         scale: scene.scale,
-        pipelines: cfg.pipelines,
+        pipelines: choice.pipelines,
         leaf_size_range,
         leaf_size,
+        max_pipelines: cfg.pipelines,
+        modelled_s: choice.modelled_s,
+        rule_leaf_size: cfg.pipelines.min(255),
+        rule_modelled_s: choice.rule_modelled_s,
+        bram_bits: choice.bram_bits,
+        bram_budget: cfg.bram_bits,
+        model_rays: cfg.model_rays,
+        arch: choice.arch,
         level_pipelines: b.depth,
         history_bits: 2 * b.depth,
         fits_levels: b.depth <= cfg.max_levels,
@@ -229,14 +342,29 @@ pub fn render(p: &Plan) -> String {
         "raypipe plan: scene {} ({} triangles, coordinates x {}), {} RTI pipelines\n\n",
         p.scene, p.triangles, p.scale, p.pipelines
     );
+    let us = |x: Option<f64>| x.map_or("n/a (does not fit)".to_string(), |x| format!("{:.1} us", x * 1e6));
     s += &format!(
-        "leaf size {} (the thesis: {}..={} for {} pipelines): {} level pipelines, {} history bits ({})\n",
+        "modelled (raypipe arch, {} rays): {} pipelines of at most {}, leaf size {}: {}; \
+         the rule of thumb (leaf size = pipelines = {}): {}\n",
+        p.model_rays,
+        p.pipelines,
+        p.max_pipelines,
+        p.leaf_size,
+        us(p.modelled_s),
+        p.rule_leaf_size,
+        us(p.rule_modelled_s)
+    );
+    s += &format!(
+        "leaf size {} (the thesis: {}..={} for {} pipelines): {} level pipelines, {} history bits, \
+         {} BRAM bits{} ({})\n",
         p.leaf_size,
         p.leaf_size_range[0],
         p.leaf_size_range[1],
         p.pipelines,
         p.level_pipelines,
         p.history_bits,
+        p.bram_bits,
+        p.bram_budget.map_or(String::new(), |b| format!(" of {b}")),
         if p.fits_levels { "fits the hardware" } else { "DOES NOT fit the hardware's level pipelines" }
     );
     s += &format!(

@@ -10,9 +10,8 @@
 
 use crate::bvh::build;
 use crate::scene::Scene;
-use datapath::bvh::history_traverse;
 use golden::bvh::stack_traverse;
-use golden::{intersect, slab_f64, Faces};
+use golden::slab_f64;
 use serde::Serialize;
 
 /// Results for one leaf size.
@@ -113,36 +112,24 @@ pub fn stats_on(
                 let mut acc = StatsAcc::default();
                 for k in range {
                     let ray = gen.ray(k);
+                    let w = b.nearest_work(&hw, scene, &ray);
+                    let (h, upto) = (&w.history, w.leaves.len());
                     let test = |i: u32| {
                         let n = &b.nodes[i as usize];
                         let r = slab_f64(ray.o, ray.d, ray.tmin, ray.tmax, n.min, n.max);
                         r.hit.then_some(r.t_near)
                     };
-                    let all = history_traverse(&hw, usize::MAX, |&i| test(i));
-                    // the nearest hit over every leaf reached, and the position of its leaf
-                    let mut best: Option<(usize, f64)> = None;
-                    for (k, &leaf) in all.leaves.iter().enumerate() {
-                        for &t in &b.leaf_tris[leaf as usize] {
-                            let r = intersect(&ray, &scene.tris[t as usize], Faces::default());
-                            if r.hit && best.is_none_or(|(_, bt)| r.t < bt) {
-                                best = Some((k, r.t));
-                            }
-                        }
-                    }
-                    let upto = best.map_or(all.leaves.len(), |(k, _)| k + 1);
-                    let h = history_traverse(&hw, upto.max(1), |&i| test(i));
                     let g = stack_traverse(&tree, upto.max(1), test);
-                    let tests: u64 = all.leaves[..upto].iter().map(|&l| b.leaf_tris[l as usize].len() as u64).sum();
-                    for &leaf in &all.leaves[..upto] {
+                    let tests: u64 = w.leaves.iter().map(|&l| b.leaf_tris[l as usize].len() as u64).sum();
+                    for &leaf in &w.leaves {
                         acc.seen.insert(leaf as usize);
                     }
-                    let add =
-                        [best.is_some() as u64, tests - best.is_some() as u64, h.box_tests, g.box_tests, upto as u64];
+                    let add = [w.hit as u64, tests - w.hit as u64, h.box_tests, g.box_tests, upto as u64];
                     for (a, x) in acc.c.0.iter_mut().zip(add) {
                         *a += x;
                     }
                     acc.back.0[(h.passes.saturating_sub(1) as usize).min(BACK_BINS - 1)] += 1;
-                    for d in h.back_distances {
+                    for &d in &h.back_distances {
                         acc.dist.add((d as usize).min(b.depth + 1), 1);
                     }
                 }
