@@ -97,8 +97,8 @@ struct ArchArgs {
     /// Cycles to broadcast a triangle (thesis: 1).
     #[arg(long, default_value_t = 1)]
     tri_broadcast: u32,
-    /// RTI pipeline latency in cycles.
-    #[arg(long, default_value_t = 7)]
+    /// RTI pipeline latency in cycles (default: the modelled datapath's 10 stages).
+    #[arg(long, default_value_t = 10)]
     rti_latency: u32,
     /// RTI clock in MHz (thesis: 100).
     #[arg(long, default_value_t = 100.0)]

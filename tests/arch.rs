@@ -8,18 +8,18 @@ use raypipe::arch::{estimate, gather, ArchParams, RtiCycles, SceneEvents};
 use raypipe::scene::Scene;
 
 /// One leaf by hand with the default parameters: n = 16, b = min(4, 3 + 1) = 4, so 64 rays a
-/// round, a triangle every 4 cycles, latency 7, 12 DRAM bytes a cycle, 36-byte rays, 16-byte
+/// round, a triangle every 4 cycles, latency 10, 12 DRAM bytes a cycle, 36-byte rays, 16-byte
 /// results.
 #[test]
 fn a_leaf_costs_the_hand_count() {
     let p = ArchParams::default();
     assert_eq!((p.packet(), p.cadence()), (64, 4));
     let mut c = RtiCycles::default();
-    // 100 rays, 5 triangles: 2 rounds; load 100·36/12 = 300; stream 2·4·5 = 40; drain 2·7 = 14;
+    // 100 rays, 5 triangles: 2 rounds; load 100·36/12 = 300; stream 2·4·5 = 40; drain 2·10 = 20;
     // store ⌈100·16/12⌉ = ⌈133.3⌉ = 134
     leaf_cycles(&p, 100, 5, &mut c);
-    assert_eq!(c, RtiCycles { rounds: 2, ray_load: 300, stream: 40, drain: 14, store: 134, total: 488, tests: 500 });
-    // overlapped: max(40 + 14, 300 + 134) = 434
+    assert_eq!(c, RtiCycles { rounds: 2, ray_load: 300, stream: 40, drain: 20, store: 134, total: 494, tests: 500 });
+    // overlapped: max(40 + 20, 300 + 134) = 434
     let mut o = RtiCycles::default();
     leaf_cycles(&ArchParams { overlap_io: true, ..p.clone() }, 100, 5, &mut o);
     assert_eq!(o.total, 434);
@@ -79,17 +79,17 @@ fn the_events_and_cycles_of_a_hand_built_scene_are_the_hand_count() {
         }
     );
     let p = ArchParams::default();
-    // leaf of triangle 0: 2 rays, 1 round: load 6, stream 4, drain 7, store ⌈32/12⌉ = 3 → 20;
-    // leaf of triangle 1: 1 ray: load 3, stream 4, drain 7, store ⌈16/12⌉ = 2 → 16
+    // leaf of triangle 0: 2 rays, 1 round: load 6, stream 4, drain 10, store ⌈32/12⌉ = 3 → 23;
+    // leaf of triangle 1: 1 ray: load 3, stream 4, drain 10, store ⌈16/12⌉ = 2 → 19
     let r = rti_cycles(&p, &e);
-    assert_eq!((r.rounds, r.ray_load, r.stream, r.drain, r.store, r.total, r.tests), (2, 9, 8, 14, 5, 36, 3));
+    assert_eq!((r.rounds, r.ray_load, r.stream, r.drain, r.store, r.total, r.tests), (2, 9, 8, 20, 5, 42, 3));
     // traversal: 4 slots, 1 trip (depth 1 ≤ 32 levels), fill 32 · 16 = 512
     let t = trav_cycles(&p, &e);
     assert_eq!((t.trips, t.slots, t.fill, t.total), (1, 4, 512, 516));
     let est = estimate(&p, &e);
-    assert_eq!(est.rti_s, 36.0 / 100e6);
+    assert_eq!(est.rti_s, 42.0 / 100e6);
     assert_eq!(est.trav_s, 516.0 / 200e6);
-    assert_eq!(est.total_s, 36.0 / 100e6 + 516.0 / 200e6);
+    assert_eq!(est.total_s, 42.0 / 100e6 + 516.0 / 200e6);
     assert_eq!(est.bram_bits, 3 * (192 + 32));
     // a tree deeper than the level pipelines takes ⌈depth / L⌉ trips per pass
     let deep = SceneEvents { depth: 70, ..e.clone() };

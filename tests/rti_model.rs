@@ -8,7 +8,7 @@ use datapath::format::DivMode;
 use datapath::probe::{NoProbe, Recorder, Signal};
 use datapath::rng::SplitMix64;
 use datapath::rti::{
-    stage_table, Capture, Cull, HitsSoa, Op, Ray, RaysSoa, Rti, RtiConfig, TieRule, Tri, TrisSoa, RTI_INPUTS,
+    stage_count, stage_table, Capture, Cull, HitsSoa, Op, Ray, RaysSoa, Rti, RtiConfig, TieRule, Tri, TrisSoa, RTI_INPUTS,
 };
 use datapath::{with_format, Format};
 
@@ -141,6 +141,10 @@ fn stage_table_has_the_51_operations_plus_the_uv_add() {
         // the valid bit is decided before any division
         let valid_stage = t.iter().find(|d| d.name == "valid").unwrap().stage;
         assert!(t.iter().filter(|d| d.op == Op::Div).all(|d| d.stage > valid_stage));
+        // the latency the vector manifests state: the table's last stage (documented: 10 with
+        // the reciprocal, 9 with the divider)
+        assert_eq!(stage_count(div), t.iter().map(|d| d.stage).max().unwrap());
+        assert_eq!(stage_count(div), if div == DivMode::RecipMul { 10 } else { 9 });
     }
 }
 

@@ -17,7 +17,8 @@ pub struct ArchParams {
     /// Cycles to broadcast an assembled triangle to the pipelines (thesis ch. 4: 1).
     pub tri_broadcast: u32,
     /// RTI pipeline latency in cycles, ray and triangle in to min-capture updated (no thesis
-    /// value; default 7, one cycle per stage of the modelled datapath).
+    /// value; default 10, one cycle per stage of the modelled datapath with the reciprocal,
+    /// `datapath::rti::stage_count`).
     pub rti_latency: u32,
     /// RTI clock in MHz (thesis ch. 4: 100).
     pub rti_mhz: f64,
@@ -54,7 +55,7 @@ impl Default for ArchParams {
             buffers: 4,
             tri_assemble: 3,
             tri_broadcast: 1,
-            rti_latency: 7,
+            rti_latency: datapath::rti::stage_count(datapath::format::DivMode::RecipMul) as u32,
             rti_mhz: 100.0,
             dram_bytes_per_cycle: 12,
             ray_bytes: 36,
