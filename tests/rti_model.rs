@@ -8,7 +8,8 @@ use datapath::format::DivMode;
 use datapath::probe::{NoProbe, Recorder, Signal};
 use datapath::rng::SplitMix64;
 use datapath::rti::{
-    stage_count, stage_table, Capture, Cull, HitsSoa, Op, Ray, RaysSoa, Rti, RtiConfig, TieRule, Tri, TrisSoa, RTI_INPUTS,
+    stage_count, stage_table, Capture, Cull, HitsSoa, Op, Ray, RaysSoa, Rti, RtiConfig, TieRule, Tri, TrisSoa,
+    RTI_INPUTS,
 };
 use datapath::{with_format, Format};
 
