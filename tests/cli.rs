@@ -386,6 +386,52 @@ fn plan_stress_report_and_speed_refuse_bad_input_clearly() {
     assert_clear_error(&raypipe(&["plan", "--budget=-1"]), "--budget");
     assert_clear_error(&raypipe(&["plan", "--scene", "/nonexistent.obj"]), "nonexistent");
     assert_clear_error(&raypipe(&["speed", "--pairs", "4"]), "--pairs");
+    assert_clear_error(&raypipe(&["plan", "--bram-bits=-3"]), "--bram-bits");
+    assert_clear_error(&raypipe(&["plan", "--dram-bytes", "0"]), "--dram-bytes");
+    assert_clear_error(&raypipe(&["arch", "--dram-bytes", "0"]), "--dram-bytes");
+    assert_clear_error(&raypipe(&["arch", "--rti-mhz", "0"]), "--rti-mhz");
+    assert_clear_error(&raypipe(&["arch", "--leaf-sizes", "0"]), "--leaf-sizes");
+    assert_clear_error(&raypipe(&["arch", "--sweep-pipelines", "0"]), "--sweep-pipelines");
+    assert_clear_error(&raypipe(&["arch", "--scene", "/nonexistent.obj"]), "nonexistent");
+}
+
+/// `raypipe arch`: one estimate per (leaf size, pipeline count), an optimum per pipeline count
+/// (the least total time among its rows), and the calibration's peak.
+#[test]
+fn arch_prints_figure_3_3_as_json_and_svg() {
+    let dir = std::env::temp_dir().join(format!("raypipe-cli-{}-arch", std::process::id()));
+    let o = raypipe(&[
+        "arch",
+        "--rays",
+        "500",
+        "--leaf-sizes",
+        "1,4,16",
+        "--sweep-pipelines",
+        "2,8",
+        "--svg",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3 * 2);
+    for opt in v["optima"].as_array().unwrap() {
+        let n = opt["pipelines"].as_u64().unwrap();
+        let least = rows
+            .iter()
+            .filter(|r| r["pipelines"] == n)
+            .map(|r| r["total_s"].as_f64().unwrap())
+            .fold(f64::INFINITY, f64::min);
+        assert_eq!(opt["total_s"].as_f64().unwrap(), least);
+    }
+    // 16 pipelines (the default) at 100 MHz, 4 buffers, a triangle every 4 cycles: 1.6 G/s
+    assert_eq!(v["calibration"]["peak_rti_rate"].as_f64().unwrap(), 1.6e9);
+    assert_eq!(v["seed"], 1);
+    for f in raypipe::arch::SVG_FILES {
+        assert!(std::fs::read_to_string(dir.join(f)).unwrap().starts_with("<svg"), "{f}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
