@@ -99,6 +99,9 @@ pub struct Plan {
     /// The BRAM budget, if any.
     #[serde(default)]
     pub bram_budget: Option<u64>,
+    /// The chosen tree fits the BRAM budget.
+    #[serde(default)]
+    pub fits_bram: bool,
     /// Rays of the model's traversals.
     #[serde(default)]
     pub model_rays: u64,
@@ -247,7 +250,12 @@ fn choose(cfg: &PlanConfig, scene: &Scene) -> Result<Choice, String> {
     }
     let (modelled_s, pipelines, leaf_size, bram_bits) = match best {
         Some((s, n, l, bits)) => (Some(s), n, l, bits),
-        None => (None, cfg.pipelines, rule, 0),
+        None => {
+            // nothing fits: the rule of thumb's tree, with the BRAM it would need
+            let b = crate::bvh::build(scene, rule);
+            let inner = b.nodes.iter().filter(|n| n.children.is_some()).count() as u64;
+            (None, cfg.pipelines, rule, (1 + 2 * inner) * (base.box_bits + base.addr_bits) as u64)
+        }
     };
     Ok(Choice {
         pipelines,
@@ -320,6 +328,7 @@ pub fn plan(cfg: &PlanConfig, scene: &Scene) -> Result<Plan, String> {
         rule_modelled_s: choice.rule_modelled_s,
         bram_bits: choice.bram_bits,
         bram_budget: cfg.bram_bits,
+        fits_bram: cfg.bram_bits.is_none_or(|budget| choice.bram_bits <= budget),
         model_rays: cfg.model_rays,
         arch: choice.arch,
         level_pipelines: b.depth,
@@ -365,7 +374,11 @@ pub fn render(p: &Plan) -> String {
         p.history_bits,
         p.bram_bits,
         p.bram_budget.map_or(String::new(), |b| format!(" of {b}")),
-        if p.fits_levels { "fits the hardware" } else { "DOES NOT fit the hardware's level pipelines" }
+        match (p.fits_levels, p.fits_bram) {
+            (true, true) => "fits the hardware",
+            (false, _) => "DOES NOT fit the hardware's level pipelines",
+            (true, false) => "DOES NOT fit the BRAM budget",
+        }
     );
     s += &format!(
         "mesh: closed {}, consistently oriented {}: back-face culling {}\n\n",

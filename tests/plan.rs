@@ -110,4 +110,9 @@ fn the_plan_chooses_the_least_modelled_time_within_the_budget() {
     let q = plan(&tight, &scene).unwrap();
     assert!(q.bram_bits < p.bram_bits || q.modelled_s.is_none(), "{q:?}");
     assert_ne!((q.pipelines, q.leaf_size, q.modelled_s), (p.pipelines, p.leaf_size, p.modelled_s));
+    assert!(p.fits_bram && q.fits_bram == q.modelled_s.is_some());
+    // a budget no tree fits: the rule of thumb's tree, reported as not fitting, with its bits
+    let none = plan(&PlanConfig { bram_bits: Some(1), ..c.clone() }, &scene).unwrap();
+    assert_eq!((none.modelled_s, none.fits_bram, none.leaf_size), (None, false, 8));
+    assert!(none.bram_bits > 1);
 }
