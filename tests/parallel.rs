@@ -36,13 +36,13 @@ fn verify_does_not_depend_on_threads_or_chunks() {
     let base = cfg(&["f32", "fp16", "q8.24:divide"], 64, 5);
     let one = {
         let mut c = base.clone();
-        c.engine = engine::Engine { threads: 1, chunk: 64 };
+        c.engine = engine::Engine { threads: 1, chunk: 64, shard: engine::Shard::ALL };
         verify(&c, &scene)
     };
     assert!(one.formats.iter().all(|f| f.tests > 0));
     for (threads, chunk) in [(2, 16), (2, 1), (3, 5), (1, 7), (4, 1000)] {
         let mut c = base.clone();
-        c.engine = engine::Engine { threads, chunk };
+        c.engine = engine::Engine { threads, chunk, shard: engine::Shard::ALL };
         assert_eq!(untimed(&one), untimed(&verify(&c, &scene)), "threads {threads} chunk {chunk}");
     }
     let s1 = pool(1).install(|| verify_slab(&base, &scene));
@@ -173,7 +173,7 @@ fn the_streaming_engine_equals_the_scalar_judge() {
 fn stats_and_traverse_do_not_depend_on_threads_or_chunks() {
     let scene = Scene::builtin();
     let on = |threads, chunk| {
-        raypipe::stats::stats_on(&engine::Engine { threads, chunk }, false, &scene, &[2, 8], 300, 4).unwrap()
+        raypipe::stats::stats_on(&engine::Engine { threads, chunk, shard: engine::Shard::ALL }, false, &scene, &[2, 8], 300, 4).unwrap()
     };
     let one = on(1, 1000);
     for (t, c) in [(2, 256), (3, 7), (2, 1)] {
@@ -181,7 +181,7 @@ fn stats_and_traverse_do_not_depend_on_threads_or_chunks() {
     }
     assert!(one.rows.iter().all(|r| r.rays_hit > 0));
     let tr = |threads, chunk| {
-        raypipe::traverse::traverse(&traverse_cfg(200, 3, engine::Engine { threads, chunk }), &scene).unwrap()
+        raypipe::traverse::traverse(&traverse_cfg(200, 3, engine::Engine { threads, chunk, shard: engine::Shard::ALL }), &scene).unwrap()
     };
     let one = tr(1, 1000);
     assert!(one.passed && one.rows.iter().all(|r| r.leaves > 0));

@@ -3,6 +3,7 @@
 //! commutative, `Default` is its identity, no floating-point sum anywhere), so a run's result
 //! does not depend on how its items were chunked, scheduled or merged.
 
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::collections::BTreeMap;
 
 /// An accumulator: `Default` is the empty result, `merge` adds another chunk's result. `merge`
@@ -22,6 +23,21 @@ impl<const N: usize> Default for Counts<N> {
     }
 }
 
+// serde's arrays stop at 32: a sequence of exactly N numbers
+impl<const N: usize> Serialize for Counts<N> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.0.as_slice().serialize(s)
+    }
+}
+
+impl<'de, const N: usize> Deserialize<'de> for Counts<N> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = Vec::<u64>::deserialize(d)?;
+        let n = v.len();
+        v.try_into().map(Counts).map_err(|_| serde::de::Error::custom(format!("expected {N} counts, found {n}")))
+    }
+}
+
 impl<const N: usize> Merge for Counts<N> {
     fn merge(&mut self, other: Self) {
         for (a, b) in self.0.iter_mut().zip(other.0) {
@@ -32,7 +48,7 @@ impl<const N: usize> Merge for Counts<N> {
 
 /// The record with the smallest key (e.g. the first violation by item index), merged by taking
 /// the smaller key; equal keys keep `self`'s record (keys are unique per item in practice).
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct First<K, T>(pub Option<(K, T)>);
 
 impl<K, T> Default for First<K, T> {
@@ -77,12 +93,25 @@ const HIST_SHIFT: u32 = 52 - HIST_FRACTION_BITS;
 /// `[from_bits(b << 42), from_bits((b + 1) << 42))` and every bucket is narrower than 2⁻¹⁰ of
 /// its lower edge; 0 and subnormals below 2⁻¹⁰²² · 2⁻⁴² share bucket 0's range as the encoding
 /// says. A NaN or negative value is counted in `invalid`, not in a bucket.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Hist {
     buckets: BTreeMap<u32, u64>,
     count: u64,
     invalid: u64,
+    /// Serialised as its binary64 encoding (JSON has no +∞).
+    #[serde(with = "f64_bits")]
     max: f64,
+}
+
+/// An f64 as its encoding.
+mod f64_bits {
+    use serde::{Deserialize, Deserializer, Serializer};
+    pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_u64(x.to_bits())
+    }
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        u64::deserialize(d).map(f64::from_bits)
+    }
 }
 
 impl Hist {
@@ -155,7 +184,7 @@ impl Merge for Hist {
 }
 
 /// A set of small indices as a bitmap, merged by union.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Bits(Vec<u64>);
 
 impl Bits {
@@ -186,7 +215,7 @@ impl Merge for Bits {
 
 /// Integer counters of a length known only at run time (e.g. one per tree level), merged by
 /// element-wise addition; a shorter operand counts as zeros.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Tally(pub Vec<u64>);
 
 impl Tally {

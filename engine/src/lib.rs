@@ -29,4 +29,4 @@ pub mod run;
 
 pub use acc::{Bits, Counts, First, Hist, Merge, Tally};
 pub use progress::Progress;
-pub use run::{run, Engine};
+pub use run::{run, Engine, Shard};
