@@ -189,6 +189,13 @@ struct VerifyArgs {
     /// No progress bar on stderr.
     #[arg(long)]
     quiet: bool,
+    /// Run one shard of the rays: K/N (0 <= K < N), or `slurm` (the Slurm array task's);
+    /// needs --partial.
+    #[arg(long)]
+    shard: Option<String>,
+    /// Write this shard's partial result to FILE (JSON) for `raypipe merge`.
+    #[arg(long)]
+    partial: Option<PathBuf>,
     #[command(flatten)]
     rti: RtiArgs,
 }
@@ -260,6 +267,15 @@ enum Cmd {
         json: bool,
         #[command(flatten)]
         run: EngineArgs,
+    },
+    /// Merge the partial results of a sharded run (--shard K/N --partial FILE) into its report.
+    Merge {
+        /// The partial files, one per shard (any order).
+        #[arg(required = true)]
+        partials: Vec<PathBuf>,
+        /// Print the results as JSON.
+        #[arg(long)]
+        json: bool,
     },
     /// The thesis hardware as a throughput model: figure 3-3 (time against leaf size per pipeline count) and its calibration.
     Arch {
@@ -643,12 +659,59 @@ fn run_verify(a: VerifyArgs) -> Result<Outcome, String> {
         (true, None) => DEFAULT_FORMATS.iter().map(|f| f.parse().expect("built-in format name")).collect(),
     };
     check_tests(a.rays, &scene, a.sample)?;
+    let shard = shard_of(a.shard.as_deref(), a.partial.as_deref())?;
     let mut cfg = VerifyConfig::new(formats, a.rays as usize, a.seed, rti, a.sample as usize);
-    cfg.engine = engine::Engine::new(a.chunk).with_threads(a.threads.map(|t| t as usize));
+    cfg.engine = engine::Engine::new(a.chunk).with_threads(a.threads.map(|t| t as usize)).with_shard(shard);
     cfg.progress = !a.quiet;
+    if let Some(path) = &a.partial {
+        let data = raypipe::verify::accumulate(&cfg, &scene);
+        let p = raypipe::partial::Partial {
+            raypipe_partial: raypipe::partial::FORMAT,
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            command: "verify".into(),
+            args: raypipe::verify::args(&cfg),
+            scene_hash: raypipe::partial::scene_hash(&scene),
+            chunk: a.chunk,
+            shard,
+            data,
+        };
+        raypipe::partial::write(path, &p)?;
+        return wrote_partial(a.json, "verify", shard, path);
+    }
     let rep = verify(&cfg, &scene);
     emit(a.json, &rep, render)?;
     Ok(rep.outcome())
+}
+
+/// The shard of a run from `--shard` (checked against `--partial` before any work: a shard
+/// needs a partial file to write, and the file must be one raypipe may write).
+fn shard_of(shard: Option<&str>, partial: Option<&std::path::Path>) -> Result<engine::Shard, String> {
+    let s = match shard {
+        Some(s) => engine::Shard::parse(s, |v| std::env::var(v).ok())?,
+        None => engine::Shard::ALL,
+    };
+    match partial {
+        Some(p) => raypipe::partial::check_path(p)?,
+        None if shard.is_some() => {
+            return Err("--shard needs --partial FILE (merge the shards with raypipe merge)".into())
+        }
+        None => {}
+    }
+    Ok(s)
+}
+
+/// What a shard prints once its partial is written.
+fn wrote_partial(json: bool, command: &str, shard: engine::Shard, path: &std::path::Path) -> Result<Outcome, String> {
+    if json {
+        let v = serde_json::json!({ "command": command, "shard": shard, "partial": path.display().to_string() });
+        println!("{}", serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?);
+    } else {
+        println!(
+            "raypipe {command}: shard {shard} written to {} (merge every shard with raypipe merge)",
+            path.display()
+        );
+    }
+    Ok(Outcome::Pass)
 }
 
 fn stages_markdown(table: &[datapath::rti::SigDef]) -> String {
@@ -686,6 +749,8 @@ fn run() -> Result<Outcome, String> {
             threads: None,
             chunk: raypipe::verify::CHUNK_RAYS,
             quiet: false,
+            shard: None,
+            partial: None,
             rti: RtiArgs { cull: false, det_threshold: 0.0, tie: Tie::First },
         }),
         Some(Cmd::Verify(a)) => run_verify(a),
@@ -731,6 +796,25 @@ fn run() -> Result<Outcome, String> {
             let rep = raypipe::traverse::traverse(&cfg, &scene)?;
             emit(json, &rep, raypipe::traverse::render)?;
             Ok(Outcome::from(rep.passed))
+        }
+        Some(Cmd::Merge { partials, json }) => {
+            let parts = raypipe::partial::read_all(&partials)?;
+            match parts[0].command.as_str() {
+                "verify" => {
+                    let mut total: Option<raypipe::verify::VerifyData> = None;
+                    for p in &parts {
+                        let d: raypipe::verify::VerifyData = raypipe::partial::data(p)?;
+                        match total.as_mut() {
+                            Some(t) => t.merge(d)?,
+                            None => total = Some(d),
+                        }
+                    }
+                    let rep = raypipe::verify::finish(total.expect("at least one partial"));
+                    emit(json, &rep, render)?;
+                    Ok(rep.outcome())
+                }
+                other => Err(format!("raypipe merge: partials of '{other}' cannot be merged by this raypipe")),
+            }
         }
         Some(Cmd::Arch { scene, rays, seed, leaf_sizes, sweep, pipelines, levels, hw, svg, json, run }) => {
             check_rays(rays)?;

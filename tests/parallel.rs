@@ -173,7 +173,15 @@ fn the_streaming_engine_equals_the_scalar_judge() {
 fn stats_and_traverse_do_not_depend_on_threads_or_chunks() {
     let scene = Scene::builtin();
     let on = |threads, chunk| {
-        raypipe::stats::stats_on(&engine::Engine { threads, chunk, shard: engine::Shard::ALL }, false, &scene, &[2, 8], 300, 4).unwrap()
+        raypipe::stats::stats_on(
+            &engine::Engine { threads, chunk, shard: engine::Shard::ALL },
+            false,
+            &scene,
+            &[2, 8],
+            300,
+            4,
+        )
+        .unwrap()
     };
     let one = on(1, 1000);
     for (t, c) in [(2, 256), (3, 7), (2, 1)] {
@@ -181,7 +189,11 @@ fn stats_and_traverse_do_not_depend_on_threads_or_chunks() {
     }
     assert!(one.rows.iter().all(|r| r.rays_hit > 0));
     let tr = |threads, chunk| {
-        raypipe::traverse::traverse(&traverse_cfg(200, 3, engine::Engine { threads, chunk, shard: engine::Shard::ALL }), &scene).unwrap()
+        raypipe::traverse::traverse(
+            &traverse_cfg(200, 3, engine::Engine { threads, chunk, shard: engine::Shard::ALL }),
+            &scene,
+        )
+        .unwrap()
     };
     let one = tr(1, 1000);
     assert!(one.passed && one.rows.iter().all(|r| r.leaves > 0));

@@ -95,7 +95,10 @@ fn rti_classes_count_failures_cracks_and_undecided_inputs() {
 #[test]
 fn the_suite_is_deterministic_and_thread_independent() {
     let c = cfg(&["fp16"], &["plain"], 20);
-    let on = |threads, chunk| stress(&StressConfig { engine: engine::Engine { threads, chunk, shard: engine::Shard::ALL }, ..c.clone() }).unwrap();
+    let on = |threads, chunk| {
+        stress(&StressConfig { engine: engine::Engine { threads, chunk, shard: engine::Shard::ALL }, ..c.clone() })
+            .unwrap()
+    };
     let one = on(1, 1 << 20);
     for (t, ch) in [(2, 64), (3, 7), (2, 1)] {
         assert_eq!(serde_json::to_string(&one).unwrap(), serde_json::to_string(&on(t, ch)).unwrap(), "{t} {ch}");

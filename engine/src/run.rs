@@ -171,9 +171,8 @@ mod tests {
         let n = 10_007;
         let whole = toy(&Engine { threads: 2, chunk: 64, shard: Shard::ALL }, n);
         for shards in [1, 2, 3, 7, 200] {
-            let parts: Vec<_> = (0..shards)
-                .map(|k| toy(&Engine { threads: 2, chunk: 64, shard: Shard { k, n: shards } }, n))
-                .collect();
+            let parts: Vec<_> =
+                (0..shards).map(|k| toy(&Engine { threads: 2, chunk: 64, shard: Shard { k, n: shards } }, n)).collect();
             let e = Engine::new(64);
             let total: u64 = (0..shards).map(|k| e.with_shard(Shard { k, n: shards }).shard_items(n)).sum();
             assert_eq!(total, n);

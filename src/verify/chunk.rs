@@ -74,7 +74,7 @@ pub fn explain_cmd(fmt: &str, ray: &Ray64, tri: &Tri64, scale: f64) -> String {
 /// fell through the f64 filter to exact arithmetic), the t
 /// errors of shared hits in ulps and relative, the first violation by (ray, test), and the
 /// nanoseconds spent in the model's batch calls.
-#[derive(Default)]
+#[derive(Default, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct RtiAcc {
     c: Counts<11>,
     ulps: Hist,
@@ -95,7 +95,7 @@ impl Merge for RtiAcc {
 
 /// One slab variant's results: counts (tests, exact hits, false misses, false hits, exact
 /// calls) and the nanoseconds in its batch calls.
-#[derive(Default)]
+#[derive(Default, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct SlabAcc {
     c: Counts<5>,
     model_ns: u64,
@@ -422,6 +422,89 @@ fn rate(tests: u64, ns: u64) -> f64 {
     }
 }
 
+/// One format's results over the engine's shard of the rays, before the report: what a
+/// partial result carries and [`FormatAcc::merge`] adds up (every field an exact monoid;
+/// the nanosecond sums are timings, which a merged report adds up too).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FormatAcc {
+    name: String,
+    width: u32,
+    rti: Option<RtiAcc>,
+    /// Per slab variant the format accepts: its name, whether it is conservative, its results.
+    slab: Vec<(String, bool, SlabAcc)>,
+    wall_ns: u64,
+}
+
+impl FormatAcc {
+    /// The format's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Adds another shard's results of the same format (refused when they are not).
+    pub fn merge(&mut self, o: FormatAcc) -> Result<(), String> {
+        let shape = |a: &FormatAcc| {
+            (a.name.clone(), a.width, a.rti.is_some(), a.slab.iter().map(|v| (v.0.clone(), v.1)).collect::<Vec<_>>())
+        };
+        if shape(self) != shape(&o) {
+            return Err(format!("partials disagree on format {}: {:?} vs {:?}", self.name, shape(self), shape(&o)));
+        }
+        if let (Some(a), Some(b)) = (self.rti.as_mut(), o.rti) {
+            a.merge(b);
+        }
+        for (a, b) in self.slab.iter_mut().zip(o.slab) {
+            a.2.merge(b.2);
+        }
+        self.wall_ns += o.wall_ns;
+        Ok(())
+    }
+
+    /// The format's RTI report (when it ran the RTI unit) and one slab report per variant.
+    pub fn finish(self) -> (Option<FormatReport>, Vec<SlabReport>) {
+        let rep = self.rti.map(|acc| {
+            let c = acc.c.0;
+            FormatReport {
+                format: self.name.clone(),
+                width: self.width,
+                tests: c[0],
+                decisive: c[1],
+                golden_hits: c[2],
+                model_hits: c[3],
+                false_misses: c[4],
+                false_hits: c[5],
+                violations: c[6],
+                shared_hits: c[7],
+                t_err_ulps_median: acc.ulps.median(),
+                t_err_ulps_max: acc.ulps.max(),
+                t_err_rel_median: acc.rels.median(),
+                t_err_rel_max: acc.rels.max(),
+                closest_disagreements: c[8],
+                divide_skipped: c[9],
+                exact: c[10],
+                mtests_per_s: rate(c[0], acc.model_ns),
+                judged_mtests_per_s: rate(c[0], self.wall_ns),
+                first_violation: acc.first.into_inner(),
+            }
+        });
+        let slab = self
+            .slab
+            .into_iter()
+            .map(|(variant, conservative, a)| SlabReport {
+                format: self.name.clone(),
+                variant,
+                conservative,
+                tests: a.c.0[0],
+                exact_hits: a.c.0[1],
+                false_misses: a.c.0[2],
+                false_hits: a.c.0[3],
+                exact_calls: a.c.0[4],
+                mtests_per_s: rate(a.c.0[0], a.model_ns),
+            })
+            .collect();
+        (rep, slab)
+    }
+}
+
 /// One format's pass over every ray on the engine: the RTI report (when `with_rti`) and one
 /// slab report per variant the format accepts.
 pub fn run_format<F: Format + 'static>(
@@ -430,6 +513,14 @@ pub fn run_format<F: Format + 'static>(
     scene: &Scene,
     with_rti: bool,
 ) -> (Option<FormatReport>, Vec<SlabReport>)
+where
+    F::V: 'static + Default + Send + Sync,
+{
+    accumulate_format(fmt, cfg, scene, with_rti).finish()
+}
+
+/// One format's pass over the engine's shard of the rays, as an accumulator.
+pub fn accumulate_format<F: Format + 'static>(fmt: F, cfg: &VerifyConfig, scene: &Scene, with_rti: bool) -> FormatAcc
 where
     F::V: 'static + Default + Send + Sync,
 {
@@ -486,7 +577,7 @@ where
         name: f.name(),
         rti: rti.clone(),
     };
-    let progress = Progress::new(cfg.rays as u64, "rays", !cfg.progress);
+    let progress = Progress::new(cfg.engine.shard_items(cfg.rays as u64), "rays", !cfg.progress);
     progress.message(format!("{} ({} tests per ray)", setup.name, tests_per_ray(scene, cfg.sample)));
     let wall = Instant::now();
     let (acc, sacc) = engine::run(&cfg.engine, cfg.rays as u64, &progress, Scratch::new, |s, r| setup.chunk(s, r));
@@ -494,44 +585,11 @@ where
     progress.finish();
     // an empty run merges nothing: one empty accumulator per variant
     let sacc = if sacc.is_empty() { setup.variants.iter().map(|_| SlabAcc::default()).collect() } else { sacc };
-    let c = acc.c.0;
-    let rep = with_rti.then(|| FormatReport {
-        format: setup.name.clone(),
+    FormatAcc {
+        name: setup.name.clone(),
         width: f.width(),
-        tests: c[0],
-        decisive: c[1],
-        golden_hits: c[2],
-        model_hits: c[3],
-        false_misses: c[4],
-        false_hits: c[5],
-        violations: c[6],
-        shared_hits: c[7],
-        t_err_ulps_median: acc.ulps.median(),
-        t_err_ulps_max: acc.ulps.max(),
-        t_err_rel_median: acc.rels.median(),
-        t_err_rel_max: acc.rels.max(),
-        closest_disagreements: c[8],
-        divide_skipped: c[9],
-        exact: c[10],
-        mtests_per_s: rate(c[0], acc.model_ns),
-        judged_mtests_per_s: rate(c[0], wall_ns),
-        first_violation: acc.first.into_inner(),
-    });
-    let slab = setup
-        .variants
-        .iter()
-        .zip(sacc)
-        .map(|(v, a)| SlabReport {
-            format: setup.name.clone(),
-            variant: v.name.to_string(),
-            conservative: v.conservative,
-            tests: a.c.0[0],
-            exact_hits: a.c.0[1],
-            false_misses: a.c.0[2],
-            false_hits: a.c.0[3],
-            exact_calls: a.c.0[4],
-            mtests_per_s: rate(a.c.0[0], a.model_ns),
-        })
-        .collect();
-    (rep, slab)
+        rti: with_rti.then_some(acc),
+        slab: setup.variants.iter().zip(sacc).map(|(v, a)| (v.name.to_string(), v.conservative, a)).collect(),
+        wall_ns,
+    }
 }

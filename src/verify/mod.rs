@@ -9,7 +9,7 @@ pub mod chunk;
 use crate::scene::Scene;
 use datapath::rti::RtiConfig;
 use datapath::{with_format, AnyFormat};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -128,23 +128,78 @@ impl VerifyReport {
 }
 
 /// Runs every format on the scene: per format one engine pass over the rays, the RTI model and
-/// every slab variant the format accepts on the same tests.
+/// Runs every format over the engine's rays and reports.
 pub fn verify(cfg: &VerifyConfig, scene: &Scene) -> VerifyReport {
-    let mut formats = Vec::new();
-    let mut slab = Vec::new();
-    for f in &cfg.formats {
-        let (r, s) = with_format!(*f, |f| chunk::run_format(f, cfg, scene, true));
-        formats.extend(r);
-        slab.extend(s);
+    finish(accumulate(cfg, scene))
+}
+
+/// What a verify run accumulates (a shard's partial result): the scene's facts the report
+/// prints and one accumulator per format.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VerifyData {
+    /// Scene name.
+    pub scene: String,
+    /// Triangles.
+    pub triangles: usize,
+    /// Coordinate scale.
+    pub scale: f64,
+    /// Rays of the whole run.
+    pub rays: usize,
+    /// Seed.
+    pub seed: u64,
+    /// Tests per ray.
+    pub tests_per_ray: usize,
+    /// Per format, in the run's order.
+    pub formats: Vec<chunk::FormatAcc>,
+}
+
+impl VerifyData {
+    /// Adds another shard's data of the same run.
+    pub fn merge(&mut self, o: VerifyData) -> Result<(), String> {
+        if self.formats.len() != o.formats.len() {
+            return Err("partials disagree on the formats".into());
+        }
+        for (a, b) in self.formats.iter_mut().zip(o.formats) {
+            a.merge(b)?;
+        }
+        Ok(())
     }
-    let slab_ok = slab.iter().all(|r| !r.conservative || r.false_misses == 0);
-    VerifyReport {
+}
+
+/// Runs every format over the engine's shard of the rays.
+pub fn accumulate(cfg: &VerifyConfig, scene: &Scene) -> VerifyData {
+    VerifyData {
         scene: scene.name.clone(),
         triangles: scene.tris.len(),
         scale: scene.scale,
         rays: cfg.rays,
         seed: cfg.seed,
         tests_per_ray: chunk::tests_per_ray(scene, cfg.sample),
+        formats: cfg
+            .formats
+            .iter()
+            .map(|f| with_format!(*f, |f| chunk::accumulate_format(f, cfg, scene, true)))
+            .collect(),
+    }
+}
+
+/// The report of (merged) data.
+pub fn finish(d: VerifyData) -> VerifyReport {
+    let mut formats = Vec::new();
+    let mut slab = Vec::new();
+    for f in d.formats {
+        let (r, s) = f.finish();
+        formats.extend(r);
+        slab.extend(s);
+    }
+    let slab_ok = slab.iter().all(|r| !r.conservative || r.false_misses == 0);
+    VerifyReport {
+        scene: d.scene,
+        triangles: d.triangles,
+        scale: d.scale,
+        rays: d.rays,
+        seed: d.seed,
+        tests_per_ray: d.tests_per_ray,
         passed: formats.iter().all(|f| f.violations == 0) && slab_ok,
         inconclusive: formats.iter().filter(|f| f.decisive == 0).map(|f| f.format.clone()).collect(),
         formats,
@@ -152,7 +207,17 @@ pub fn verify(cfg: &VerifyConfig, scene: &Scene) -> VerifyReport {
     }
 }
 
-/// The slab unit alone on the same (ray, box) pairs as [`verify`]: the boxes are the bounding
+/// The options that change a verify run's results, for a partial's `args`.
+pub fn args(cfg: &VerifyConfig) -> serde_json::Value {
+    serde_json::json!({
+        "formats": cfg.formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
+        "rays": cfg.rays,
+        "seed": cfg.seed,
+        "rti": format!("{:?}", cfg.rti),
+        "sample": cfg.sample,
+    })
+}
+
 /// boxes of the triangles each ray is tested against (axis-aligned walls give zero-extent boxes).
 pub fn verify_slab(cfg: &VerifyConfig, scene: &Scene) -> Vec<SlabReport> {
     cfg.formats.iter().flat_map(|f| with_format!(*f, |f| chunk::run_format(f, cfg, scene, false)).1).collect()

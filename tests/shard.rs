@@ -1,0 +1,158 @@
+//! Sharded runs: `--shard K/N --partial FILE` on every shard, then `raypipe merge`, equals the
+//! unsharded run (timings aside) for several N and any merge order; every bad partial set is
+//! refused with exit 2 and nothing merged.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn raypipe(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_raypipe")).args(args).output().expect("run raypipe")
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("raypipe-shard-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn json(o: &Output) -> serde_json::Value {
+    assert!(o.status.code().is_some_and(|c| c <= 1), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&o.stdout)))
+}
+
+/// The report without its timings (rates differ between any two runs).
+fn untimed(mut v: serde_json::Value) -> serde_json::Value {
+    for key in ["formats", "slab"] {
+        for r in v[key].as_array_mut().unwrap() {
+            let r = r.as_object_mut().unwrap();
+            r.remove("mtests_per_s");
+            r.remove("judged_mtests_per_s");
+        }
+    }
+    v
+}
+
+const RUN: [&str; 7] = ["verify", "--rays", "200", "--format", "f32,fp16,q8.24:divide", "--quiet", "--json"];
+
+fn shards(d: &Path, n: u64, extra: &[&str]) -> Vec<String> {
+    (0..n)
+        .map(|k| {
+            let p = d.join(format!("part{k}of{n}.json")).display().to_string();
+            let shard = format!("{k}/{n}");
+            let mut a = RUN.to_vec();
+            a.extend(["--shard", &shard, "--partial", &p]);
+            a.extend(extra);
+            let o = raypipe(&a);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            p
+        })
+        .collect()
+}
+
+fn merge(parts: &[String]) -> Output {
+    let mut a = vec!["merge", "--json"];
+    a.extend(parts.iter().map(String::as_str));
+    raypipe(&a)
+}
+
+#[test]
+fn merged_shards_equal_the_unsharded_run() {
+    let d = dir("equal");
+    let whole = untimed(json(&raypipe(&RUN)));
+    assert!(whole["formats"][0]["tests"].as_u64().unwrap() > 0);
+    for n in [1, 2, 3, 5] {
+        let mut parts = shards(&d, n, &[]);
+        assert_eq!(untimed(json(&merge(&parts))), whole, "{n} shards");
+        parts.reverse();
+        assert_eq!(untimed(json(&merge(&parts))), whole, "{n} shards, reversed");
+    }
+    // more shards than chunks: some shards run nothing, the merge is still the whole
+    let parts = shards(&d, 20, &["--chunk", "64"]);
+    let mut whole64 = RUN.to_vec();
+    whole64.extend(["--chunk", "64"]);
+    assert_eq!(untimed(json(&merge(&parts))), untimed(json(&raypipe(&whole64))));
+    // the exit code is the unsharded run's, and the text report too (timings aside)
+    let o = merge(&shards(&d, 2, &[]));
+    assert_eq!(o.status.code(), raypipe(&RUN).status.code());
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn a_slurm_array_task_names_its_shard() {
+    let d = dir("slurm");
+    let p = d.join("t1.json");
+    let mut a = RUN.to_vec();
+    a.extend(["--shard", "slurm", "--partial", p.to_str().unwrap()]);
+    let o = Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .args(&a)
+        .env("SLURM_ARRAY_TASK_ID", "1")
+        .env("SLURM_ARRAY_TASK_COUNT", "2")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+    assert_eq!((v["shard"]["k"].as_u64(), v["shard"]["n"].as_u64()), (Some(1), Some(2)));
+    // outside a Slurm task
+    let o = Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .args(&a)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("SLURM_ARRAY_TASK_COUNT")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("SLURM_ARRAY_TASK_ID"));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+fn refused(o: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains(needle), "stderr lacks '{needle}': {err}");
+    assert!(o.stdout.is_empty(), "nothing is merged: {}", String::from_utf8_lossy(&o.stdout));
+}
+
+#[test]
+fn bad_shards_and_partials_are_refused() {
+    let d = dir("bad");
+    let parts = shards(&d, 3, &[]);
+    // a missing and a duplicated shard
+    refused(&merge(&parts[..2]), "missing shard(s) 2/3");
+    refused(&merge(&[parts[0].clone(), parts[1].clone(), parts[1].clone(), parts[2].clone()]), "given twice");
+    // another run: other seed, other shard count
+    let other = d.join("other");
+    std::fs::create_dir_all(&other).unwrap();
+    let seeds = shards(&other, 3, &["--seed", "9"]);
+    refused(&merge(&[parts[0].clone(), parts[1].clone(), seeds[2].clone()]), "options differs");
+    let two = shards(&other, 2, &[]);
+    refused(&merge(&[parts[0].clone(), two[1].clone()]), "shard count differs");
+    // another scene
+    let obj = d.join("tri.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let scene = shards(&other, 3, &["--scene", obj.to_str().unwrap()]);
+    refused(&merge(&[parts[0].clone(), parts[1].clone(), scene[2].clone()]), "differs");
+    // another version, a corrupt and a truncated file
+    let text = std::fs::read_to_string(&parts[2]).unwrap();
+    let old = d.join("old.json");
+    std::fs::write(
+        &old,
+        text.replacen(&format!("\"version\":\"{}\"", env!("CARGO_PKG_VERSION")), "\"version\":\"0.0.1\"", 1),
+    )
+    .unwrap();
+    refused(&merge(&[parts[0].clone(), parts[1].clone(), old.display().to_string()]), "version");
+    let cut = d.join("cut.json");
+    std::fs::write(&cut, &text[..text.len() / 2]).unwrap();
+    refused(&merge(&[parts[0].clone(), parts[1].clone(), cut.display().to_string()]), "not a raypipe partial");
+    // K >= N, N = 0, a shard without a partial file, a partial over a file raypipe did not write
+    let p = d.join("x.json");
+    let ps = p.to_str().unwrap();
+    refused(&raypipe(&["verify", "--shard", "3/3", "--partial", ps]), "below N");
+    refused(&raypipe(&["verify", "--shard", "0/0", "--partial", ps]), "at least 1");
+    refused(&raypipe(&["verify", "--shard", "0/2"]), "--partial");
+    let mine = d.join("mine.json");
+    std::fs::write(&mine, "{\"my\": \"data\"}").unwrap();
+    refused(&raypipe(&["verify", "--shard", "0/2", "--partial", mine.to_str().unwrap()]), "not replacing it");
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "{\"my\": \"data\"}");
+    refused(&raypipe(&["merge", mine.to_str().unwrap()]), "not a raypipe partial");
+    std::fs::remove_dir_all(&d).unwrap();
+}
