@@ -9,6 +9,7 @@ pub mod bvh;
 pub mod explain;
 pub mod faults;
 pub mod judge;
+pub mod ops;
 pub mod partial;
 pub mod plan;
 pub mod render;

@@ -268,6 +268,35 @@ enum Cmd {
         #[command(flatten)]
         run: EngineArgs,
     },
+    /// One operation of a format against the per-op oracle (APFloat): every pair or specials + random; shardable.
+    Ops {
+        /// Format: f32, fp16 or bf16 (ieee or ftz, recip or divide; canonical NaN rule).
+        #[arg(long, value_parser = parse_format)]
+        format: AnyFormat,
+        /// Operation: add, sub, mul, div (the format's division mode), recip, lt, le.
+        #[arg(long)]
+        op: String,
+        /// Every operand pair (16-bit formats: 2^32 pairs).
+        #[arg(long)]
+        exhaustive: bool,
+        /// Pairs of a sampled sweep (the special operands' pairs first, then random).
+        #[arg(long, default_value_t = 1_000_000)]
+        count: u64,
+        /// Seed of the random pairs.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Run one shard: K/N or slurm; needs --partial.
+        #[arg(long)]
+        shard: Option<String>,
+        /// Write this shard's partial result to FILE for `raypipe merge`.
+        #[arg(long)]
+        partial: Option<PathBuf>,
+        /// Print the results as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        run: EngineArgs,
+    },
     /// Merge the partial results of a sharded run (--shard K/N --partial FILE) into its report.
     Merge {
         /// The partial files, one per shard (any order).
@@ -797,9 +826,53 @@ fn run() -> Result<Outcome, String> {
             emit(json, &rep, raypipe::traverse::render)?;
             Ok(Outcome::from(rep.passed))
         }
+        Some(Cmd::Ops { format, op, exhaustive, count, seed, shard, partial, json, run }) => {
+            let sh = shard_of(shard.as_deref(), partial.as_deref())?;
+            let cfg = raypipe::ops::OpsConfig {
+                format,
+                op,
+                exhaustive,
+                count,
+                seed,
+                engine: run.engine(raypipe::ops::CHUNK).with_shard(sh),
+                progress: !run.quiet,
+            };
+            raypipe::ops::items(&cfg)?;
+            let data = raypipe::ops::accumulate(&cfg)?;
+            if let Some(path) = &partial {
+                let p = raypipe::partial::Partial {
+                    raypipe_partial: raypipe::partial::FORMAT,
+                    version: env!("CARGO_PKG_VERSION").to_string(),
+                    command: "ops".into(),
+                    args: raypipe::ops::args(&cfg),
+                    scene_hash: String::new(),
+                    chunk: raypipe::ops::CHUNK,
+                    shard: sh,
+                    data,
+                };
+                raypipe::partial::write(path, &p)?;
+                return wrote_partial(json, "ops", sh, path);
+            }
+            let rep = raypipe::ops::finish(data);
+            emit(json, &rep, raypipe::ops::render)?;
+            Ok(Outcome::from(rep.passed))
+        }
         Some(Cmd::Merge { partials, json }) => {
             let parts = raypipe::partial::read_all(&partials)?;
             match parts[0].command.as_str() {
+                "ops" => {
+                    let mut total: Option<raypipe::ops::OpsData> = None;
+                    for p in &parts {
+                        let d: raypipe::ops::OpsData = raypipe::partial::data(p)?;
+                        match total.as_mut() {
+                            Some(t) => t.merge(d)?,
+                            None => total = Some(d),
+                        }
+                    }
+                    let rep = raypipe::ops::finish(total.expect("at least one partial"));
+                    emit(json, &rep, raypipe::ops::render)?;
+                    Ok(Outcome::from(rep.passed))
+                }
                 "verify" => {
                     let mut total: Option<raypipe::verify::VerifyData> = None;
                     for p in &parts {

@@ -156,3 +156,49 @@ fn bad_shards_and_partials_are_refused() {
     refused(&raypipe(&["merge", mine.to_str().unwrap()]), "not a raypipe partial");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// `raypipe ops` sharded and merged equals one pass; what it cannot run is refused.
+#[test]
+fn ops_sweeps_shard_and_merge() {
+    let d = dir("ops");
+    let base = ["ops", "--format", "fp16:ftz+divide", "--op", "div", "--count", "300000", "--quiet", "--json"];
+    let whole = json(&raypipe(&base));
+    assert_eq!((whole["tests"].as_u64(), whole["mismatches"].as_u64()), (Some(300000), Some(0)));
+    for n in [2u64, 3] {
+        let parts: Vec<String> = (0..n)
+            .map(|k| {
+                let p = d.join(format!("ops{k}of{n}.json")).display().to_string();
+                let shard = format!("{k}/{n}");
+                let mut a = base.to_vec();
+                a.extend(["--shard", &shard, "--partial", &p]);
+                assert!(raypipe(&a).status.success());
+                p
+            })
+            .collect();
+        assert_eq!(json(&merge(&parts)), whole, "{n} shards");
+    }
+    // an exhaustive shard: 2^32 / 4096 pairs of chunk 0 mod 4096 (one chunk of 65536 pairs: a = 0)
+    let p = d.join("ex.json");
+    let o = raypipe(&[
+        "ops",
+        "--format",
+        "bf16",
+        "--op",
+        "mul",
+        "--exhaustive",
+        "--shard",
+        "0/65536",
+        "--partial",
+        p.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+    assert_eq!(v["data"]["counts"], serde_json::json!([65536, 0]));
+    refused(&raypipe(&["ops", "--format", "f32", "--op", "add", "--exhaustive"]), "16-bit");
+    refused(&raypipe(&["ops", "--format", "e8m16", "--op", "add"]), "oracle covers");
+    refused(&raypipe(&["ops", "--format", "fp16:propagate", "--op", "add"]), "propagate");
+    refused(&raypipe(&["ops", "--format", "fp16", "--op", "pow"]), "unknown --op");
+    refused(&raypipe(&["ops", "--format", "fp16", "--op", "add", "--count", "0"]), "--count");
+    std::fs::remove_dir_all(&d).unwrap();
+}

@@ -5,6 +5,7 @@
 pub mod block;
 pub mod bvh;
 pub mod mt;
+pub mod ops;
 pub mod slab;
 
 pub use mt::{closest_hit, intersect, intersect_exact, Faces, MtResult, Ray64, Tri64};
