@@ -84,6 +84,18 @@ impl EngineArgs {
     }
 }
 
+/// Sharding of a run (`raypipe merge` puts the shards together).
+#[derive(clap::Args, Clone)]
+struct ShardArgs {
+    /// Run one shard of the work: K/N (0 <= K < N), or `slurm` (the Slurm array task's); needs
+    /// --partial.
+    #[arg(long)]
+    shard: Option<String>,
+    /// Write this shard's partial result to FILE (JSON) for `raypipe merge`.
+    #[arg(long)]
+    partial: Option<PathBuf>,
+}
+
 /// The thesis hardware's parameters (`raypipe arch`, `raypipe plan`); defaults are the thesis's
 /// values where it gives one (docs/arch.md).
 #[derive(clap::Args, Clone)]
@@ -267,6 +279,8 @@ enum Cmd {
         json: bool,
         #[command(flatten)]
         run: EngineArgs,
+        #[command(flatten)]
+        sharding: ShardArgs,
     },
     /// One operation of a format against the per-op oracle (APFloat): every pair or specials + random; shardable.
     Ops {
@@ -694,17 +708,8 @@ fn run_verify(a: VerifyArgs) -> Result<Outcome, String> {
     cfg.progress = !a.quiet;
     if let Some(path) = &a.partial {
         let data = raypipe::verify::accumulate(&cfg, &scene);
-        let p = raypipe::partial::Partial {
-            raypipe_partial: raypipe::partial::FORMAT,
-            version: env!("CARGO_PKG_VERSION").to_string(),
-            command: "verify".into(),
-            args: raypipe::verify::args(&cfg),
-            scene_hash: raypipe::partial::scene_hash(&scene),
-            chunk: a.chunk,
-            shard,
-            data,
-        };
-        raypipe::partial::write(path, &p)?;
+        let (args, hash) = (raypipe::verify::args(&cfg), raypipe::partial::scene_hash(&scene));
+        write_partial(path, "verify", args, hash, a.chunk, shard, data)?;
         return wrote_partial(a.json, "verify", shard, path);
     }
     let rep = verify(&cfg, &scene);
@@ -727,6 +732,29 @@ fn shard_of(shard: Option<&str>, partial: Option<&std::path::Path>) -> Result<en
         None => {}
     }
     Ok(s)
+}
+
+/// Writes a shard's partial result.
+fn write_partial<T: serde::Serialize>(
+    path: &std::path::Path,
+    command: &str,
+    args: serde_json::Value,
+    scene_hash: String,
+    chunk: u64,
+    shard: engine::Shard,
+    data: T,
+) -> Result<(), String> {
+    let p = raypipe::partial::Partial {
+        raypipe_partial: raypipe::partial::FORMAT,
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        command: command.into(),
+        args,
+        scene_hash,
+        chunk,
+        shard,
+        data,
+    };
+    raypipe::partial::write(path, &p)
 }
 
 /// What a shard prints once its partial is written.
@@ -808,8 +836,9 @@ fn run() -> Result<Outcome, String> {
             }
             Ok(Outcome::Pass)
         }
-        Some(Cmd::Traverse { scene, format, variant, rays, seed, n, leaf_size, levels, json, run }) => {
+        Some(Cmd::Traverse { scene, format, variant, rays, seed, n, leaf_size, levels, json, run, sharding }) => {
             check_rays(rays)?;
+            let sh = shard_of(sharding.shard.as_deref(), sharding.partial.as_deref())?;
             let scene = load_scene(scene.as_deref())?;
             let cfg = raypipe::traverse::TraverseConfig {
                 formats: format,
@@ -819,10 +848,16 @@ fn run() -> Result<Outcome, String> {
                 n: n as usize,
                 leaf_size,
                 levels: levels as usize,
-                engine: run.engine(raypipe::traverse::CHUNK_RAYS),
+                engine: run.engine(raypipe::traverse::CHUNK_RAYS).with_shard(sh),
                 progress: !run.quiet,
             };
             let rep = raypipe::traverse::traverse(&cfg, &scene)?;
+            if let Some(path) = &sharding.partial {
+                let hash = raypipe::partial::scene_hash(&scene);
+                let args = raypipe::traverse::args(&cfg);
+                write_partial(path, "traverse", args, hash, raypipe::traverse::CHUNK_RAYS, sh, rep)?;
+                return wrote_partial(json, "traverse", sh, path);
+            }
             emit(json, &rep, raypipe::traverse::render)?;
             Ok(Outcome::from(rep.passed))
         }
@@ -840,17 +875,7 @@ fn run() -> Result<Outcome, String> {
             raypipe::ops::items(&cfg)?;
             let data = raypipe::ops::accumulate(&cfg)?;
             if let Some(path) = &partial {
-                let p = raypipe::partial::Partial {
-                    raypipe_partial: raypipe::partial::FORMAT,
-                    version: env!("CARGO_PKG_VERSION").to_string(),
-                    command: "ops".into(),
-                    args: raypipe::ops::args(&cfg),
-                    scene_hash: String::new(),
-                    chunk: raypipe::ops::CHUNK,
-                    shard: sh,
-                    data,
-                };
-                raypipe::partial::write(path, &p)?;
+                write_partial(path, "ops", raypipe::ops::args(&cfg), String::new(), raypipe::ops::CHUNK, sh, data)?;
                 return wrote_partial(json, "ops", sh, path);
             }
             let rep = raypipe::ops::finish(data);
@@ -860,29 +885,21 @@ fn run() -> Result<Outcome, String> {
         Some(Cmd::Merge { partials, json }) => {
             let parts = raypipe::partial::read_all(&partials)?;
             match parts[0].command.as_str() {
+                "traverse" => {
+                    let rep = raypipe::partial::merge_data(&parts, raypipe::traverse::TraverseReport::merge)?;
+                    emit(json, &rep, raypipe::traverse::render)?;
+                    Ok(Outcome::from(rep.passed))
+                }
                 "ops" => {
-                    let mut total: Option<raypipe::ops::OpsData> = None;
-                    for p in &parts {
-                        let d: raypipe::ops::OpsData = raypipe::partial::data(p)?;
-                        match total.as_mut() {
-                            Some(t) => t.merge(d)?,
-                            None => total = Some(d),
-                        }
-                    }
-                    let rep = raypipe::ops::finish(total.expect("at least one partial"));
+                    let rep = raypipe::ops::finish(raypipe::partial::merge_data(&parts, raypipe::ops::OpsData::merge)?);
                     emit(json, &rep, raypipe::ops::render)?;
                     Ok(Outcome::from(rep.passed))
                 }
                 "verify" => {
-                    let mut total: Option<raypipe::verify::VerifyData> = None;
-                    for p in &parts {
-                        let d: raypipe::verify::VerifyData = raypipe::partial::data(p)?;
-                        match total.as_mut() {
-                            Some(t) => t.merge(d)?,
-                            None => total = Some(d),
-                        }
-                    }
-                    let rep = raypipe::verify::finish(total.expect("at least one partial"));
+                    let rep = raypipe::verify::finish(raypipe::partial::merge_data(
+                        &parts,
+                        raypipe::verify::VerifyData::merge,
+                    )?);
                     emit(json, &rep, render)?;
                     Ok(rep.outcome())
                 }

@@ -165,3 +165,19 @@ pub fn data<T: DeserializeOwned>(p: &Partial<serde_json::Value>) -> Result<T, St
     serde_json::from_value(p.data.clone())
         .map_err(|e| format!("shard {}: its data is not a {} result: {e}", p.shard, p.command))
 }
+
+/// The checked partials' data, typed and added up in shard order by `add`.
+pub fn merge_data<T: DeserializeOwned>(
+    parts: &[Partial<serde_json::Value>],
+    add: impl Fn(&mut T, T) -> Result<(), String>,
+) -> Result<T, String> {
+    let mut total: Option<T> = None;
+    for p in parts {
+        let d: T = data(p)?;
+        match total.as_mut() {
+            Some(t) => add(t, d)?,
+            None => total = Some(d),
+        }
+    }
+    total.ok_or_else(|| "name the partial files to merge".to_string())
+}

@@ -36,7 +36,7 @@ pub struct TraverseConfig {
 }
 
 /// Results for one format.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct TraverseRow {
     /// Box format.
     pub format: String,
@@ -70,7 +70,7 @@ pub struct TraverseRow {
 }
 
 /// The whole run.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct TraverseReport {
     /// Scene name.
     pub scene: String,
@@ -177,6 +177,76 @@ pub fn traverse(cfg: &TraverseConfig, scene: &Scene) -> Result<TraverseReport, S
 }
 
 /// Counters of [`TraverseRow`] in field order from `rays` to `box_tests_skipped`.
+impl TraverseRow {
+    fn counters(&self) -> [u64; COUNTERS] {
+        [
+            self.rays,
+            self.history_mismatches,
+            self.trail_mismatches,
+            self.leaves,
+            self.rays_with_leaves,
+            self.rays_without_restart,
+            self.stack_box_tests,
+            self.history_box_tests,
+            self.trail_box_tests,
+            self.restarts,
+            self.back_within_8,
+            self.back_total,
+            self.box_tests_skipped,
+        ]
+    }
+
+    fn from_counters(format: String, c: [u64; COUNTERS]) -> Self {
+        let [rays, history_mismatches, trail_mismatches, leaves, rays_with_leaves, rays_without_restart, stack_box_tests, history_box_tests, trail_box_tests, restarts, back_within_8, back_total, box_tests_skipped] =
+            c;
+        TraverseRow {
+            format,
+            rays,
+            history_mismatches,
+            trail_mismatches,
+            leaves,
+            rays_with_leaves,
+            rays_without_restart,
+            stack_box_tests,
+            history_box_tests,
+            trail_box_tests,
+            restarts,
+            back_within_8,
+            back_total,
+            box_tests_skipped,
+        }
+    }
+}
+
+impl TraverseReport {
+    /// Adds another shard's report of the same run (every row's counters; `passed` again).
+    pub fn merge(&mut self, o: TraverseReport) -> Result<(), String> {
+        let names = |r: &TraverseReport| r.rows.iter().map(|x| x.format.clone()).collect::<Vec<_>>();
+        if names(self) != names(&o) {
+            return Err("partials disagree on the formats".into());
+        }
+        for (a, b) in self.rows.iter_mut().zip(o.rows) {
+            let (x, y) = (a.counters(), b.counters());
+            *a = TraverseRow::from_counters(a.format.clone(), std::array::from_fn(|k| x[k] + y[k]));
+        }
+        self.passed = self.rows.iter().all(|r| r.history_mismatches == 0 && r.trail_mismatches == 0);
+        Ok(())
+    }
+}
+
+/// The options that change a traverse run's results, for a partial's `args`.
+pub fn args(cfg: &TraverseConfig) -> serde_json::Value {
+    serde_json::json!({
+        "formats": cfg.formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
+        "variant": cfg.variant,
+        "rays": cfg.rays,
+        "seed": cfg.seed,
+        "n": cfg.n,
+        "leaf_size": cfg.leaf_size,
+        "levels": cfg.levels,
+    })
+}
+
 const COUNTERS: usize = 13;
 
 fn one_format<F: Format>(
@@ -192,7 +262,7 @@ fn one_format<F: Format>(
     let boxes: Vec<_> =
         b.nodes.iter().map(|nd| s.store_box(nd.min, nd.max)).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
     let n = cfg.n;
-    let progress = engine::Progress::new(cfg.rays as u64, "rays", !cfg.progress);
+    let progress = engine::Progress::new(cfg.engine.shard_items(cfg.rays as u64), "rays", !cfg.progress);
     progress.message(f.name());
     let acc = engine::run(
         &cfg.engine,
@@ -240,24 +310,7 @@ fn one_format<F: Format>(
         },
     );
     progress.finish();
-    let [rays, history_mismatches, trail_mismatches, leaves, rays_with_leaves, rays_without_restart, stack_box_tests, history_box_tests, trail_box_tests, restarts, back_within_8, back_total, box_tests_skipped] =
-        acc.0;
-    Ok(TraverseRow {
-        format: f.name(),
-        rays,
-        history_mismatches,
-        trail_mismatches,
-        leaves,
-        rays_with_leaves,
-        rays_without_restart,
-        stack_box_tests,
-        history_box_tests,
-        trail_box_tests,
-        restarts,
-        back_within_8,
-        back_total,
-        box_tests_skipped,
-    })
+    Ok(TraverseRow::from_counters(f.name(), acc.0))
 }
 
 /// The report as text.

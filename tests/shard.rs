@@ -202,3 +202,27 @@ fn ops_sweeps_shard_and_merge() {
     refused(&raypipe(&["ops", "--format", "fp16", "--op", "add", "--count", "0"]), "--count");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// `raypipe traverse` sharded and merged equals one pass (its report is all counts).
+#[test]
+fn traverse_shards_and_merges() {
+    let d = dir("traverse");
+    let base = ["traverse", "--rays", "3000", "--format", "f32,fp16", "--quiet", "--json"];
+    let whole = json(&raypipe(&base));
+    assert_eq!(whole["rows"][0]["rays"].as_u64(), Some(3000));
+    for n in [2u64, 7] {
+        let mut parts: Vec<String> = (0..n)
+            .map(|k| {
+                let p = d.join(format!("tr{k}of{n}.json")).display().to_string();
+                let shard = format!("{k}/{n}");
+                let mut a = base.to_vec();
+                a.extend(["--shard", &shard, "--partial", &p]);
+                assert!(raypipe(&a).status.success());
+                p
+            })
+            .collect();
+        parts.rotate_left(1);
+        assert_eq!(json(&merge(&parts)), whole, "{n} shards");
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
