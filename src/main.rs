@@ -593,6 +593,8 @@ enum Cmd {
         json: bool,
         #[command(flatten)]
         run: EngineArgs,
+        #[command(flatten)]
+        sharding: ShardArgs,
     },
     /// Print the RTI stage table (markdown).
     Stages {
@@ -885,6 +887,11 @@ fn run() -> Result<Outcome, String> {
         Some(Cmd::Merge { partials, json }) => {
             let parts = raypipe::partial::read_all(&partials)?;
             match parts[0].command.as_str() {
+                "stress" => {
+                    let rep = raypipe::partial::merge_data(&parts, raypipe::stress::StressReport::merge)?;
+                    emit(json, &rep, raypipe::stress::render)?;
+                    Ok(Outcome::from(rep.passed))
+                }
                 "traverse" => {
                     let rep = raypipe::partial::merge_data(&parts, raypipe::traverse::TraverseReport::merge)?;
                     emit(json, &rep, raypipe::traverse::render)?;
@@ -1158,11 +1165,17 @@ fn run() -> Result<Outcome, String> {
             emit(json, &rep, raypipe::speed::render)?;
             Ok(Outcome::Pass)
         }
-        Some(Cmd::Stress { format, variant, count, seed, json, run }) => {
+        Some(Cmd::Stress { format, variant, count, seed, json, run, sharding }) => {
+            let sh = shard_of(sharding.shard.as_deref(), sharding.partial.as_deref())?;
             let mut cfg = raypipe::stress::StressConfig::new(format, variant, count as usize, seed);
-            cfg.engine = run.engine(raypipe::stress::CHUNK_CASES);
+            cfg.engine = run.engine(raypipe::stress::CHUNK_CASES).with_shard(sh);
             cfg.progress = !run.quiet;
             let rep = raypipe::stress::stress(&cfg)?;
+            if let Some(path) = &sharding.partial {
+                let args = raypipe::stress::args(&cfg);
+                write_partial(path, "stress", args, String::new(), raypipe::stress::CHUNK_CASES, sh, rep)?;
+                return wrote_partial(json, "stress", sh, path);
+            }
             emit(json, &rep, raypipe::stress::render)?;
             Ok(Outcome::from(rep.passed))
         }

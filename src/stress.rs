@@ -81,7 +81,7 @@ pub const SLAB_STRESS: [(&str, &str); 15] = [
 ];
 
 /// Failures of one RTI class in one format.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct RtiStressRow {
     /// Class.
     pub class: String,
@@ -102,7 +102,7 @@ pub struct RtiStressRow {
 }
 
 /// Failures of one slab class in one format and variant.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct SlabStressRow {
     /// Class.
     pub class: String,
@@ -129,7 +129,7 @@ pub struct SlabStressRow {
 }
 
 /// The whole suite.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct StressReport {
     /// Seed.
     pub seed: u64,
@@ -297,7 +297,7 @@ fn run_classes<const N: usize>(
 ) -> Vec<[u64; N]> {
     let count = cfg.count as u64;
     let items = classes as u64 * count;
-    let progress = engine::Progress::new(items, "cases", !cfg.progress);
+    let progress = engine::Progress::new(cfg.engine.shard_items(items), "cases", !cfg.progress);
     progress.message(what);
     let acc: Vec<engine::Counts<N>> = engine::run(
         &cfg.engine,
@@ -602,6 +602,49 @@ fn slab_rows<F: Format>(f: F, sc: SlabConfig, variant: &str, cfg: &StressConfig)
             undecided_hits: c[6],
         })
         .collect()
+}
+
+impl StressReport {
+    /// Adds another shard's report of the same run (every row's counts; `passed` again).
+    pub fn merge(&mut self, o: StressReport) -> Result<(), String> {
+        let rkey = |r: &RtiStressRow| (r.class.clone(), r.format.clone());
+        let skey = |r: &SlabStressRow| (r.class.clone(), r.format.clone(), r.variant.clone(), r.conservative);
+        if self.rti.iter().map(rkey).ne(o.rti.iter().map(rkey))
+            || self.slab.iter().map(skey).ne(o.slab.iter().map(skey))
+            || (self.seed, self.count, &self.refused) != (o.seed, o.count, &o.refused)
+        {
+            return Err("partials disagree on the stress classes".into());
+        }
+        for (a, b) in self.rti.iter_mut().zip(o.rti) {
+            a.tests += b.tests;
+            a.undecided += b.undecided;
+            a.false_misses += b.false_misses;
+            a.false_hits += b.false_hits;
+            a.undecided_hits += b.undecided_hits;
+            a.cracks += b.cracks;
+        }
+        for (a, b) in self.slab.iter_mut().zip(o.slab) {
+            a.tests += b.tests;
+            a.unstorable += b.unstorable;
+            a.exact_hits += b.exact_hits;
+            a.undecided += b.undecided;
+            a.false_misses += b.false_misses;
+            a.false_hits += b.false_hits;
+            a.undecided_hits += b.undecided_hits;
+        }
+        self.passed = self.slab.iter().all(|x| !x.conservative || x.false_misses == 0);
+        Ok(())
+    }
+}
+
+/// The options that change a stress run's results, for a partial's `args`.
+pub fn args(cfg: &StressConfig) -> serde_json::Value {
+    serde_json::json!({
+        "formats": cfg.formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
+        "variants": cfg.variants,
+        "count": cfg.count,
+        "seed": cfg.seed,
+    })
 }
 
 /// Runs the suite.

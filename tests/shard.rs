@@ -50,6 +50,21 @@ fn shards(d: &Path, n: u64, extra: &[&str]) -> Vec<String> {
         .collect()
 }
 
+/// Runs `base` as shards 0..n with partials in `d` (named after `tag`), in the given order.
+fn run_shards(d: &Path, base: &[&str], n: u64, tag: &str) -> Vec<String> {
+    (0..n)
+        .map(|k| {
+            let p = d.join(format!("{tag}{k}of{n}.json")).display().to_string();
+            let shard = format!("{k}/{n}");
+            let mut a = base.to_vec();
+            a.extend(["--shard", &shard, "--partial", &p]);
+            let o = raypipe(&a);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            p
+        })
+        .collect()
+}
+
 fn merge(parts: &[String]) -> Output {
     let mut a = vec!["merge", "--json"];
     a.extend(parts.iter().map(String::as_str));
@@ -165,16 +180,7 @@ fn ops_sweeps_shard_and_merge() {
     let whole = json(&raypipe(&base));
     assert_eq!((whole["tests"].as_u64(), whole["mismatches"].as_u64()), (Some(300000), Some(0)));
     for n in [2u64, 3] {
-        let parts: Vec<String> = (0..n)
-            .map(|k| {
-                let p = d.join(format!("ops{k}of{n}.json")).display().to_string();
-                let shard = format!("{k}/{n}");
-                let mut a = base.to_vec();
-                a.extend(["--shard", &shard, "--partial", &p]);
-                assert!(raypipe(&a).status.success());
-                p
-            })
-            .collect();
+        let parts = run_shards(&d, &base, n, "ops");
         assert_eq!(json(&merge(&parts)), whole, "{n} shards");
     }
     // an exhaustive shard: 2^32 / 4096 pairs of chunk 0 mod 4096 (one chunk of 65536 pairs: a = 0)
@@ -211,17 +217,32 @@ fn traverse_shards_and_merges() {
     let whole = json(&raypipe(&base));
     assert_eq!(whole["rows"][0]["rays"].as_u64(), Some(3000));
     for n in [2u64, 7] {
-        let mut parts: Vec<String> = (0..n)
-            .map(|k| {
-                let p = d.join(format!("tr{k}of{n}.json")).display().to_string();
-                let shard = format!("{k}/{n}");
-                let mut a = base.to_vec();
-                a.extend(["--shard", &shard, "--partial", &p]);
-                assert!(raypipe(&a).status.success());
-                p
-            })
-            .collect();
+        let mut parts = run_shards(&d, &base, n, "tr");
         parts.rotate_left(1);
+        assert_eq!(json(&merge(&parts)), whole, "{n} shards");
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// `raypipe stress` sharded and merged equals one pass (its report is all counts).
+#[test]
+fn stress_shards_and_merges() {
+    let d = dir("stress");
+    let base = [
+        "stress",
+        "--count",
+        "40",
+        "--format",
+        "fp16,q8.24:divide",
+        "--variant",
+        "conservative,plain",
+        "--quiet",
+        "--json",
+    ];
+    let whole = json(&raypipe(&base));
+    for n in [2u64, 5] {
+        let mut parts = run_shards(&d, &base, n, "st");
+        parts.reverse();
         assert_eq!(json(&merge(&parts)), whole, "{n} shards");
     }
     std::fs::remove_dir_all(&d).unwrap();
