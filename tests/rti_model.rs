@@ -309,3 +309,35 @@ fn nan_in_any_input_never_hits() {
         });
     }
 }
+
+/// The structure-of-arrays columns: resize fills every column, set writes lane i of every
+/// column (get reads it back), len / is_empty follow.
+#[test]
+fn soa_columns_resize_set_get() {
+    let ray = |k: u32| Ray { o: [k, k + 1, k + 2], d: [k + 3, k + 4, k + 5], tmin: k + 6, tmax: k + 7 };
+    let mut rs = RaysSoa::<u32>::default();
+    assert!(rs.is_empty());
+    rs.resize(3, 9);
+    assert_eq!((rs.len(), rs.is_empty()), (3, false));
+    assert!([&rs.o[0], &rs.o[1], &rs.o[2], &rs.d[0], &rs.d[1], &rs.d[2], &rs.tmin, &rs.tmax]
+        .iter()
+        .all(|c| c.as_slice() == [9, 9, 9]));
+    rs.set(1, &ray(10));
+    let g = rs.get(1);
+    assert_eq!((g.o, g.d, g.tmin, g.tmax), ([10, 11, 12], [13, 14, 15], 16, 17));
+    assert_eq!(rs.get(0).o, [9, 9, 9]);
+    let tri = |k: u32| Tri { v: [[k, k + 1, k + 2], [k + 3, k + 4, k + 5], [k + 6, k + 7, k + 8]] };
+    let mut ts = TrisSoa::<u32>::default();
+    assert!(ts.is_empty());
+    ts.resize(2, 5);
+    assert_eq!((ts.len(), ts.is_empty()), (2, false));
+    assert!(ts.v.iter().flatten().all(|c| c.as_slice() == [5, 5]));
+    ts.set(0, &tri(20));
+    assert_eq!(ts.get(0).v, tri(20).v);
+    assert_eq!(ts.get(1).v, [[5; 3]; 3]);
+    let mut hs = HitsSoa::<u32>::with_len(0);
+    assert!(hs.is_empty());
+    hs.resize(4);
+    assert_eq!((hs.len(), hs.is_empty()), (4, false));
+    assert_eq!((hs.hit.len(), hs.valid.len(), hs.t.len(), hs.u.len(), hs.v.len()), (4, 4, 4, 4, 4));
+}
