@@ -321,6 +321,10 @@ fn narrow_box_storage_contains_the_original() {
     let s = Slab::new(fmt_f32(), SlabConfig::default());
     assert_eq!(s.store_box([0.0, f64::NAN, 0.0], [1.0; 3]).unwrap_err(), BoxError::Nan);
     assert_eq!(s.store_box([2.0, 0.0, 0.0], [1.0; 3]).unwrap_err(), BoxError::Inverted);
+    // the messages a refused box reports (CLI errors quote them)
+    assert_eq!(BoxError::Nan.to_string(), "box coordinate is NaN");
+    assert_eq!(BoxError::Inverted.to_string(), "box min exceeds max");
+    assert_eq!(BoxError::OutOfRange(300.5).to_string(), "box coordinate 300.5 is outside the fixed-point range");
     // zero-extent boxes stay zero-extent when exactly representable, and still contain the point
     let b = s.store_box([0.5; 3], [0.5; 3]).unwrap();
     assert_eq!((b.min, b.max), ([0.5; 3], [0.5; 3]));
