@@ -316,6 +316,9 @@ enum Cmd {
         /// The partial files, one per shard (any order).
         #[arg(required = true)]
         partials: Vec<PathBuf>,
+        /// A report's files (markdown, JSON, SVG) into this directory (report partials only).
+        #[arg(long)]
+        out: Option<PathBuf>,
         /// Print the results as JSON.
         #[arg(long)]
         json: bool,
@@ -561,6 +564,8 @@ enum Cmd {
         /// Print JSON instead of markdown.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        sharding: ShardArgs,
     },
     /// This machine's no-FMA FP peak and each RTI / slab implementation's throughput as a fraction of it.
     Speed {
@@ -884,9 +889,26 @@ fn run() -> Result<Outcome, String> {
             emit(json, &rep, raypipe::ops::render)?;
             Ok(Outcome::from(rep.passed))
         }
-        Some(Cmd::Merge { partials, json }) => {
+        Some(Cmd::Merge { partials, out, json }) => {
+            let dir = out.as_deref().map(|d| OutDir::check(d, &raypipe::report::FILES)).transpose()?;
             let parts = raypipe::partial::read_all(&partials)?;
+            if dir.is_some() && parts[0].command != "report" {
+                return Err(format!("--out writes a report's files; these are {} partials", parts[0].command));
+            }
             match parts[0].command.as_str() {
+                "report" => {
+                    let rep = raypipe::report::finish(raypipe::partial::merge_data(
+                        &parts,
+                        raypipe::report::ReportData::merge,
+                    )?)?;
+                    if let Some(dir) = &dir {
+                        for f in raypipe::report::write(&rep, dir)? {
+                            eprintln!("wrote {}", f.display());
+                        }
+                    }
+                    emit(json, &rep, raypipe::report::markdown)?;
+                    Ok(Outcome::Pass)
+                }
                 "stress" => {
                     let rep = raypipe::partial::merge_data(&parts, raypipe::stress::StressReport::merge)?;
                     emit(json, &rep, raypipe::stress::render)?;
@@ -1135,8 +1157,13 @@ fn run() -> Result<Outcome, String> {
             emit(json, &p, raypipe::plan::render)?;
             Ok(Outcome::Pass)
         }
-        Some(Cmd::Report { scene, format, variant, rays, stress_count, seed, out, json }) => {
-            let dir = OutDir::check(&out, &raypipe::report::FILES)?;
+        Some(Cmd::Report { scene, format, variant, rays, stress_count, seed, out, json, sharding }) => {
+            let sh = shard_of(sharding.shard.as_deref(), sharding.partial.as_deref())?;
+            // a shard writes its partial, not the report's files
+            let dir = match sharding.partial {
+                None => Some(OutDir::check(&out, &raypipe::report::FILES)?),
+                Some(_) => None,
+            };
             let mut scenes = vec![Scene::builtin()];
             for p in &scene {
                 scenes.push(load_scene(Some(p))?);
@@ -1150,9 +1177,16 @@ fn run() -> Result<Outcome, String> {
                 rays: rays as usize,
                 stress_count: stress_count as usize,
                 seed,
+                engine: engine::Engine::new(raypipe::verify::CHUNK_RAYS).with_shard(sh),
             };
+            if let Some(path) = &sharding.partial {
+                let data = raypipe::report::accumulate(&cfg, &scenes)?;
+                let args = raypipe::report::args(&cfg, &scenes);
+                write_partial(path, "report", args, String::new(), raypipe::verify::CHUNK_RAYS, sh, data)?;
+                return wrote_partial(json, "report", sh, path);
+            }
             let rep = raypipe::report::report(&cfg, &scenes)?;
-            let files = raypipe::report::write(&rep, &dir)?;
+            let files = raypipe::report::write(&rep, dir.as_ref().expect("checked when there is no partial"))?;
             emit(json, &rep, raypipe::report::markdown)?;
             for f in files {
                 eprintln!("wrote {}", f.display());

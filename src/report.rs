@@ -11,13 +11,13 @@
 //! the scenes' pairs, weighted.
 
 use crate::scene::Scene;
-use crate::stress::{stress, StressConfig};
-use crate::verify::{verify, verify_slab, VerifyConfig};
+use crate::stress::{stress, StressConfig, StressReport};
+use crate::verify::{VerifyConfig, VerifyData};
 use datapath::rng::SplitMix64;
 use datapath::rti::{Rti, RtiConfig};
 use datapath::{with_format, AnyFormat, Format};
 use golden::{Faces, Ray64, Tri64};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -32,6 +32,8 @@ pub struct ReportConfig {
     pub stress_count: usize,
     /// Seed.
     pub seed: u64,
+    /// The engine (threads, shard) of every streamed part.
+    pub engine: engine::Engine,
 }
 
 /// One variant's point.
@@ -101,38 +103,44 @@ pub struct Report {
 }
 
 /// Scene rays against their target and 31 sampled triangles: (tests, false misses, false hits)
-/// against the exact decision on the quantised inputs.
-fn exact_rti<F: Format>(f: F, scene: &Scene, rays: usize, seed: u64) -> (u64, u64, u64) {
-    use rayon::prelude::*;
+/// against the exact decision on the quantised inputs, over the engine's shard of the rays
+/// (ray i samples its triangles from `SplitMix64::new(seed ^ i · 0x9e3779b97f4a7c15)`).
+fn exact_rti<F: Format>(f: F, scene: &Scene, rays: usize, seed: u64, eng: &engine::Engine) -> [u64; 3] {
     let rti = Rti::new(f, RtiConfig::default());
     let q = |x: f64| f.to_f64(f.from_f64(x));
-    let list = scene.rays(rays, seed);
+    let gen = scene.ray_gen(seed);
     let n = scene.tris.len() as u64;
-    let parts: Vec<(u64, u64, u64)> = list
-        .par_iter()
-        .enumerate()
-        .map(|(i, (ray, target))| {
-            let mut r = SplitMix64::new(seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-            let mut ids = vec![*target];
-            ids.extend((0..31.min(n as usize - 1)).map(|_| r.below(n) as usize));
-            let mray = rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
-            let qray = Ray64 { o: ray.o.map(q), d: ray.d.map(q), tmin: q(ray.tmin), tmax: q(ray.tmax) };
-            let mut c = (0, 0, 0);
-            for &t in &ids {
-                let tri = &scene.tris[t];
-                let hit = rti.test(&mray, &rti.tri(tri.v)).hit;
-                let Some(e) = golden::intersect_exact(&qray, &Tri64 { v: tri.v.map(|p| p.map(q)) }, Faces::default())
-                else {
-                    continue;
-                };
-                c.0 += 1;
-                c.1 += (e && !hit) as u64;
-                c.2 += (!e && hit) as u64;
+    let acc = engine::run(
+        eng,
+        rays as u64,
+        &engine::Progress::off(),
+        || (),
+        |_, range| {
+            let mut c = engine::Counts::<3>::default();
+            for i in range {
+                let (ray, target) = gen.ray(scene, i);
+                let mut r = SplitMix64::new(seed ^ i.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+                let mut ids = vec![target];
+                ids.extend((0..31.min(n as usize - 1)).map(|_| r.below(n) as usize));
+                let mray = rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
+                let qray = Ray64 { o: ray.o.map(q), d: ray.d.map(q), tmin: q(ray.tmin), tmax: q(ray.tmax) };
+                for &t in &ids {
+                    let tri = &scene.tris[t];
+                    let hit = rti.test(&mray, &rti.tri(tri.v)).hit;
+                    let Some(e) =
+                        golden::intersect_exact(&qray, &Tri64 { v: tri.v.map(|p| p.map(q)) }, Faces::default())
+                    else {
+                        continue;
+                    };
+                    c.0[0] += 1;
+                    c.0[1] += (e && !hit) as u64;
+                    c.0[2] += (!e && hit) as u64;
+                }
             }
             c
-        })
-        .collect();
-    parts.iter().fold((0, 0, 0), |a, p| (a.0 + p.0, a.1 + p.1, a.2 + p.2))
+        },
+    );
+    acc.0
 }
 
 fn mark_pareto(points: &mut [Point]) {
@@ -145,29 +153,133 @@ fn mark_pareto(points: &mut [Point]) {
     }
 }
 
+/// What a report run accumulates (a shard's partial result): the stress suite, and per format
+/// its RTI kernel rate (measured by the shard: a timing) and, per scene, the verify data and the
+/// exact-decision counts.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReportData {
+    /// Scene names.
+    pub scenes: Vec<String>,
+    /// Formats, by name.
+    pub formats: Vec<String>,
+    /// Slab variants.
+    pub variants: Vec<String>,
+    /// Rays per scene.
+    pub rays: usize,
+    /// Stress cases per class.
+    pub stress_count: usize,
+    /// Seed.
+    pub seed: u64,
+    /// The stress suite.
+    pub stress: StressReport,
+    /// Per format: the fastest bit-identical RTI implementation's rate (million tests/s).
+    pub rti_rate: Vec<f64>,
+    /// Per format, per scene: verify's data.
+    pub verify: Vec<Vec<VerifyData>>,
+    /// Per format, per scene: exact-decision tests, false misses, false hits.
+    pub exact: Vec<Vec<[u64; 3]>>,
+}
+
+impl ReportData {
+    /// Adds another shard's data of the same run (the rate: the faster measurement).
+    pub fn merge(&mut self, o: ReportData) -> Result<(), String> {
+        if (&self.scenes, &self.formats, &self.variants) != (&o.scenes, &o.formats, &o.variants) {
+            return Err("partials disagree on the scenes, formats or variants".into());
+        }
+        self.stress.merge(o.stress)?;
+        for (a, b) in self.rti_rate.iter_mut().zip(o.rti_rate) {
+            *a = a.max(b);
+        }
+        for (a, b) in self.verify.iter_mut().zip(o.verify) {
+            for (x, y) in a.iter_mut().zip(b) {
+                x.merge(y)?;
+            }
+        }
+        for (a, b) in self.exact.iter_mut().zip(o.exact) {
+            for (x, y) in a.iter_mut().zip(b) {
+                for k in 0..3 {
+                    x[k] += y[k];
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The options that change a report's results, for a partial's `args`.
+pub fn args(cfg: &ReportConfig, scenes: &[Scene]) -> serde_json::Value {
+    serde_json::json!({
+        "formats": cfg.formats.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
+        "variants": cfg.variants,
+        "rays": cfg.rays,
+        "stress_count": cfg.stress_count,
+        "seed": cfg.seed,
+        "scenes": scenes.iter().map(crate::partial::scene_hash).collect::<Vec<_>>(),
+    })
+}
+
 /// Runs every variant on every scene and the stress classes.
 pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
+    finish(accumulate(cfg, scenes)?)
+}
+
+/// Runs the engine's shard of every part.
+pub fn accumulate(cfg: &ReportConfig, scenes: &[Scene]) -> Result<ReportData, String> {
     if scenes.is_empty() || cfg.rays == 0 {
         return Err("report needs at least one scene and one ray".into());
     }
-    let st = stress(&StressConfig::new(cfg.formats.clone(), cfg.variants.clone(), cfg.stress_count.max(1), cfg.seed))?;
-    let vcfg = VerifyConfig::new(cfg.formats.clone(), cfg.rays, cfg.seed, RtiConfig::default(), 512);
-    let mut points = Vec::new();
+    let mut scfg = StressConfig::new(cfg.formats.clone(), cfg.variants.clone(), cfg.stress_count.max(1), cfg.seed);
+    scfg.engine = engine::Engine { chunk: crate::stress::CHUNK_CASES, ..cfg.engine };
+    let st = stress(&scfg)?;
+    let mut vcfg = VerifyConfig::new(cfg.formats.clone(), cfg.rays, cfg.seed, RtiConfig::default(), 512);
+    vcfg.engine = engine::Engine { chunk: crate::verify::CHUNK_RAYS, ..cfg.engine };
+    let exact_engine = engine::Engine { chunk: crate::verify::CHUNK_RAYS, ..cfg.engine };
+    let mut verify = Vec::new();
+    let mut exact = Vec::new();
+    let mut rti_rate = Vec::new();
     for f in &cfg.formats {
+        // time: the fastest bit-identical implementation (SIMD kernel where one applies)
+        rti_rate.push(crate::speed::rti_rate(*f, 512, cfg.seed));
+        let one = VerifyConfig { formats: vec![*f], ..vcfg.clone() };
+        verify.push(scenes.iter().map(|s| crate::verify::accumulate(&one, s)).collect());
+        exact.push(
+            scenes.iter().map(|s| with_format!(*f, |f| exact_rti(f, s, cfg.rays, cfg.seed, &exact_engine))).collect(),
+        );
+    }
+    Ok(ReportData {
+        scenes: scenes.iter().map(|s| s.name.clone()).collect(),
+        formats: cfg.formats.iter().map(|f| f.to_string()).collect(),
+        variants: cfg.variants.clone(),
+        rays: cfg.rays,
+        stress_count: cfg.stress_count,
+        seed: cfg.seed,
+        stress: st,
+        rti_rate,
+        verify,
+        exact,
+    })
+}
+
+/// The report of (merged) data.
+pub fn finish(d: ReportData) -> Result<Report, String> {
+    let formats: Vec<AnyFormat> = d.formats.iter().map(|f| f.parse()).collect::<Result<_, _>>()?;
+    let st = &d.stress;
+    let mut points = Vec::new();
+    // per format, per scene: the verify report (RTI row and slab rows)
+    let reports: Vec<Vec<crate::verify::VerifyReport>> =
+        d.verify.iter().map(|per| per.iter().map(|v| crate::verify::finish(v.clone())).collect()).collect();
+    for (k, f) in formats.iter().enumerate() {
         let name = f.name();
         let mut p = Point::new("rti", name.clone(), *f);
-        // time: the fastest bit-identical implementation (SIMD kernel where one applies)
-        p.ns_per_test = 1e3 / crate::speed::rti_rate(*f, 512, cfg.seed).max(1e-9);
-        for s in scenes {
-            let v = verify(&VerifyConfig { formats: vec![*f], ..vcfg.clone() }, s);
+        p.ns_per_test = 1e3 / d.rti_rate[k].max(1e-9);
+        for (v, e) in reports[k].iter().zip(&d.exact[k]) {
             let r = &v.formats[0];
             p.t_err_ulps_median = p.t_err_ulps_median.max(r.t_err_ulps_median);
             p.t_err_ulps_max = p.t_err_ulps_max.max(r.t_err_ulps_max);
             p.t_err_rel_max = p.t_err_rel_max.max(r.t_err_rel_max);
-            let (t, fm, fh) = with_format!(*f, |f| exact_rti(f, s, cfg.rays, cfg.seed));
-            p.tests += t;
-            p.false_misses += fm;
-            p.false_hits += fh;
+            p.tests += e[0];
+            p.false_misses += e[1];
+            p.false_hits += e[2];
         }
         for x in st.rti.iter().filter(|x| x.format == name) {
             p.tests += x.tests - x.undecided;
@@ -177,9 +289,9 @@ pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
         p.error_rate = (p.false_misses + p.false_hits) as f64 / p.tests.max(1) as f64;
         points.push(p);
     }
-    for f in &cfg.formats {
+    for (k, f) in formats.iter().enumerate() {
         let name = f.name();
-        for v in &cfg.variants {
+        for v in &d.variants {
             let named = datapath::slab::SlabConfig::named(v)?;
             // a variant that cannot keep its promise in this format is not run (stress names it)
             if with_format!(*f, |f| named.for_format(v, &f)).is_err() {
@@ -187,9 +299,8 @@ pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
             }
             let mut p = Point::new("slab", format!("{name} {v}"), *f);
             let (mut time, mut timed) = (0.0, 0u64);
-            for s in scenes {
-                let rows = verify_slab(&VerifyConfig { formats: vec![*f], ..vcfg.clone() }, s);
-                for r in rows.iter().filter(|r| &r.variant == v) {
+            for rep in &reports[k] {
+                for r in rep.slab.iter().filter(|r| &r.variant == v) {
                     time += r.tests as f64 * 1e3 / r.mtests_per_s.max(1e-9);
                     timed += r.tests;
                     p.tests += r.tests;
@@ -209,10 +320,10 @@ pub fn report(cfg: &ReportConfig, scenes: &[Scene]) -> Result<Report, String> {
     }
     mark_pareto(&mut points);
     Ok(Report {
-        scenes: scenes.iter().map(|s| s.name.clone()).collect(),
-        rays: cfg.rays,
-        stress_count: cfg.stress_count,
-        seed: cfg.seed,
+        scenes: d.scenes,
+        rays: d.rays,
+        stress_count: d.stress_count,
+        seed: d.seed,
         points,
         refused: st.refused.clone(),
     })

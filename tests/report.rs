@@ -12,6 +12,7 @@ fn points_pareto_front_and_files() {
         rays: 8,
         stress_count: 4,
         seed: 2,
+        engine: engine::Engine::new(16),
     };
     let r = report(&cfg, &[Scene::builtin()]).unwrap();
     assert_eq!(r.points.len(), 2 + 2 * 2);

@@ -247,3 +247,46 @@ fn stress_shards_and_merges() {
     }
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// `raypipe report` sharded and merged equals one pass: every count and error figure (the time
+/// per test, and so the Pareto marks, are measurements of each run).
+#[test]
+fn report_shards_and_merges() {
+    let d = dir("report");
+    let out = d.join("whole");
+    let o = out.to_str().unwrap();
+    let base = [
+        "report",
+        "--rays",
+        "24",
+        "--stress-count",
+        "6",
+        "--format",
+        "f32,bf16,q8.24:divide",
+        "--variant",
+        "plain,conservative",
+        "--json",
+    ];
+    let mut whole_args = base.to_vec();
+    whole_args.extend(["--out", o]);
+    let untimed = |mut v: serde_json::Value| {
+        for p in v["points"].as_array_mut().unwrap() {
+            let p = p.as_object_mut().unwrap();
+            p.remove("ns_per_test");
+            p.remove("pareto");
+        }
+        v
+    };
+    let whole = untimed(json(&raypipe(&whole_args)));
+    assert!(whole["points"].as_array().unwrap().len() >= 6);
+    let parts = run_shards(&d, &base, 3, "rep");
+    let merged_dir = d.join("merged");
+    let mut a = vec!["merge", "--json", "--out", merged_dir.to_str().unwrap()];
+    a.extend(parts.iter().map(String::as_str));
+    assert_eq!(untimed(json(&raypipe(&a))), whole);
+    assert!(merged_dir.join("report.md").exists());
+    // --out is for report partials only
+    let v = run_shards(&d, &RUN, 1, "v");
+    refused(&raypipe(&["merge", "--out", merged_dir.to_str().unwrap(), &v[0]]), "report");
+    std::fs::remove_dir_all(&d).unwrap();
+}
