@@ -287,7 +287,7 @@ enum Cmd {
         /// Format: f32, fp16 or bf16 (ieee or ftz, recip or divide; canonical NaN rule).
         #[arg(long, value_parser = parse_format)]
         format: AnyFormat,
-        /// Operation: add, sub, mul, div (the format's division mode), recip, lt, le.
+        /// Operation: add, sub, mul, div (the format's division mode), recip, lt, le, cmp (both compares).
         #[arg(long)]
         op: String,
         /// Every operand pair (16-bit formats: 2^32 pairs).

@@ -7,7 +7,8 @@
 //! sampled sweep is pair (s[i / S], s[i mod S]) of the S special operands while i < S², and
 //! after that two random encodings drawn by `SplitMix64::for_item(seed, OPS_STREAM, i)`.
 //! A result is right when its encoding equals the oracle's, or, when the oracle's is a NaN,
-//! when it is the format's canonical NaN (the canonical NaN rule). Comparisons are 0 or 1.
+//! when it is the format's canonical NaN (the canonical NaN rule). `lt` and `le` are 0 or 1;
+//! `cmp` is both, (a < b) + 2 (a <= b).
 
 use datapath::format::{DivMode, NanMode, Subnormals};
 use datapath::rng::SplitMix64;
@@ -21,7 +22,7 @@ pub const OPS_STREAM: u64 = 0x6f70_7321;
 pub const CHUNK: u64 = 1 << 16;
 
 /// The operations `ops` sweeps.
-pub const OP_NAMES: [&str; 7] = ["add", "sub", "mul", "div", "recip", "lt", "le"];
+pub const OP_NAMES: [&str; 8] = ["add", "sub", "mul", "div", "recip", "lt", "le", "cmp"];
 
 /// What to sweep.
 #[derive(Clone, Debug)]
@@ -122,6 +123,7 @@ fn oracle_op_of(name: &str) -> Result<OracleOp, String> {
         "recip" => OracleOp::Recip,
         "lt" => OracleOp::Lt,
         "le" => OracleOp::Le,
+        "cmp" => OracleOp::Cmp,
         other => return Err(format!("unknown --op '{other}'; ops: {}", OP_NAMES.join(", "))),
     })
 }
@@ -222,9 +224,10 @@ pub fn accumulate(cfg: &OpsConfig) -> Result<OpsData, String> {
                         OracleOp::Recip => f.to_bits(f.div(f.one(), y)),
                         OracleOp::Lt => f.lt(x, y) as u64,
                         OracleOp::Le => f.le(x, y) as u64,
+                        OracleOp::Cmp => f.lt(x, y) as u64 + 2 * f.le(x, y) as u64,
                     };
                     let want = oracle_op(of, rules, op, a, b);
-                    let cmp = matches!(op, OracleOp::Lt | OracleOp::Le);
+                    let cmp = matches!(op, OracleOp::Lt | OracleOp::Le | OracleOp::Cmp);
                     let ok = if !cmp && f.is_nan(f.from_bits(want)) { got == canonical } else { got == want };
                     counts.0[0] += 1;
                     if !ok {

@@ -7,7 +7,7 @@
 //! * division by reciprocal (`recip_div`): a ÷ b is a × (1 ÷ b), each operation rounded (and
 //!   flushed under FTZ) on its own;
 //! * `Recip` is 1 ÷ b; `Lt` and `Le` are IEEE ordered comparisons (a NaN operand gives false,
-//!   −0 equals +0), returned as 1 or 0.
+//!   −0 equals +0), returned as 1 or 0; `Cmp` is both, (a < b) + 2 (a <= b).
 //!
 //! NaN results are returned as APFloat makes them; the caller judges them by the model's NaN
 //! rule (the canonical rule: any NaN result must be the format's canonical NaN).
@@ -43,6 +43,8 @@ pub enum OracleOp {
     Lt,
     /// a <= b.
     Le,
+    /// Both comparisons as one result: (a < b) + 2 (a <= b).
+    Cmp,
 }
 
 /// The rules around the IEEE operation.
@@ -75,6 +77,14 @@ fn flush<T: Float>(rules: OracleRules, x: T) -> T {
     }
 }
 
+fn lt<T: Float>(x: T, y: T) -> bool {
+    x.partial_cmp(&y) == Some(std::cmp::Ordering::Less)
+}
+
+fn le<T: Float>(x: T, y: T) -> bool {
+    matches!(x.partial_cmp(&y), Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal))
+}
+
 fn run<T: Float>(rules: OracleRules, op: OracleOp, a: u64, b: u64) -> u64 {
     let r = Round::NearestTiesToEven;
     let (x, y) = (flush(rules, T::from_bits(a as u128)), flush(rules, T::from_bits(b as u128)));
@@ -87,10 +97,9 @@ fn run<T: Float>(rules: OracleRules, op: OracleOp, a: u64, b: u64) -> u64 {
         OracleOp::Div if rules.recip_div => x.mul_r(recip(y), r).value,
         OracleOp::Div => x.div_r(y, r).value,
         OracleOp::Recip => recip(y),
-        OracleOp::Lt => return (x.partial_cmp(&y) == Some(std::cmp::Ordering::Less)) as u64,
-        OracleOp::Le => {
-            return matches!(x.partial_cmp(&y), Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)) as u64
-        }
+        OracleOp::Lt => return lt(x, y) as u64,
+        OracleOp::Le => return le(x, y) as u64,
+        OracleOp::Cmp => return lt(x, y) as u64 + 2 * le(x, y) as u64,
     };
     flush(rules, v).to_bits() as u64
 }
@@ -121,8 +130,11 @@ mod tests {
         assert_eq!(oracle_op(Binary16, d, Le, 0x8000, 0x0000), 1);
         assert_eq!(oracle_op(Binary16, d, Lt, 0x8000, 0x0000), 0);
         assert_eq!(oracle_op(Binary16, d, Le, 0x7e00, 0x7e00), 0);
-        // 5 / 3 by reciprocal: 5 × RN(1/3) is one ulp below RN(5/3) in binary16; 11 / 11 is
-        // 1 - 2^-11 (checked with Python's struct 'e' packing)
+        assert_eq!(oracle_op(Binary16, d, Cmp, 0x3c00, 0x4000), 3); // 1 < 2
+        assert_eq!(oracle_op(Binary16, d, Cmp, 0x4000, 0x4000), 2); // 2 <= 2
+        assert_eq!(oracle_op(Binary16, d, Cmp, 0x7e00, 0x4000), 0); // NaN
+                                                                    // 5 / 3 by reciprocal: 5 × RN(1/3) is one ulp below RN(5/3) in binary16; 11 / 11 is
+                                                                    // 1 - 2^-11 (checked with Python's struct 'e' packing)
         let rd = OracleRules { recip_div: true, ..d };
         assert_eq!(oracle_op(Binary16, d, Div, 0x4500, 0x4200), 0x3eab);
         assert_eq!(oracle_op(Binary16, rd, Div, 0x4500, 0x4200), 0x3eaa);
