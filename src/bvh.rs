@@ -48,13 +48,24 @@ pub struct NearestWork {
 }
 
 impl SceneBvh {
-    /// [`NearestWork`] of `ray`, boxes and triangles tested by the golden f64 tests.
-    pub fn nearest_work(&self, hw: &datapath::bvh::HwTree<u32>, scene: &Scene, ray: &golden::Ray64) -> NearestWork {
-        let test = |i: u32| {
+    /// The golden f64 slab test of `ray` against node `i`'s box: its entry distance on a hit.
+    pub fn box_test<'a>(&'a self, ray: &'a golden::Ray64) -> impl Fn(u32) -> Option<f64> + 'a {
+        move |i: u32| {
             let n = &self.nodes[i as usize];
             let r = golden::slab_f64(ray.o, ray.d, ray.tmin, ray.tmax, n.min, n.max);
             r.hit.then_some(r.t_near)
-        };
+        }
+    }
+
+    /// Box entries the traversal core stores in BRAM: the root and both children of every
+    /// inner node.
+    pub fn bram_boxes(&self) -> u64 {
+        1 + 2 * self.nodes.iter().filter(|n| n.children.is_some()).count() as u64
+    }
+
+    /// [`NearestWork`] of `ray`, boxes and triangles tested by the golden f64 tests.
+    pub fn nearest_work(&self, hw: &datapath::bvh::HwTree<u32>, scene: &Scene, ray: &golden::Ray64) -> NearestWork {
+        let test = self.box_test(ray);
         let all = datapath::bvh::history_traverse(hw, usize::MAX, |&i| test(i));
         // the nearest hit over every leaf reached, and the position of its leaf
         let mut best: Option<(usize, f64)> = None;

@@ -716,8 +716,8 @@ fn run_verify(a: VerifyArgs) -> Result<Outcome, String> {
     if let Some(path) = &a.partial {
         let data = raypipe::verify::accumulate(&cfg, &scene);
         let (args, hash) = (raypipe::verify::args(&cfg), raypipe::partial::scene_hash(&scene));
-        write_partial(path, "verify", args, hash, a.chunk, shard, data)?;
-        return wrote_partial(a.json, "verify", shard, path);
+        let p = raypipe::partial::Partial::new("verify", args, hash, a.chunk, shard, data);
+        return shard_done(a.json, path, p);
     }
     let rep = verify(&cfg, &scene);
     emit(a.json, &rep, render)?;
@@ -741,31 +741,14 @@ fn shard_of(shard: Option<&str>, partial: Option<&std::path::Path>) -> Result<en
     Ok(s)
 }
 
-/// Writes a shard's partial result.
-fn write_partial<T: serde::Serialize>(
+/// Writes a shard's partial result and says so (JSON with `json`); the shard's run passes.
+fn shard_done<T: serde::Serialize>(
+    json: bool,
     path: &std::path::Path,
-    command: &str,
-    args: serde_json::Value,
-    scene_hash: String,
-    chunk: u64,
-    shard: engine::Shard,
-    data: T,
-) -> Result<(), String> {
-    let p = raypipe::partial::Partial {
-        raypipe_partial: raypipe::partial::FORMAT,
-        version: env!("CARGO_PKG_VERSION").to_string(),
-        command: command.into(),
-        args,
-        scene_hash,
-        chunk,
-        shard,
-        data,
-    };
-    raypipe::partial::write(path, &p)
-}
-
-/// What a shard prints once its partial is written.
-fn wrote_partial(json: bool, command: &str, shard: engine::Shard, path: &std::path::Path) -> Result<Outcome, String> {
+    p: raypipe::partial::Partial<T>,
+) -> Result<Outcome, String> {
+    raypipe::partial::write(path, &p)?;
+    let (command, shard) = (&p.command, p.shard);
     if json {
         let v = serde_json::json!({ "command": command, "shard": shard, "partial": path.display().to_string() });
         println!("{}", serde_json::to_string_pretty(&v).map_err(|e| e.to_string())?);
@@ -862,8 +845,8 @@ fn run() -> Result<Outcome, String> {
             if let Some(path) = &sharding.partial {
                 let hash = raypipe::partial::scene_hash(&scene);
                 let args = raypipe::traverse::args(&cfg);
-                write_partial(path, "traverse", args, hash, raypipe::traverse::CHUNK_RAYS, sh, rep)?;
-                return wrote_partial(json, "traverse", sh, path);
+                let p = raypipe::partial::Partial::new("traverse", args, hash, raypipe::traverse::CHUNK_RAYS, sh, rep);
+                return shard_done(json, path, p);
             }
             emit(json, &rep, raypipe::traverse::render)?;
             Ok(Outcome::from(rep.passed))
@@ -879,11 +862,17 @@ fn run() -> Result<Outcome, String> {
                 engine: run.engine(raypipe::ops::CHUNK).with_shard(sh),
                 progress: !run.quiet,
             };
-            raypipe::ops::items(&cfg)?;
             let data = raypipe::ops::accumulate(&cfg)?;
             if let Some(path) = &partial {
-                write_partial(path, "ops", raypipe::ops::args(&cfg), String::new(), raypipe::ops::CHUNK, sh, data)?;
-                return wrote_partial(json, "ops", sh, path);
+                let p = raypipe::partial::Partial::new(
+                    "ops",
+                    raypipe::ops::args(&cfg),
+                    String::new(),
+                    raypipe::ops::CHUNK,
+                    sh,
+                    data,
+                );
+                return shard_done(json, path, p);
             }
             let rep = raypipe::ops::finish(data);
             emit(json, &rep, raypipe::ops::render)?;
@@ -1182,8 +1171,15 @@ fn run() -> Result<Outcome, String> {
             if let Some(path) = &sharding.partial {
                 let data = raypipe::report::accumulate(&cfg, &scenes)?;
                 let args = raypipe::report::args(&cfg, &scenes);
-                write_partial(path, "report", args, String::new(), raypipe::verify::CHUNK_RAYS, sh, data)?;
-                return wrote_partial(json, "report", sh, path);
+                let p = raypipe::partial::Partial::new(
+                    "report",
+                    args,
+                    String::new(),
+                    raypipe::verify::CHUNK_RAYS,
+                    sh,
+                    data,
+                );
+                return shard_done(json, path, p);
             }
             let rep = raypipe::report::report(&cfg, &scenes)?;
             let files = raypipe::report::write(&rep, dir.as_ref().expect("checked when there is no partial"))?;
@@ -1207,8 +1203,15 @@ fn run() -> Result<Outcome, String> {
             let rep = raypipe::stress::stress(&cfg)?;
             if let Some(path) = &sharding.partial {
                 let args = raypipe::stress::args(&cfg);
-                write_partial(path, "stress", args, String::new(), raypipe::stress::CHUNK_CASES, sh, rep)?;
-                return wrote_partial(json, "stress", sh, path);
+                let p = raypipe::partial::Partial::new(
+                    "stress",
+                    args,
+                    String::new(),
+                    raypipe::stress::CHUNK_CASES,
+                    sh,
+                    rep,
+                );
+                return shard_done(json, path, p);
             }
             emit(json, &rep, raypipe::stress::render)?;
             Ok(Outcome::from(rep.passed))

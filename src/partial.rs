@@ -39,6 +39,22 @@ pub struct Partial<T> {
     pub data: T,
 }
 
+impl<T> Partial<T> {
+    /// One shard's result of `command`, stamped with this partial format and raypipe version.
+    pub fn new(command: &str, args: serde_json::Value, scene_hash: String, chunk: u64, shard: Shard, data: T) -> Self {
+        Partial {
+            raypipe_partial: FORMAT,
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            command: command.into(),
+            args,
+            scene_hash,
+            chunk,
+            shard,
+            data,
+        }
+    }
+}
+
 /// FNV-1a 64 over the binary64 encodings of every triangle coordinate, in order, as 16 hex
 /// digits.
 pub fn scene_hash(scene: &crate::scene::Scene) -> String {
@@ -69,9 +85,8 @@ pub fn check_path(path: &Path) -> Result<(), String> {
     }
     if path.exists() {
         let text = std::fs::read_to_string(path).map_err(|e| format!("--partial {shown}: {e}"))?;
-        let v: serde_json::Value = serde_json::from_str(&text)
-            .map_err(|_| format!("--partial {shown} exists and is not a raypipe partial: not replacing it"))?;
-        if v.get("raypipe_partial").is_none() {
+        let ours = serde_json::from_str::<serde_json::Value>(&text).is_ok_and(|v| v.get("raypipe_partial").is_some());
+        if !ours {
             return Err(format!("--partial {shown} exists and is not a raypipe partial: not replacing it"));
         }
     }

@@ -252,9 +252,7 @@ fn choose(cfg: &PlanConfig, scene: &Scene) -> Result<Choice, String> {
         Some((s, n, l, bits)) => (Some(s), n, l, bits),
         None => {
             // nothing fits: the rule of thumb's tree, with the BRAM it would need
-            let b = crate::bvh::build(scene, rule);
-            let inner = b.nodes.iter().filter(|n| n.children.is_some()).count() as u64;
-            (None, cfg.pipelines, rule, (1 + 2 * inner) * (base.box_bits + base.addr_bits) as u64)
+            (None, cfg.pipelines, rule, base.bram_bits(crate::bvh::build(scene, rule).bram_boxes()))
         }
     };
     Ok(Choice {

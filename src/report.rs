@@ -233,7 +233,6 @@ pub fn accumulate(cfg: &ReportConfig, scenes: &[Scene]) -> Result<ReportData, St
     let st = stress(&scfg)?;
     let mut vcfg = VerifyConfig::new(cfg.formats.clone(), cfg.rays, cfg.seed, RtiConfig::default(), 512);
     vcfg.engine = engine::Engine { chunk: crate::verify::CHUNK_RAYS, ..cfg.engine };
-    let exact_engine = engine::Engine { chunk: crate::verify::CHUNK_RAYS, ..cfg.engine };
     let mut verify = Vec::new();
     let mut exact = Vec::new();
     let mut rti_rate = Vec::new();
@@ -243,7 +242,7 @@ pub fn accumulate(cfg: &ReportConfig, scenes: &[Scene]) -> Result<ReportData, St
         let one = VerifyConfig { formats: vec![*f], ..vcfg.clone() };
         verify.push(scenes.iter().map(|s| crate::verify::accumulate(&one, s)).collect());
         exact.push(
-            scenes.iter().map(|s| with_format!(*f, |f| exact_rti(f, s, cfg.rays, cfg.seed, &exact_engine))).collect(),
+            scenes.iter().map(|s| with_format!(*f, |f| exact_rti(f, s, cfg.rays, cfg.seed, &vcfg.engine))).collect(),
         );
     }
     Ok(ReportData {

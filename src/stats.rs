@@ -11,7 +11,6 @@
 use crate::bvh::build;
 use crate::scene::Scene;
 use golden::bvh::stack_traverse;
-use golden::slab_f64;
 use serde::Serialize;
 
 /// Results for one leaf size.
@@ -114,12 +113,7 @@ pub fn stats_on(
                     let ray = gen.ray(k);
                     let w = b.nearest_work(&hw, scene, &ray);
                     let (h, upto) = (&w.history, w.leaves.len());
-                    let test = |i: u32| {
-                        let n = &b.nodes[i as usize];
-                        let r = slab_f64(ray.o, ray.d, ray.tmin, ray.tmax, n.min, n.max);
-                        r.hit.then_some(r.t_near)
-                    };
-                    let g = stack_traverse(&tree, upto.max(1), test);
+                    let g = stack_traverse(&tree, upto.max(1), b.box_test(&ray));
                     let tests: u64 = w.leaves.iter().map(|&l| b.leaf_tris[l as usize].len() as u64).sum();
                     for &leaf in &w.leaves {
                         acc.seen.insert(leaf as usize);

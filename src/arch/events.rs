@@ -93,7 +93,6 @@ pub fn gather(
     );
     let mut leaf_rays = engine::Tally(vec![0; b.leaf_tris.len()]);
     leaf_rays.merge(acc.leaf_rays);
-    let inner = b.nodes.iter().filter(|n| n.children.is_some()).count() as u64;
     Ok(SceneEvents {
         leaf_size,
         depth: b.depth,
@@ -102,6 +101,6 @@ pub fn gather(
         leaf_tris: b.leaf_tris.iter().map(|t| t.len() as u32).collect(),
         leaf_rays: leaf_rays.0,
         passes: acc.c.0[1],
-        bram_boxes: 1 + 2 * inner,
+        bram_boxes: b.bram_boxes(),
     })
 }

@@ -135,12 +135,8 @@ pub fn sweep_events(
 
 /// The least-total-time estimate (the first on a tie) and the least-RTI-time one.
 fn best<'a>(rows: impl Iterator<Item = &'a Estimate> + Clone) -> Option<(&'a Estimate, &'a Estimate)> {
-    let by = |f: fn(&Estimate) -> f64| {
-        rows.clone().fold(None, |b: Option<&Estimate>, e| match b {
-            Some(b) if f(b) <= f(e) => Some(b),
-            _ => Some(e),
-        })
-    };
+    // `min_by` keeps the first of equal minima
+    let by = |f: fn(&Estimate) -> f64| rows.clone().min_by(|a, b| f(a).total_cmp(&f(b)));
     Some((by(|e| e.total_s)?, by(|e| e.rti_s)?))
 }
 
@@ -184,7 +180,7 @@ pub fn arch(eng: &engine::Engine, cfg: &ArchConfig, scene: &Scene) -> Result<Arc
     // calibration at the base parameters and their fastest leaf size
     let base: Vec<Estimate> = events.iter().map(|e| estimate(&cfg.params, e)).collect();
     let (b, _) = best(base.iter()).expect("a leaf size");
-    let be = &events[base.iter().position(|e| std::ptr::eq(e, b)).expect("from base")];
+    let be = events.iter().find(|e| e.leaf_size == b.leaf_size).expect("the leaf sizes are distinct");
     let p = &cfg.params;
     let peak = p.rti_peak();
     let per_pipeline = peak / p.pipelines as f64;

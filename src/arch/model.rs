@@ -157,6 +157,6 @@ pub fn estimate(p: &ArchParams, e: &SceneEvents) -> Estimate {
         rti_rate: rate(rti.tests as f64, rti_s),
         rti_utilisation: rti.tests as f64 / (rti.total as f64 * p.pipelines as f64).max(1.0),
         trav_rate: rate(e.rays as f64, trav_s),
-        bram_bits: e.bram_boxes * (p.box_bits + p.addr_bits) as u64,
+        bram_bits: p.bram_bits(e.bram_boxes),
     }
 }

@@ -94,6 +94,11 @@ impl ArchParams {
         self.pipelines as f64 * self.rti_mhz * 1e6 * self.buffers_used() as f64 / self.cadence() as f64
     }
 
+    /// BRAM bits of `boxes` stored box entries (a box and an address word each).
+    pub fn bram_bits(&self, boxes: u64) -> u64 {
+        boxes * (self.box_bits + self.addr_bits) as u64
+    }
+
     /// Refuses a parameter set the model cannot evaluate (a clear message naming the flag).
     pub fn check(&self) -> Result<(), String> {
         let positive = [
