@@ -21,6 +21,20 @@ pub mod stress;
 pub mod traverse;
 pub mod verify;
 
+/// The golden's f64-lane level for the engine: the fastest here within the kernels' caps
+/// (`datapath::simd::cap_process`, `raypipe speed --cap`); the golden crate itself knows no cap.
+pub fn golden_level() -> golden::block::Level {
+    use datapath::simd::{kernels_here, Kernel};
+    use golden::block::Level;
+    let k = kernels_here();
+    let allowed = |l: &Level| match l {
+        Level::Scalar => true,
+        Level::Avx2 => k.contains(&Kernel::Avx2),
+        Level::Avx512 => k.contains(&Kernel::Avx512),
+    };
+    golden::block::levels_here().into_iter().rfind(allowed).unwrap_or(Level::Scalar)
+}
+
 /// How a run ended, as its exit code: 0 every property held, 1 one failed, 3 the run proved
 /// nothing (no test could decide the property). Bad input is 2 (a clear error, no result).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -575,6 +575,9 @@ enum Cmd {
         /// Seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Use no kernel wider than this (as a machine without the wider ones would): scalar, avx2, avx512 or avx512fp16.
+        #[arg(long, value_parser = ["scalar", "avx2", "avx512", "avx512fp16"])]
+        cap: Option<String>,
         /// Print the results as JSON.
         #[arg(long)]
         json: bool,
@@ -1189,9 +1192,20 @@ fn run() -> Result<Outcome, String> {
             }
             Ok(Outcome::Pass)
         }
-        Some(Cmd::Speed { pairs, seed, json }) => {
+        Some(Cmd::Speed { pairs, seed, cap, json }) => {
             limit("--pairs", pairs, MAX_SPEED_PAIRS, "the columns are held in memory")?;
-            let rep = raypipe::speed::speed(pairs as usize, seed);
+            if let Some(c) = &cap {
+                use datapath::simd::Kernel;
+                let k = match c.as_str() {
+                    "scalar" => Kernel::Scalar,
+                    "avx2" => Kernel::Avx2,
+                    "avx512" => Kernel::Avx512,
+                    _ => Kernel::Avx512Fp16,
+                };
+                datapath::simd::cap_process(k);
+            }
+            let mut rep = raypipe::speed::speed(pairs as usize, seed);
+            rep.cap = cap;
             emit(json, &rep, raypipe::speed::render)?;
             Ok(Outcome::Pass)
         }

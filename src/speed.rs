@@ -54,6 +54,9 @@ pub struct SpeedReport {
     pub rows: Vec<SpeedRow>,
     /// Which formats have a SIMD batch path for RTI and which run the scalar model only.
     pub batch_paths: Vec<String>,
+    /// The widest kernel allowed (`--cap`), when capped.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cap: Option<String>,
 }
 
 /// The RTI batch path of each format family (the SIMD kernels of `datapath::simd`).
@@ -360,7 +363,7 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
             std::array::from_fn(|k| (0..n).map(|i| cases.get(i).map_or(0.0, |c| c.1.v[k / 3][k % 3])).collect());
         let c9 = || -> [&[f64]; 9] { std::array::from_fn(|k| &cols[k][..]) };
         let (mut hit, mut t) = (vec![false; n], vec![0.0; n]);
-        let level = golden::block::best_level();
+        let level = crate::golden_level();
         push(row(&format!("golden mt f64 block ({level:?})"), n, 0.0, 3, || {
             golden::block::intersect_block(level, &ray, golden::Faces::default(), c9(), &mut hit, &mut t)
         }));
@@ -499,6 +502,7 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         peak_gops: peak / 1e9,
         peak16_gops: (peak16 > 0.0).then_some(peak16 / 1e9),
         rows,
+        cap: None,
     }
 }
 
@@ -527,8 +531,13 @@ fn half_mt(r: &[half::f16; 6], v: &[half::f16; 9]) -> bool {
 pub fn render(s: &SpeedReport) -> String {
     let p16 = s.peak16_gops.map_or(String::new(), |p| format!(", {p:.1} G lane-ops/s (binary16, AVX512-FP16)"));
     let mut out = format!(
-        "raypipe speed: {} pairs (built-in scene, seed {}), one thread; kernels: f32 {}, fp16 {}; measured no-FMA peak {:.1} G lane-ops/s (binary32){p16}\n\n",
-        s.pairs, s.seed, s.kernels[0], s.kernels[1], s.peak_gops
+        "raypipe speed: {} pairs (built-in scene, seed {}), one thread; kernels{}: f32 {}, fp16 {}; measured no-FMA peak {:.1} G lane-ops/s (binary32){p16}\n\n",
+        s.pairs,
+        s.seed,
+        s.cap.as_ref().map_or(String::new(), |c| format!(" (capped at {c})")),
+        s.kernels[0],
+        s.kernels[1],
+        s.peak_gops
     );
     let with16 = s.peak16_gops.is_some();
     out += if with16 {

@@ -543,3 +543,20 @@ fn speed_fractions_are_each_rows_rate_over_the_one_peak_it_prints() {
         }
     }
 }
+
+/// `speed --cap` measures as a narrower machine would: every dispatch (the f32 / fp16 kernels
+/// it names) stays within the cap, the cap is in the JSON, and an unknown cap is refused.
+#[test]
+fn speed_cap_limits_every_kernel_it_names() {
+    let o = raypipe(&["speed", "--pairs", "64", "--cap", "scalar", "--json"]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["cap"], "scalar");
+    assert_eq!(v["kernels"], serde_json::json!(["Scalar", "Scalar"]));
+    let o = raypipe(&["speed", "--pairs", "64", "--cap", "avx2"]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("kernels (capped at avx2): f32 "), "{out}");
+    assert!(!out.contains("Avx512"), "{out}");
+    assert_clear_error(&raypipe(&["speed", "--cap", "avx3"]), "--cap");
+}

@@ -286,6 +286,8 @@ pub fn verdict_block(
     use crate::simd::Kernel;
     let n = hit.len();
     assert!(decisive.len() == n && t_err.len() == n && tris.iter().all(|c| c.len() == n), "column lengths differ");
+    // within this thread's and the process's caps as well
+    let cap = crate::simd::best_kernel(true, cap);
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::is_x86_feature_detected as has;

@@ -75,6 +75,16 @@ pub fn with_kernel_cap<R>(cap: Kernel, f: impl FnOnce() -> R) -> R {
     crate::scoped(&CAP, cap, f)
 }
 
+/// The process-wide cap ([`cap_process`]), as `Kernel as u8`.
+static PROCESS_CAP: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(Kernel::Avx512Fp16 as u8);
+
+/// Limits the dispatch of every thread, from now on, to kernels no wider than `cap`, as if the
+/// machine had none wider ([`kernels_here`] included): `raypipe speed --cap avx2` measures an
+/// AVX2 machine's kernels on an AVX-512 one.
+pub fn cap_process(cap: Kernel) {
+    PROCESS_CAP.store(cap as u8, std::sync::atomic::Ordering::Relaxed);
+}
+
 /// The kernels this machine can run, narrowest first (`Scalar` always).
 pub fn kernels_here() -> Vec<Kernel> {
     [Kernel::Scalar, Kernel::Avx2, Kernel::Avx512, Kernel::Avx512Fp16]
@@ -83,8 +93,15 @@ pub fn kernels_here() -> Vec<Kernel> {
         .collect()
 }
 
-/// The widest kernel this machine can run, detected once.
+/// The widest kernel this machine can run (detected once) within the process cap.
 fn widest_here() -> Kernel {
+    let all = [Kernel::Scalar, Kernel::Avx2, Kernel::Avx512, Kernel::Avx512Fp16];
+    let cap = all[PROCESS_CAP.load(std::sync::atomic::Ordering::Relaxed) as usize];
+    detected().min(cap)
+}
+
+/// The widest kernel this machine's features allow, detected once.
+fn detected() -> Kernel {
     static WIDEST: std::sync::OnceLock<Kernel> = std::sync::OnceLock::new();
     *WIDEST.get_or_init(|| {
         #[cfg(target_arch = "x86_64")]
@@ -287,6 +304,17 @@ pub fn rti_batch_bf16(
     )
 }
 
+/// The kernel `rti_batch_soft` uses for this unit on this machine: [`kernel_narrow`], whose
+/// 8-lane kernel also needs AVX-512DQ (the range filter's `vrangepd`).
+pub fn kernel_soft(rti: &Rti<Ieee<Soft>>) -> Kernel {
+    let k = kernel_narrow(rti);
+    #[cfg(target_arch = "x86_64")]
+    if k == Kernel::Avx512 && !std::arch::is_x86_feature_detected!("avx512dq") {
+        return Kernel::Avx2;
+    }
+    k
+}
+
 /// [`Rti::batch`] for a custom `eEmM` layout on the fastest kernel available; the same bits.
 ///
 /// # Panics
@@ -297,7 +325,7 @@ pub fn rti_batch_soft(
     tris: &TrisSoa<u64>,
     out: &mut HitsSoa<u64>,
 ) -> Kernel {
-    let which = kernel_narrow(rti);
+    let which = kernel_soft(rti);
     rti_dispatch(
         rti,
         rays,
@@ -1445,19 +1473,23 @@ mod isa {
         /// `n.fast_lo` and all magnitudes at most `n.fast_hi`, so that no result of stages 2-7
         /// leaves {±0} ∪ [2^emin, max]. A NaN fails (the unfiltered stage 1 turns an infinite
         /// difference into a NaN, which must take the filtered road).
+        ///
+        /// Five operations a value, on a = |x|: the upper limit on a's encoding as a signed
+        /// integer (a NaN's is above +∞'s, so it fails there); the lower limit on the binary64
+        /// just below a (encoding − 1: order kept for a > 0, and ±0 becomes the all-ones NaN,
+        /// which `vminpd` skips, returning its second operand, the running minimum).
         #[inline]
         #[target_feature(enable = "avx2")]
         pub fn fast_ok(v: &[__m256d; 12], n: &Narrow) -> bool {
-            let (zero, inf, top) = (splat(0.0), splat(f64::INFINITY), splat(n.fast_hi));
-            let mut lo = inf;
-            // all lanes, then cleared where a magnitude is above fast_hi or NaN
-            let mut good = le(zero, zero);
+            let top = _mm256_set1_epi64x(n.fast_hi.to_bits() as i64);
+            let mut over = _mm256_setzero_si256();
+            let mut lo = splat(f64::INFINITY);
             for &x in v {
-                let a = abs(x);
-                good = and_m(good, le(a, top));
-                lo = min_where(lo, a, lt(zero, a));
+                let a = _mm256_castpd_si256(abs(x));
+                over = _mm256_or_si256(over, _mm256_cmpgt_epi64(a, top));
+                lo = _mm256_min_pd(_mm256_castsi256_pd(_mm256_sub_epi64(a, int(1))), lo);
             }
-            bits(and_m(good, le(splat(n.fast_lo), lo))) == (1 << LANES) - 1
+            _mm256_testz_si256(over, over) == 1 && bits(le(pred(splat(n.fast_lo)), lo)) == (1 << LANES) - 1
         }
         narrow_ops!("avx2", "avx2,fma", __m256d, _mm256_fnmadd_pd);
         /// Loads 4 `eEmM` encodings as binary64 (exact).
@@ -1676,23 +1708,31 @@ mod isa {
         fn exponent(x: __m512d) -> __m512d {
             fb(_mm512_and_si512(ib(x), int(0x7ff0_0000_0000_0000)))
         }
-        /// [`super::v4d::fast_ok`] on 8 lanes, in integer lanes: u = the encoding shifted left
-        /// by one (the sign dropped; for magnitudes, the order of u is the order of the values,
-        /// and a NaN's u is above +∞'s), the largest u and the smallest u − 1 (a zero's u − 1
-        /// wraps to the largest value, so zeros drop out) against the limits' encodings.
+        /// [`super::v4d::fast_ok`] on 8 lanes, in three AVX-512 operations a value: the largest
+        /// magnitude by `vrangepd` (max-abs, sign cleared), and the smallest nonzero magnitude
+        /// by `vfixupimmpd` (±0 becomes +∞, a NaN becomes +0, every other class stays itself)
+        /// and `vrangepd` (min-abs, sign cleared), each over a balanced tree of the twelve.
+        /// `vrangepd` returns the other operand when one is a quiet NaN (as `maxNum` does), so
+        /// the NaN is caught by the lower limit: it reads as +0 there, below `fast_lo` (> 0);
+        /// an infinity fails the upper limit.
         #[inline]
-        #[target_feature(enable = "avx512f")]
+        #[target_feature(enable = "avx512f,avx512dq")]
         pub fn fast_ok(v: &[__m512d; 12], n: &Narrow) -> bool {
-            let one = int(1);
-            let (mut hi, mut lo) = (_mm512_setzero_si512(), int(u64::MAX));
-            for &x in v {
-                let u = _mm512_add_epi64(ib(x), ib(x));
-                hi = _mm512_max_epu64(hi, u);
-                lo = _mm512_min_epu64(lo, _mm512_sub_epi64(u, one));
-            }
-            let top = int(n.fast_hi.to_bits() << 1);
-            let bottom = int((n.fast_lo.to_bits() << 1) - 1);
-            _mm512_cmple_epu64_mask(hi, top) & _mm512_cmpge_epu64_mask(lo, bottom) == u8::MAX
+            // vfixupimmpd's table: a 4-bit response per input class, class j in bits 4j..4j+3
+            // (QNaN, SNaN, ±0, +1, −∞, +∞, negative, positive); 1 = the input itself, 5 = +∞,
+            // 8 = +0
+            let table = int(0x1111_1588);
+            let nz = |x: __m512d| _mm512_fixupimm_pd::<0>(x, x, table);
+            // imm bits 1:0 = 11 max-abs / 10 min-abs; bits 3:2 = 10 sign cleared
+            let hi = |a, b| _mm512_range_pd::<0b1011>(a, b);
+            let lo = |a, b| _mm512_range_pd::<0b1010>(a, b);
+            let z: [__m512d; 12] = std::array::from_fn(|k| nz(v[k]));
+            let h = |k: usize| hi(hi(v[k], v[k + 1]), hi(v[k + 2], v[k + 3]));
+            let l = |k: usize| lo(lo(z[k], z[k + 1]), lo(z[k + 2], z[k + 3]));
+            let (h, l) = (hi(hi(h(0), h(4)), h(8)), lo(lo(l(0), l(4)), l(8)));
+            let ok = _mm512_cmp_pd_mask::<_CMP_LE_OQ>(h, splat(n.fast_hi))
+                & _mm512_cmp_pd_mask::<_CMP_GE_OQ>(l, splat(n.fast_lo));
+            ok == u8::MAX
         }
         narrow_ops!("avx512f", "avx512f", __m512d, _mm512_fnmadd_pd);
         /// Loads 8 `eEmM` encodings as binary64 (exact).
@@ -1731,11 +1771,23 @@ mod isa {
         #[inline]
         #[target_feature(enable = "avx512f")]
         pub unsafe fn load_e8(p: *const u64, i: usize, n: &Narrow) -> __m512d {
-            let b = unsafe { _mm512_loadu_si512(p.add(i) as *const __m512i) };
-            // the low halves of the 8 lanes to the low 256 bits: one `vpermd` (a `vpmovqd`
-            // is two shuffle uops); the encodings fit 32 bits
+            // the low halves of the 8 lanes to the low 256 bits (the encodings fit 32 bits):
+            // one `vpermd` from memory, written out because LLVM turns the permute intrinsic
+            // into a `vpmovqd` (two shuffle uops and a separate load)
             let idx = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 0, 0, 0, 0, 0, 0, 0, 0);
-            let low = _mm512_castsi512_si256(_mm512_permutexvar_epi32(idx, b));
+            let low: __m512i;
+            // SAFETY: `p[i..i + 8]` is in bounds (the caller): the 64 bytes read; the asm
+            // writes only its output register.
+            unsafe {
+                std::arch::asm!(
+                    "vpermd {o}, {x}, zmmword ptr [{p}]",
+                    o = lateout(zmm_reg) low,
+                    x = in(zmm_reg) idx,
+                    p = in(reg) p.add(i),
+                    options(pure, readonly, nostack, preserves_flags)
+                );
+            }
+            let low = _mm512_castsi512_si256(low);
             _mm512_cvtps_pd(_mm256_castsi256_ps(_mm256_sll_epi32(low, count(n.e8_shift))))
         }
         /// [`store_soft`] for `e8mM` with M ≤ 23 (`n.e8`): the lanes hold target values, which
@@ -2536,7 +2588,7 @@ mod kernels {
     /// ([`isa::v4d::round_full`]), and stages 2-7 by the split alone when the range filter
     /// ([`isa::v4d::fast_ok`]) proves them in range (see [`crate::format::narrow`]).
     macro_rules! narrow_for {
-        ($x:ident, $feat:literal) => {
+        ($x:ident, $feat:literal, $rtifeat:literal) => {
             pub(in crate::simd) mod $x {
                 use super::super::isa::$x;
                 use super::*;
@@ -2571,7 +2623,7 @@ mod kernels {
                 }
 
                 /// The `eEmM` RTI kernel on lanes `0..full`.
-                #[target_feature(enable = $feat)]
+                #[target_feature(enable = $rtifeat)]
                 pub fn rti_soft(
                     rti: &Rti<Ieee<Soft>>,
                     rays: &RaysSoa<u64>,
@@ -2748,8 +2800,9 @@ mod kernels {
     bf16_for!(b8, v8, "avx2");
     bf16_for!(b16, v16, "avx512f,avx2");
 
-    narrow_for!(v4d, "avx2,fma");
-    narrow_for!(v8d, "avx512f,avx2");
+    narrow_for!(v4d, "avx2,fma", "avx2,fma");
+    // the RTI kernel's range filter uses AVX-512DQ's `vrangepd` ([`isa::v8d::fast_ok`])
+    narrow_for!(v8d, "avx512f,avx2", "avx512f,avx512dq,avx2");
 }
 
 #[cfg(all(test, target_arch = "x86_64"))]
@@ -2757,6 +2810,71 @@ mod tests {
     use super::isa::{v4d, v8d};
     use crate::format::{Ieee, Soft};
     use crate::Format;
+
+    /// The range filter of both binary64-lane ISAs passes a vector exactly when, on every lane,
+    /// every one of the twelve values is ±0 or a magnitude in [`fast_lo`, `fast_hi`] (the
+    /// predicate of `datapath::format::narrow`, written here per value): NaNs, infinities,
+    /// zeros, the limits and their neighbours, one odd value in one lane among ordinary ones.
+    #[test]
+    fn the_range_filter_is_the_documented_predicate() {
+        use crate::rng::SplitMix64;
+        use std::arch::is_x86_feature_detected as has;
+        for name in ["e8m16", "e10m24", "e8m7", "e6m9"] {
+            let crate::AnyFormat::Soft(f) = name.parse::<crate::AnyFormat>().unwrap() else { unreachable!() };
+            let n = super::narrow_of(&f).unwrap();
+            let (lo, hi) = (n.fast_lo, n.fast_hi);
+            let odd = [
+                f64::NAN,
+                -f64::NAN,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                0.0,
+                -0.0,
+                lo,
+                -lo,
+                hi,
+                -hi,
+                lo * (1.0 - f64::EPSILON / 2.0),
+                -lo * (1.0 - f64::EPSILON / 2.0),
+                hi * (1.0 + f64::EPSILON),
+                -hi * (1.0 + f64::EPSILON),
+                lo / 2.0,
+                hi * 2.0,
+                f64::MIN_POSITIVE,
+                f64::MAX,
+            ];
+            let ordinary = (lo * hi).sqrt();
+            let pass = |x: f64| !x.is_nan() && x.abs() <= hi && (x == 0.0 || x.abs() >= lo);
+            let mut r = SplitMix64::new(0xf11);
+            for round in 0..4000 {
+                // every value ordinary, then one to three odd values at random places
+                let mut v = [[ordinary; 8]; 12];
+                for _ in 0..round % 4 {
+                    v[r.below(12) as usize][r.below(8) as usize] = odd[r.below(odd.len() as u64) as usize];
+                }
+                let want = v.iter().flatten().all(|&x| pass(x));
+                if has!("avx2") && has!("fma") {
+                    for half in 0..2 {
+                        let w: [std::arch::x86_64::__m256d; 12] = std::array::from_fn(|k| {
+                            let l = &v[k][4 * half..4 * half + 4];
+                            // SAFETY: the features were detected.
+                            unsafe { std::mem::transmute::<[f64; 4], _>([l[0], l[1], l[2], l[3]]) }
+                        });
+                        let want = v.iter().all(|l| l[4 * half..4 * half + 4].iter().all(|&x| pass(x)));
+                        // SAFETY: the features were detected.
+                        assert_eq!(unsafe { v4d::fast_ok(&w, &n) }, want, "{name} v4d {v:?}");
+                    }
+                }
+                if has!("avx512f") && has!("avx512dq") {
+                    // SAFETY: the features were detected.
+                    let w: [std::arch::x86_64::__m512d; 12] =
+                        std::array::from_fn(|k| unsafe { std::mem::transmute::<[f64; 8], _>(v[k]) });
+                    // SAFETY: the features were detected.
+                    assert_eq!(unsafe { v8d::fast_ok(&w, &n) }, want, "{name} v8d {v:?}");
+                }
+            }
+        }
+    }
 
     /// The lanes' grid step equals the model's `next_up` on every encoding of small formats
     /// (subnormals, ±0, ±max, ±∞ dense), on every binary64-lane ISA here. (Under FTZ the step

@@ -573,7 +573,7 @@ where
             det_threshold: f.to_f64(rti.det_thr),
         },
         faces: crate::judge::faces(&rti),
-        level: golden::block::best_level(),
+        level: crate::golden_level(),
         name: f.name(),
         rti: rti.clone(),
     };
