@@ -1,0 +1,395 @@
+//! raypipe's models behind a C ABI: a live reference model that C programs, SystemVerilog
+//! testbenches (DPI-C) and VHDL testbenches (GHDL's VHPIDIRECT) call while they run.
+//!
+//! A unit handle ([`rp_unit_new`]) names a unit (`rti`, `slab`, `op`), a format and options
+//! with the CLI's own strings. Every call evaluates rows laid out as the vector files' rows
+//! (docs/vectors.md): an input row is a `*_inputs.hex` row without its class column, an output
+//! row a `*_expected.hex` row, a stage row a `*_stages.hex` row; each value is the format's
+//! encoding in the low bits of a `uint64_t` (flags 0 or 1). The bits are those of the models
+//! the vector sets are written from.
+//!
+//! Errors: every function returns `RP_OK` (0) or an error code, and [`rp_last_error`] says
+//! what went wrong in words; no call panics across the boundary (every entry catches an
+//! unwinding panic and reports `RP_ERR_INTERNAL`), none aborts on bad input.
+
+use std::cell::RefCell;
+use std::ffi::{c_char, CStr, CString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+pub mod unit;
+
+/// The call succeeded.
+pub const RP_OK: i32 = 0;
+/// A bad argument: an unknown unit, format or option, an encoding wider than the format, an
+/// op code out of range.
+pub const RP_ERR_ARGUMENT: i32 = 1;
+/// A null pointer where one is required.
+pub const RP_ERR_NULL: i32 = 2;
+/// A pointer not aligned to its type (8 bytes for `uint64_t`).
+pub const RP_ERR_ALIGN: i32 = 3;
+/// An array length that does not fit the unit (too few values, or not whole rows).
+pub const RP_ERR_LENGTH: i32 = 4;
+/// The call does not fit the handle's unit (e.g. `rp_rti` on a slab handle).
+pub const RP_ERR_UNIT: i32 = 5;
+/// An internal error (a bug in raypipe) caught at the boundary; the message says where.
+pub const RP_ERR_INTERNAL: i32 = 6;
+
+/// A unit handle: one model in one format with its options (opaque; immutable, so it may be
+/// shared by threads).
+pub struct RpUnit(unit::Unit);
+
+thread_local! {
+    /// This thread's last error message.
+    static LAST: RefCell<CString> = RefCell::new(CString::default());
+}
+
+struct Fail(i32, String);
+
+fn set_last(msg: &str) {
+    let c = CString::new(msg.replace('\0', " ")).unwrap_or_default();
+    LAST.with(|l| *l.borrow_mut() = c);
+}
+
+/// Runs `f`, turning its error or a panic into a code and this thread's message.
+fn guard(f: impl FnOnce() -> Result<(), Fail>) -> i32 {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(Ok(())) => {
+            set_last("");
+            RP_OK
+        }
+        Ok(Err(Fail(code, msg))) => {
+            set_last(&msg);
+            code
+        }
+        Err(p) => {
+            let what = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "a panic".into());
+            set_last(&format!("internal error: {what}"));
+            RP_ERR_INTERNAL
+        }
+    }
+}
+
+fn arg(msg: String) -> Fail {
+    Fail(RP_ERR_ARGUMENT, msg)
+}
+
+/// `p` as a string, or the error naming `what`.
+///
+/// # Safety
+/// `p` is null or a NUL-terminated string.
+unsafe fn text<'a>(p: *const c_char, what: &str) -> Result<&'a str, Fail> {
+    if p.is_null() {
+        return Err(Fail(RP_ERR_NULL, format!("{what} is a null pointer")));
+    }
+    // SAFETY: non-null and NUL-terminated (the caller's promise)
+    unsafe { CStr::from_ptr(p) }.to_str().map_err(|_| arg(format!("{what} is not UTF-8")))
+}
+
+/// The handle behind `u`.
+///
+/// # Safety
+/// `u` is null or a handle from [`rp_unit_new`] not yet freed.
+unsafe fn handle<'a>(u: *const RpUnit) -> Result<&'a unit::Unit, Fail> {
+    if u.is_null() {
+        return Err(Fail(RP_ERR_NULL, "the unit handle is a null pointer".into()));
+    }
+    // SAFETY: a live handle (the caller's promise)
+    Ok(unsafe { &(*u).0 })
+}
+
+/// `n` values at `p`, checked for null and alignment.
+///
+/// # Safety
+/// `p` is null or points to `n` readable `uint64_t`.
+unsafe fn slice<'a>(p: *const u64, n: usize, what: &str) -> Result<&'a [u64], Fail> {
+    if p.is_null() {
+        return Err(Fail(RP_ERR_NULL, format!("{what} is a null pointer")));
+    }
+    if !(p as usize).is_multiple_of(std::mem::align_of::<u64>()) {
+        return Err(Fail(RP_ERR_ALIGN, format!("{what} is not aligned to 8 bytes")));
+    }
+    // SAFETY: non-null, aligned, n values (the caller's promise)
+    Ok(unsafe { std::slice::from_raw_parts(p, n) })
+}
+
+/// [`slice`] for writing.
+///
+/// # Safety
+/// `p` is null or points to `n` writable `uint64_t` not otherwise borrowed.
+unsafe fn slice_mut<'a>(p: *mut u64, n: usize, what: &str) -> Result<&'a mut [u64], Fail> {
+    if p.is_null() {
+        return Err(Fail(RP_ERR_NULL, format!("{what} is a null pointer")));
+    }
+    if !(p as usize).is_multiple_of(std::mem::align_of::<u64>()) {
+        return Err(Fail(RP_ERR_ALIGN, format!("{what} is not aligned to 8 bytes")));
+    }
+    // SAFETY: non-null, aligned, n values, exclusive (the caller's promise)
+    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
+}
+
+/// raypipe's version, a NUL-terminated string (static).
+#[no_mangle]
+pub extern "C" fn rp_version() -> *const c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}
+
+/// This thread's last error message ("" after a call that succeeded), NUL-terminated; valid
+/// until this thread's next raypipe call.
+#[no_mangle]
+pub extern "C" fn rp_last_error() -> *const c_char {
+    LAST.with(|l| l.borrow().as_ptr())
+}
+
+/// Creates a unit handle into `*out`: `unit` is `rti`, `slab` or `op`; `format` a format name
+/// as the CLI takes it (`f32`, `fp16:ftz`, `e8m16`, `q8.24:divide`, …); `options` the unit's
+/// CLI flags separated by spaces (rti: `--cull`, `--det-threshold X`, `--tie first|last`;
+/// slab: `--variant plain|conservative|directed|take-on-false|embree`), or null for none.
+/// Free it with [`rp_unit_free`].
+///
+/// # Safety
+/// `unit` and `format` are NUL-terminated strings, `options` one or null, `out` a writable
+/// pointer (each may be null: that is an error code, not a crash).
+#[no_mangle]
+pub unsafe extern "C" fn rp_unit_new(
+    unit: *const c_char,
+    format: *const c_char,
+    options: *const c_char,
+    out: *mut *mut RpUnit,
+) -> i32 {
+    guard(|| {
+        if out.is_null() {
+            return Err(Fail(RP_ERR_NULL, "out is a null pointer".into()));
+        }
+        // SAFETY: the caller's promise (null is checked)
+        let (u, f) = unsafe { (text(unit, "unit")?, text(format, "format")?) };
+        let o = if options.is_null() { "" } else { unsafe { text(options, "options")? } };
+        let h = unit::Unit::new(u, f, o).map_err(arg)?;
+        // SAFETY: out is non-null and writable (the caller's promise)
+        unsafe { *out = Box::into_raw(Box::new(RpUnit(h))) };
+        Ok(())
+    })
+}
+
+/// Frees a handle from [`rp_unit_new`] (null: nothing happens).
+///
+/// # Safety
+/// `u` is null or a handle not yet freed; it is not used afterwards.
+#[no_mangle]
+pub unsafe extern "C" fn rp_unit_free(u: *mut RpUnit) {
+    if !u.is_null() {
+        // SAFETY: a handle from rp_unit_new (the caller's promise)
+        drop(unsafe { Box::from_raw(u) });
+    }
+}
+
+/// Values in one input row of the unit (rti 17, slab 14, op 3); 0 for a null handle.
+///
+/// # Safety
+/// `u` is null or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn rp_unit_inputs(u: *const RpUnit) -> usize {
+    unsafe { handle(u) }.map_or(0, |h| h.kind.inputs())
+}
+
+/// Values in one output row of the unit (rti 5: valid, hit, t, u, v; slab 3: hit, t_near,
+/// t_far; op 2: result, cmp); 0 for a null handle.
+///
+/// # Safety
+/// `u` is null or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn rp_unit_outputs(u: *const RpUnit) -> usize {
+    unsafe { handle(u) }.map_or(0, |h| h.kind.outputs())
+}
+
+/// Stage signals in one stage row of the unit (0 for op, for the directed slab variant, whose
+/// signal set depends on the data, and for a null handle).
+///
+/// # Safety
+/// `u` is null or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn rp_unit_stages(u: *const RpUnit) -> usize {
+    unsafe { handle(u) }.map_or(0, |h| h.stage_names.len())
+}
+
+/// The name of stage signal `i` (as the manifest names it), NUL-terminated and owned by the
+/// handle; null when `i` is out of range or the handle is null.
+///
+/// # Safety
+/// `u` is null or a live handle; the string lives as long as the handle.
+#[no_mangle]
+pub unsafe extern "C" fn rp_unit_stage_name(u: *const RpUnit, i: usize) -> *const c_char {
+    match unsafe { handle(u) } {
+        Ok(h) => h.stage_cnames.get(i).map_or(std::ptr::null(), |c| c.as_ptr()),
+        Err(_) => std::ptr::null(),
+    }
+}
+
+/// Bits of one encoding of the handle's format (0 for a null handle).
+///
+/// # Safety
+/// `u` is null or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn rp_unit_width(u: *const RpUnit) -> u32 {
+    unsafe { handle(u) }.map_or(0, |h| h.width)
+}
+
+/// One test: `inputs` (`n_inputs` = [`rp_unit_inputs`] values) → `outputs` (`n_outputs` ≥
+/// [`rp_unit_outputs`]); when `stages` is not null, every stage signal into it (`n_stages` ≥
+/// [`rp_unit_stages`]).
+///
+/// # Safety
+/// Each pointer is null or points to as many `uint64_t` as its length says (`outputs` and
+/// `stages` writable, none overlapping another).
+#[no_mangle]
+pub unsafe extern "C" fn rp_eval(
+    u: *const RpUnit,
+    inputs: *const u64,
+    n_inputs: usize,
+    outputs: *mut u64,
+    n_outputs: usize,
+    stages: *mut u64,
+    n_stages: usize,
+) -> i32 {
+    guard(|| unsafe { eval(u, None, inputs, n_inputs, outputs, n_outputs, stages, n_stages) })
+}
+
+/// The shared body of the one-test calls (`want`: the unit the call is for).
+///
+/// # Safety
+/// As [`rp_eval`].
+#[allow(clippy::too_many_arguments)]
+unsafe fn eval(
+    u: *const RpUnit,
+    want: Option<unit::Kind>,
+    inputs: *const u64,
+    n_inputs: usize,
+    outputs: *mut u64,
+    n_outputs: usize,
+    stages: *mut u64,
+    n_stages: usize,
+) -> Result<(), Fail> {
+    let h = unsafe { handle(u)? };
+    if let Some(k) = want {
+        if k != h.kind {
+            return Err(Fail(RP_ERR_UNIT, format!("a {:?} call on a {:?} unit", k, h.kind)));
+        }
+    }
+    let (ni, no, ns) = (h.kind.inputs(), h.kind.outputs(), h.stage_names.len());
+    if n_inputs != ni {
+        return Err(Fail(RP_ERR_LENGTH, format!("{n_inputs} inputs for a {:?} unit, which takes {ni}", h.kind)));
+    }
+    if n_outputs < no {
+        return Err(Fail(RP_ERR_LENGTH, format!("room for {n_outputs} outputs, the {:?} unit gives {no}", h.kind)));
+    }
+    if !stages.is_null() && n_stages < ns {
+        return Err(Fail(RP_ERR_LENGTH, format!("room for {n_stages} stage signals, the unit has {ns}")));
+    }
+    let row = unsafe { slice(inputs, ni, "inputs")? };
+    let out = unsafe { slice_mut(outputs, no, "outputs")? };
+    if !stages.is_null() && !h.has_stages {
+        return Err(Fail(
+            RP_ERR_UNIT,
+            "the directed slab variant's signal set depends on the data: no stage signals (pass a null stages pointer)"
+                .into(),
+        ));
+    }
+    if stages.is_null() {
+        return h.eval(row, out, None).map_err(arg);
+    }
+    let st = unsafe { slice_mut(stages, ns, "stages")? };
+    let mut v = Vec::with_capacity(ns);
+    h.eval(row, out, Some(&mut v)).map_err(arg)?;
+    if v.len() != ns {
+        return Err(Fail(RP_ERR_INTERNAL, format!("internal error: {} stage signals, {ns} named", v.len())));
+    }
+    st.copy_from_slice(&v);
+    Ok(())
+}
+
+/// One RTI test ([`rp_eval`] on an rti handle): inputs ox oy oz dx dy dz tmin tmax v0x v0y
+/// v0z v1x v1y v1z v2x v2y v2z (17), outputs valid hit t u v (5), stages optional.
+///
+/// # Safety
+/// As [`rp_eval`].
+#[no_mangle]
+pub unsafe extern "C" fn rp_rti(u: *const RpUnit, inputs: *const u64, outputs: *mut u64, stages: *mut u64) -> i32 {
+    guard(|| unsafe { eval(u, Some(unit::Kind::Rti), inputs, 17, outputs, 5, stages, usize::MAX) })
+}
+
+/// One slab test ([`rp_eval`] on a slab handle, any variant): inputs ox oy oz dx dy dz tmin
+/// tmax minx miny minz maxx maxy maxz (14), outputs hit t_near t_far (3), stages optional.
+///
+/// # Safety
+/// As [`rp_eval`].
+#[no_mangle]
+pub unsafe extern "C" fn rp_slab(u: *const RpUnit, inputs: *const u64, outputs: *mut u64, stages: *mut u64) -> i32 {
+    guard(|| unsafe { eval(u, Some(unit::Kind::Slab), inputs, 14, outputs, 3, stages, usize::MAX) })
+}
+
+/// One operation ([`rp_eval`] on an op handle): `op` 0 add, 1 sub, 2 mul, 3 div (the format's
+/// division mode), 4 lt, 5 le on encodings `a`, `b`; `*result` the result's encoding (0 for
+/// a comparison), `*cmp` the comparison's bit (0 for arithmetic).
+///
+/// # Safety
+/// `u` null or a live op handle; `result` and `cmp` null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn rp_op(u: *const RpUnit, op: u64, a: u64, b: u64, result: *mut u64, cmp: *mut u64) -> i32 {
+    guard(|| {
+        if result.is_null() || cmp.is_null() {
+            return Err(Fail(RP_ERR_NULL, "result or cmp is a null pointer".into()));
+        }
+        let mut out = [0u64; 2];
+        unsafe { eval(u, Some(unit::Kind::Op), [op, a, b].as_ptr(), 3, out.as_mut_ptr(), 2, std::ptr::null_mut(), 0)? };
+        // SAFETY: non-null and writable (the caller's promise)
+        unsafe {
+            *result = out[0];
+            *cmp = out[1];
+        }
+        Ok(())
+    })
+}
+
+/// `count` tests at once: `inputs` holds `count` input rows, `outputs` room for `count` output
+/// rows (row-major, `n_inputs` = count × [`rp_unit_inputs`], `n_outputs` ≥ count ×
+/// [`rp_unit_outputs`]), on the SIMD kernels where the format has them (the same bits as
+/// [`rp_eval`]); every row is checked before any is evaluated.
+///
+/// # Safety
+/// `inputs` points to `n_inputs` values, `outputs` to `n_outputs` writable ones (or null).
+#[no_mangle]
+pub unsafe extern "C" fn rp_eval_batch(
+    u: *const RpUnit,
+    count: usize,
+    inputs: *const u64,
+    n_inputs: usize,
+    outputs: *mut u64,
+    n_outputs: usize,
+) -> i32 {
+    guard(|| {
+        let h = unsafe { handle(u)? };
+        let (ni, no) = (h.kind.inputs(), h.kind.outputs());
+        let (want_in, want_out) = match (count.checked_mul(ni), count.checked_mul(no)) {
+            (Some(a), Some(b)) => (a, b),
+            _ => return Err(Fail(RP_ERR_LENGTH, format!("count {count} is too large"))),
+        };
+        if n_inputs != want_in || n_outputs < want_out {
+            return Err(Fail(
+                RP_ERR_LENGTH,
+                format!(
+                    "{count} rows of a {:?} unit take {want_in} inputs and {want_out} outputs; got {n_inputs} and room for {n_outputs}",
+                    h.kind
+                ),
+            ));
+        }
+        if count == 0 {
+            return Ok(());
+        }
+        let input = unsafe { slice(inputs, want_in, "inputs")? };
+        let out = unsafe { slice_mut(outputs, want_out, "outputs")? };
+        h.batch(input, out).map_err(arg)
+    })
+}

@@ -1,0 +1,317 @@
+//! A unit handle: one model (RTI, slab or op unit) in one format with its options, built from
+//! the CLI's strings, evaluated on rows of encodings laid out as the vector files' rows.
+
+use datapath::fault::NoFault;
+use datapath::format::AnyFormat;
+use datapath::rti::{Cull, HitsSoa, RaysSoa, Rti, RtiConfig, TieRule, TrisSoa};
+use datapath::slab::{Aabb, BoxesSoa, Slab, SlabConfig, SlabOutSoa, SlabRaysSoa};
+use datapath::{with_format, Format};
+
+/// Which unit a handle models.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// Ray–triangle intersection: inputs o, d, tmin, tmax, v0, v1, v2 (17); outputs valid,
+    /// hit, t, u, v (5).
+    Rti,
+    /// Ray–box slab test: inputs o, d, tmin, tmax, box min, box max (14); outputs hit, t_near,
+    /// t_far (3).
+    Slab,
+    /// One operation: inputs op code (0 add, 1 sub, 2 mul, 3 div, 4 lt, 5 le), a, b (3);
+    /// outputs result, cmp (2).
+    Op,
+}
+
+impl Kind {
+    /// Encodings in an input row.
+    pub fn inputs(self) -> usize {
+        match self {
+            Kind::Rti => 17,
+            Kind::Slab => 14,
+            Kind::Op => 3,
+        }
+    }
+    /// Values in an output row.
+    pub fn outputs(self) -> usize {
+        match self {
+            Kind::Rti => 5,
+            Kind::Slab => 3,
+            Kind::Op => 2,
+        }
+    }
+}
+
+/// The format-specific part of a unit.
+trait Eval: Send + Sync {
+    /// One row: `out` (the unit's outputs) and, when `stages` is given, every stage signal in
+    /// the order of the vector set's stage file (names into `names` when given).
+    fn eval(&self, input: &[u64], out: &mut [u64], stages: Option<&mut Vec<u64>>, names: Option<&mut Vec<String>>);
+    /// `out` rows for `input` rows (row-major), on the SIMD kernels where the format has them.
+    fn batch(&self, input: &[u64], out: &mut [u64]);
+}
+
+struct RtiUnit<F: Format> {
+    rti: Rti<F>,
+}
+
+struct SlabUnit<F: Format> {
+    s: Slab<F>,
+}
+
+struct OpUnit<F: Format> {
+    f: F,
+}
+
+/// Rows per SIMD batch (the columns stay in cache).
+const CHUNK: usize = 1024;
+
+fn copy_rows(out: &mut [u64], rows: [Vec<u64>; 2], stages: Option<&mut Vec<u64>>) {
+    let [o, st] = rows;
+    out.copy_from_slice(&o);
+    if let Some(s) = stages {
+        *s = st;
+    }
+}
+
+impl<F: Format + Send + Sync + 'static> Eval for RtiUnit<F>
+where
+    F::V: 'static,
+{
+    fn eval(&self, input: &[u64], out: &mut [u64], stages: Option<&mut Vec<u64>>, names: Option<&mut Vec<String>>) {
+        let (ray, tri) = vectors::gen::rti_case_of(&self.rti.fmt, input);
+        if let Some(n) = names {
+            let mut rec = datapath::probe::Recorder::new();
+            self.rti.trace(&ray, &tri, &mut rec);
+            *n = rec.signals.iter().map(|(name, _)| name.to_string()).collect();
+        }
+        copy_rows(out, vectors::gen::rti_out_rows(&self.rti, &ray, &tri, &NoFault), stages);
+    }
+    fn batch(&self, input: &[u64], out: &mut [u64]) {
+        let f = &self.rti.fmt;
+        for (rows, outs) in input.chunks(17 * CHUNK).zip(out.chunks_mut(5 * CHUNK)) {
+            let (mut rays, mut tris) = (RaysSoa::default(), TrisSoa::default());
+            for row in rows.chunks_exact(17) {
+                let (ray, tri) = vectors::gen::rti_case_of(f, row);
+                rays.push(&ray);
+                tris.push(&tri);
+            }
+            let mut hits = HitsSoa::with_len(rays.len());
+            datapath::simd::rti_batch(&self.rti, &rays, &tris, &mut hits);
+            for (i, o) in outs.chunks_exact_mut(5).enumerate() {
+                o.copy_from_slice(&[
+                    hits.valid[i] as u64,
+                    hits.hit[i] as u64,
+                    f.to_bits(hits.t[i]),
+                    f.to_bits(hits.u[i]),
+                    f.to_bits(hits.v[i]),
+                ]);
+            }
+        }
+    }
+}
+
+impl<F: Format + Send + Sync + 'static> Eval for SlabUnit<F>
+where
+    F::V: 'static,
+{
+    fn eval(&self, input: &[u64], out: &mut [u64], stages: Option<&mut Vec<u64>>, names: Option<&mut Vec<String>>) {
+        if let Some(n) = names {
+            let f = &self.s.fmt;
+            let v = |i: usize| f.from_bits(input[i]);
+            let mut rec = datapath::probe::Recorder::new();
+            let ray = self.s.prepare_faulty([v(0), v(1), v(2)], [v(3), v(4), v(5)], v(6), v(7), &mut rec, &NoFault);
+            let b = Aabb { min: [v(8), v(9), v(10)], max: [v(11), v(12), v(13)] };
+            self.s.trace(&ray, &b, &mut rec);
+            *n = rec.signals.iter().map(|(name, _)| name.to_string()).collect();
+        }
+        copy_rows(out, vectors::gen::slab_out_rows(&self.s, input, &NoFault), stages);
+    }
+    fn batch(&self, input: &[u64], out: &mut [u64]) {
+        let f = &self.s.fmt;
+        for (rows, outs) in input.chunks(14 * CHUNK).zip(out.chunks_mut(3 * CHUNK)) {
+            let (mut rays, mut boxes) = (SlabRaysSoa::default(), BoxesSoa::default());
+            for row in rows.chunks_exact(14) {
+                let v = |i: usize| f.from_bits(row[i]);
+                let ray = self.s.prepare_faulty(
+                    [v(0), v(1), v(2)],
+                    [v(3), v(4), v(5)],
+                    v(6),
+                    v(7),
+                    &mut datapath::probe::NoProbe,
+                    &NoFault,
+                );
+                rays.push(&ray);
+                boxes.push(&Aabb { min: [v(8), v(9), v(10)], max: [v(11), v(12), v(13)] });
+            }
+            let mut res = SlabOutSoa::with_len(rows.len() / 14);
+            datapath::simd::slab_batch(&self.s, &rays, &boxes, &mut res);
+            for (i, o) in outs.chunks_exact_mut(3).enumerate() {
+                o.copy_from_slice(&[res.hit[i] as u64, f.to_bits(res.t_near[i]), f.to_bits(res.t_far[i])]);
+            }
+        }
+    }
+}
+
+impl<F: Format + Send + Sync + 'static> Eval for OpUnit<F> {
+    fn eval(&self, input: &[u64], out: &mut [u64], stages: Option<&mut Vec<u64>>, names: Option<&mut Vec<String>>) {
+        if let Some(n) = names {
+            n.clear();
+        }
+        copy_rows(out, vectors::gen::op_out_rows(&self.f, input, &NoFault), stages);
+    }
+    fn batch(&self, input: &[u64], out: &mut [u64]) {
+        for (row, o) in input.chunks_exact(3).zip(out.chunks_exact_mut(2)) {
+            self.eval(row, o, None, None);
+        }
+    }
+}
+
+/// One model in one format with its options (immutable: share it across threads freely).
+pub struct Unit {
+    /// The unit.
+    pub kind: Kind,
+    /// The format's canonical name.
+    pub format: String,
+    /// Bits of one encoding.
+    pub width: u32,
+    /// The stage signals' names, in the order of the vector set's stage file (none for op).
+    pub stage_names: Vec<String>,
+    /// The same names, NUL-terminated (for C).
+    pub stage_cnames: Vec<std::ffi::CString>,
+    /// False for the directed slab variant, whose signal set depends on the data (no stage
+    /// file either): its stage signals are not offered.
+    pub has_stages: bool,
+    eval: Box<dyn Eval>,
+}
+
+/// The options a unit takes, as the CLI spells them.
+#[derive(Default)]
+struct Options {
+    cull: bool,
+    det_threshold: f64,
+    tie: Option<TieRule>,
+    variant: Option<String>,
+}
+
+fn parse_options(s: &str) -> Result<Options, String> {
+    let mut o = Options::default();
+    let mut it = s.split_whitespace();
+    while let Some(w) = it.next() {
+        let mut value = |name: &str| it.next().ok_or_else(|| format!("option {name} needs a value"));
+        match w {
+            "--cull" => o.cull = true,
+            "--det-threshold" => {
+                let v = value(w)?;
+                o.det_threshold = v.parse().map_err(|_| format!("--det-threshold: not a number: {v}"))?;
+                if !(o.det_threshold >= 0.0 && o.det_threshold.is_finite()) {
+                    return Err(format!("--det-threshold must be a finite number >= 0, got {v}"));
+                }
+            }
+            "--tie" => {
+                o.tie = Some(match value(w)? {
+                    "first" => TieRule::First,
+                    "last" => TieRule::Last,
+                    v => return Err(format!("--tie: first or last, got {v}")),
+                })
+            }
+            "--variant" => o.variant = Some(value(w)?.to_string()),
+            _ => {
+                return Err(format!(
+                    "unknown option {w} (the unit options are --cull, --det-threshold X, --tie first|last, --variant V)"
+                ))
+            }
+        }
+    }
+    Ok(o)
+}
+
+impl Unit {
+    /// The unit named `unit` (rti, slab or op) in format `format` (e.g. `f32`, `e8m16:ftz`,
+    /// `q8.24:divide`) with `options` (the CLI's flags: `--cull`, `--det-threshold X`,
+    /// `--tie first|last` for rti; `--variant V` for slab).
+    pub fn new(unit: &str, format: &str, options: &str) -> Result<Self, String> {
+        let kind = match unit {
+            "rti" => Kind::Rti,
+            "slab" => Kind::Slab,
+            "op" => Kind::Op,
+            _ => return Err(format!("unknown unit {unit:?}: rti, slab or op")),
+        };
+        let any: AnyFormat = format.parse().map_err(|e| format!("format {format:?}: {e}"))?;
+        let o = parse_options(options)?;
+        let rti_only = o.cull || o.det_threshold != 0.0 || o.tie.is_some();
+        if kind != Kind::Rti && rti_only {
+            return Err("--cull, --det-threshold and --tie are options of the rti unit".into());
+        }
+        if kind != Kind::Slab && o.variant.is_some() {
+            return Err("--variant is an option of the slab unit".into());
+        }
+        let (name, width) = with_format!(&any, |f| (f.name(), f.width()));
+        let eval: Box<dyn Eval> = match kind {
+            Kind::Rti => {
+                let cfg = RtiConfig {
+                    cull: if o.cull { Cull::Backface } else { Cull::TwoSided },
+                    det_threshold: o.det_threshold,
+                    tie: o.tie.unwrap_or(TieRule::First),
+                };
+                with_format!(any, |f| Box::new(RtiUnit { rti: Rti::new(f, cfg) }))
+            }
+            Kind::Slab => {
+                let v = o.variant.as_deref().unwrap_or("plain");
+                with_format!(any, |f| {
+                    let cfg = SlabConfig::named_for(v, &f)?;
+                    Box::new(SlabUnit { s: Slab::new(f, cfg) })
+                })
+            }
+            Kind::Op => with_format!(any, |f| Box::new(OpUnit { f })),
+        };
+        let has_stages = kind != Kind::Slab || o.variant.as_deref() != Some("directed");
+        let mut u =
+            Unit { kind, format: name, width, stage_names: Vec::new(), stage_cnames: Vec::new(), has_stages, eval };
+        let (zero, mut out, mut names) = (vec![0u64; kind.inputs()], vec![0u64; kind.outputs()], Vec::new());
+        if has_stages {
+            u.eval.eval(&zero, &mut out, None, Some(&mut names));
+        }
+        u.stage_cnames = names.iter().map(|n| std::ffi::CString::new(n.as_str()).unwrap_or_default()).collect();
+        u.stage_names = names;
+        Ok(u)
+    }
+
+    /// Checks one input row: its length, every encoding within the format's width, an op
+    /// code 0..=5.
+    pub fn check_row(&self, row: &[u64]) -> Result<(), String> {
+        if row.len() != self.kind.inputs() {
+            return Err(format!(
+                "an input row of the {:?} unit has {} values, not {}",
+                self.kind,
+                self.kind.inputs(),
+                row.len()
+            ));
+        }
+        for (i, &b) in row.iter().enumerate() {
+            if self.kind == Kind::Op && i == 0 {
+                if b > 5 {
+                    return Err(format!("op code {b}: 0 add, 1 sub, 2 mul, 3 div, 4 lt, 5 le"));
+                }
+            } else if self.width < 64 && b >> self.width != 0 {
+                return Err(format!("input {i} ({b:#x}) has bits above the format's {} bits", self.width));
+            }
+        }
+        Ok(())
+    }
+
+    /// One row's outputs and, when `stages` is given, its stage signals (the row is checked).
+    pub fn eval(&self, row: &[u64], out: &mut [u64], stages: Option<&mut Vec<u64>>) -> Result<(), String> {
+        self.check_row(row)?;
+        self.eval.eval(row, out, stages, None);
+        Ok(())
+    }
+
+    /// The outputs of `n` rows (`input`: n × inputs, `out`: n × outputs, row-major), every row
+    /// checked first.
+    pub fn batch(&self, input: &[u64], out: &mut [u64]) -> Result<(), String> {
+        for row in input.chunks(self.kind.inputs()) {
+            self.check_row(row)?;
+        }
+        self.eval.batch(input, out);
+        Ok(())
+    }
+}
