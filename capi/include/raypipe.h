@@ -95,6 +95,34 @@ const char *rp_unit_stage_name(const struct RpUnit *u, size_t i);
 // `u` is null or a live handle.
 uint32_t rp_unit_width(const struct RpUnit *u);
 
+// The bits of output `i` of a row (1 for a flag, the format's width for a value); 0 when `i`
+// is out of range or the handle is null.
+//
+// # Safety
+// `u` is null or a live handle.
+uint32_t rp_unit_output_width(const struct RpUnit *u, size_t i);
+
+// The bits of stage signal `i` (1 for a flag, the format's width for a register); 0 when `i`
+// is out of range or the handle is null.
+//
+// # Safety
+// `u` is null or a live handle.
+uint32_t rp_unit_stage_width(const struct RpUnit *u, size_t i);
+
+// `*bits` = the format's encoding of `x`, rounded as the format's conversion from binary64
+// rounds (the rounding of `raypipe vectors`' inputs: to nearest, ties to even, for floats).
+//
+// # Safety
+// `u` null or a live handle, `bits` null or writable.
+int32_t rp_encode(const struct RpUnit *u, double x, uint64_t *bits);
+
+// `*x` = the value of encoding `bits` in binary64 (exact for every format of at most 53
+// significant bits; NaN for a NaN encoding).
+//
+// # Safety
+// `u` null or a live handle, `x` null or writable.
+int32_t rp_decode(const struct RpUnit *u, uint64_t bits, double *x);
+
 // One test: `inputs` (`n_inputs` = [`rp_unit_inputs`] values) → `outputs` (`n_outputs` ≥
 // [`rp_unit_outputs`]); when `stages` is not null, every stage signal into it (`n_stages` ≥
 // [`rp_unit_stages`]).

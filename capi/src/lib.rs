@@ -237,6 +237,65 @@ pub unsafe extern "C" fn rp_unit_width(u: *const RpUnit) -> u32 {
     unsafe { handle(u) }.map_or(0, |h| h.width)
 }
 
+/// The bits of output `i` of a row (1 for a flag, the format's width for a value); 0 when `i`
+/// is out of range or the handle is null.
+///
+/// # Safety
+/// `u` is null or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn rp_unit_output_width(u: *const RpUnit, i: usize) -> u32 {
+    unsafe { handle(u) }.ok().and_then(|h| h.output_width(i)).unwrap_or(0)
+}
+
+/// The bits of stage signal `i` (1 for a flag, the format's width for a register); 0 when `i`
+/// is out of range or the handle is null.
+///
+/// # Safety
+/// `u` is null or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn rp_unit_stage_width(u: *const RpUnit, i: usize) -> u32 {
+    unsafe { handle(u) }.ok().and_then(|h| h.stage_widths.get(i).copied()).unwrap_or(0)
+}
+
+/// `*bits` = the format's encoding of `x`, rounded as the format's conversion from binary64
+/// rounds (the rounding of `raypipe vectors`' inputs: to nearest, ties to even, for floats).
+///
+/// # Safety
+/// `u` null or a live handle, `bits` null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn rp_encode(u: *const RpUnit, x: f64, bits: *mut u64) -> i32 {
+    guard(|| {
+        let h = unsafe { handle(u)? };
+        if bits.is_null() {
+            return Err(Fail(RP_ERR_NULL, "bits is a null pointer".into()));
+        }
+        // SAFETY: non-null and writable (the caller's promise)
+        unsafe { *bits = h.encode(x) };
+        Ok(())
+    })
+}
+
+/// `*x` = the value of encoding `bits` in binary64 (exact for every format of at most 53
+/// significant bits; NaN for a NaN encoding).
+///
+/// # Safety
+/// `u` null or a live handle, `x` null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn rp_decode(u: *const RpUnit, bits: u64, x: *mut f64) -> i32 {
+    guard(|| {
+        let h = unsafe { handle(u)? };
+        if x.is_null() {
+            return Err(Fail(RP_ERR_NULL, "x is a null pointer".into()));
+        }
+        if h.width < 64 && bits >> h.width != 0 {
+            return Err(arg(format!("{bits:#x} has bits above the format's {} bits", h.width)));
+        }
+        // SAFETY: non-null and writable (the caller's promise)
+        unsafe { *x = h.decode(bits) };
+        Ok(())
+    })
+}
+
 /// One test: `inputs` (`n_inputs` = [`rp_unit_inputs`] values) → `outputs` (`n_outputs` ≥
 /// [`rp_unit_outputs`]); when `stages` is not null, every stage signal into it (`n_stages` ≥
 /// [`rp_unit_stages`]).

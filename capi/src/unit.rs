@@ -43,8 +43,19 @@ impl Kind {
 /// The format-specific part of a unit.
 trait Eval: Send + Sync {
     /// One row: `out` (the unit's outputs) and, when `stages` is given, every stage signal in
-    /// the order of the vector set's stage file (names into `names` when given).
-    fn eval(&self, input: &[u64], out: &mut [u64], stages: Option<&mut Vec<u64>>, names: Option<&mut Vec<String>>);
+    /// the order of the vector set's stage file (names and bit widths into `names` when given:
+    /// a flag is 1 bit, a register the format's width).
+    fn eval(
+        &self,
+        input: &[u64],
+        out: &mut [u64],
+        stages: Option<&mut Vec<u64>>,
+        names: Option<&mut Vec<(String, u32)>>,
+    );
+    /// The format's encoding of `x` (rounded as the format's conversion rounds).
+    fn encode(&self, x: f64) -> u64;
+    /// The value of an encoding.
+    fn decode(&self, bits: u64) -> f64;
     /// `out` rows for `input` rows (row-major), on the SIMD kernels where the format has them.
     fn batch(&self, input: &[u64], out: &mut [u64]);
 }
@@ -64,6 +75,15 @@ struct OpUnit<F: Format> {
 /// Rows per SIMD batch (the columns stay in cache).
 const CHUNK: usize = 1024;
 
+/// The names and widths of a recorder's signals.
+fn names_of<V>(rec: &datapath::probe::Recorder<V>, width: u32) -> Vec<(String, u32)> {
+    use datapath::probe::Signal;
+    rec.signals
+        .iter()
+        .map(|(name, s)| (name.to_string(), if matches!(s, Signal::Flag(_)) { 1 } else { width }))
+        .collect()
+}
+
 fn copy_rows(out: &mut [u64], rows: [Vec<u64>; 2], stages: Option<&mut Vec<u64>>) {
     let [o, st] = rows;
     out.copy_from_slice(&o);
@@ -76,14 +96,26 @@ impl<F: Format + Send + Sync + 'static> Eval for RtiUnit<F>
 where
     F::V: 'static,
 {
-    fn eval(&self, input: &[u64], out: &mut [u64], stages: Option<&mut Vec<u64>>, names: Option<&mut Vec<String>>) {
+    fn eval(
+        &self,
+        input: &[u64],
+        out: &mut [u64],
+        stages: Option<&mut Vec<u64>>,
+        names: Option<&mut Vec<(String, u32)>>,
+    ) {
         let (ray, tri) = vectors::gen::rti_case_of(&self.rti.fmt, input);
         if let Some(n) = names {
             let mut rec = datapath::probe::Recorder::new();
             self.rti.trace(&ray, &tri, &mut rec);
-            *n = rec.signals.iter().map(|(name, _)| name.to_string()).collect();
+            *n = names_of(&rec, self.rti.fmt.width());
         }
         copy_rows(out, vectors::gen::rti_out_rows(&self.rti, &ray, &tri, &NoFault), stages);
+    }
+    fn encode(&self, x: f64) -> u64 {
+        self.rti.fmt.to_bits(self.rti.fmt.from_f64(x))
+    }
+    fn decode(&self, bits: u64) -> f64 {
+        self.rti.fmt.to_f64(self.rti.fmt.from_bits(bits))
     }
     fn batch(&self, input: &[u64], out: &mut [u64]) {
         let f = &self.rti.fmt;
@@ -113,7 +145,13 @@ impl<F: Format + Send + Sync + 'static> Eval for SlabUnit<F>
 where
     F::V: 'static,
 {
-    fn eval(&self, input: &[u64], out: &mut [u64], stages: Option<&mut Vec<u64>>, names: Option<&mut Vec<String>>) {
+    fn eval(
+        &self,
+        input: &[u64],
+        out: &mut [u64],
+        stages: Option<&mut Vec<u64>>,
+        names: Option<&mut Vec<(String, u32)>>,
+    ) {
         if let Some(n) = names {
             let f = &self.s.fmt;
             let v = |i: usize| f.from_bits(input[i]);
@@ -121,9 +159,15 @@ where
             let ray = self.s.prepare_faulty([v(0), v(1), v(2)], [v(3), v(4), v(5)], v(6), v(7), &mut rec, &NoFault);
             let b = Aabb { min: [v(8), v(9), v(10)], max: [v(11), v(12), v(13)] };
             self.s.trace(&ray, &b, &mut rec);
-            *n = rec.signals.iter().map(|(name, _)| name.to_string()).collect();
+            *n = names_of(&rec, f.width());
         }
         copy_rows(out, vectors::gen::slab_out_rows(&self.s, input, &NoFault), stages);
+    }
+    fn encode(&self, x: f64) -> u64 {
+        self.s.fmt.to_bits(self.s.fmt.from_f64(x))
+    }
+    fn decode(&self, bits: u64) -> f64 {
+        self.s.fmt.to_f64(self.s.fmt.from_bits(bits))
     }
     fn batch(&self, input: &[u64], out: &mut [u64]) {
         let f = &self.s.fmt;
@@ -152,11 +196,23 @@ where
 }
 
 impl<F: Format + Send + Sync + 'static> Eval for OpUnit<F> {
-    fn eval(&self, input: &[u64], out: &mut [u64], stages: Option<&mut Vec<u64>>, names: Option<&mut Vec<String>>) {
+    fn eval(
+        &self,
+        input: &[u64],
+        out: &mut [u64],
+        stages: Option<&mut Vec<u64>>,
+        names: Option<&mut Vec<(String, u32)>>,
+    ) {
         if let Some(n) = names {
             n.clear();
         }
         copy_rows(out, vectors::gen::op_out_rows(&self.f, input, &NoFault), stages);
+    }
+    fn encode(&self, x: f64) -> u64 {
+        self.f.to_bits(self.f.from_f64(x))
+    }
+    fn decode(&self, bits: u64) -> f64 {
+        self.f.to_f64(self.f.from_bits(bits))
     }
     fn batch(&self, input: &[u64], out: &mut [u64]) {
         for (row, o) in input.chunks_exact(3).zip(out.chunks_exact_mut(2)) {
@@ -175,6 +231,8 @@ pub struct Unit {
     pub width: u32,
     /// The stage signals' names, in the order of the vector set's stage file (none for op).
     pub stage_names: Vec<String>,
+    /// Each stage signal's bits (1 for a flag, the format's width for a register).
+    pub stage_widths: Vec<u32>,
     /// The same names, NUL-terminated (for C).
     pub stage_cnames: Vec<std::ffi::CString>,
     /// False for the directed slab variant, whose signal set depends on the data (no stage
@@ -264,14 +322,23 @@ impl Unit {
             Kind::Op => with_format!(any, |f| Box::new(OpUnit { f })),
         };
         let has_stages = kind != Kind::Slab || o.variant.as_deref() != Some("directed");
-        let mut u =
-            Unit { kind, format: name, width, stage_names: Vec::new(), stage_cnames: Vec::new(), has_stages, eval };
+        let mut u = Unit {
+            kind,
+            format: name,
+            width,
+            stage_names: Vec::new(),
+            stage_widths: Vec::new(),
+            stage_cnames: Vec::new(),
+            has_stages,
+            eval,
+        };
         let (zero, mut out, mut names) = (vec![0u64; kind.inputs()], vec![0u64; kind.outputs()], Vec::new());
         if has_stages {
             u.eval.eval(&zero, &mut out, None, Some(&mut names));
         }
-        u.stage_cnames = names.iter().map(|n| std::ffi::CString::new(n.as_str()).unwrap_or_default()).collect();
-        u.stage_names = names;
+        u.stage_cnames = names.iter().map(|(n, _)| std::ffi::CString::new(n.as_str()).unwrap_or_default()).collect();
+        u.stage_widths = names.iter().map(|&(_, w)| w).collect();
+        u.stage_names = names.into_iter().map(|(n, _)| n).collect();
         Ok(u)
     }
 
@@ -296,6 +363,27 @@ impl Unit {
             }
         }
         Ok(())
+    }
+
+    /// The bits of output `i` (1 for a flag, the format's width for a value), if in range.
+    pub fn output_width(&self, i: usize) -> Option<u32> {
+        let flags: &[usize] = match self.kind {
+            Kind::Rti => &[0, 1],
+            Kind::Slab => &[0],
+            Kind::Op => &[1],
+        };
+        (i < self.kind.outputs()).then(|| if flags.contains(&i) { 1 } else { self.width })
+    }
+
+    /// The format's encoding of `x`, rounded as the format's conversion from binary64 rounds.
+    pub fn encode(&self, x: f64) -> u64 {
+        self.eval.encode(x)
+    }
+
+    /// The value of encoding `bits` as binary64 (exact for every format of at most 53
+    /// significant bits).
+    pub fn decode(&self, bits: u64) -> f64 {
+        self.eval.decode(bits)
     }
 
     /// One row's outputs and, when `stages` is given, its stage signals (the row is checked).

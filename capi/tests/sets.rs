@@ -57,6 +57,12 @@ fn check(u: *mut RpUnit, req: &Request, what: &str) {
         }
         all_in.extend_from_slice(x);
     }
+    // the output widths are the expected file's fields
+    let file = set.manifest.files.iter().find(|f| f.name.ends_with("_expected.hex")).expect("an expected file");
+    let ow: Vec<u32> = (0..no).map(|i| unsafe { rp_unit_output_width(u, i) }).collect();
+    assert_eq!(ow, file.fields.iter().map(|f| f.width).collect::<Vec<_>>(), "{what}: output widths");
+    // SAFETY: one past the end
+    assert_eq!(unsafe { rp_unit_output_width(u, no) }, 0);
     let n = inputs.len();
     let mut out = vec![0u64; n * no];
     // SAFETY: lengths as passed
@@ -75,6 +81,10 @@ fn check(u: *mut RpUnit, req: &Request, what: &str) {
         let file = m.files.iter().find(|f| f.name.ends_with("_stages.hex")).expect("a stage file");
         let want: Vec<String> = file.fields.iter().map(|f| f.name.clone()).collect();
         assert_eq!(names, want, "{what}: stage names");
+        // and their widths the fields' widths
+        let widths: Vec<u32> = (0..ns).map(|i| unsafe { rp_unit_stage_width(u, i) }).collect();
+        let want_w: Vec<u32> = file.fields.iter().map(|f| f.width).collect();
+        assert_eq!(widths, want_w, "{what}: stage widths");
         // SAFETY: one past the end
         assert!(unsafe { rp_unit_stage_name(u, ns) }.is_null());
     }

@@ -103,6 +103,31 @@ static void op_by_hand(void) {
     rp_unit_free(u);
 }
 
+/* conversions: round to nearest even from binary64, exact back */
+static void encode_decode(void) {
+    RpUnit *a = unit("op", "f32", NULL), *h = unit("op", "fp16", NULL), *q = unit("op", "q16.16", NULL);
+    uint64_t b = 0;
+    double x = 0;
+    CHECK(rp_encode(a, 0.1, &b) == RP_OK && b == 0x3dcccccd, "f32 0.1 = %" PRIx64, b);
+    CHECK(rp_encode(h, 1.0 / 3.0, &b) == RP_OK && b == 0x3555, "fp16 1/3 = %" PRIx64, b);
+    CHECK(rp_encode(h, 65520.0, &b) == RP_OK && b == 0x7c00, "fp16 65520 rounds to inf: %" PRIx64, b);
+    CHECK(rp_encode(q, 1.5, &b) == RP_OK && b == 0x18000, "q16.16 1.5 = %" PRIx64, b);
+    CHECK(rp_decode(h, 0x3c00, &x) == RP_OK && x == 1.0, "fp16 0x3c00 = %g", x);
+    CHECK(rp_decode(h, 0x0001, &x) == RP_OK && x == 0x1p-24, "fp16 least subnormal = %g", x);
+    CHECK(rp_decode(q, 0xffff8000, &x) == RP_OK && x == -0.5, "q16.16 -0.5 = %g", x);
+    CHECK(rp_decode(h, 0x10000, &x) == RP_ERR_ARGUMENT, "17 bits for fp16");
+    CHECK(rp_encode(a, 1.0, NULL) == RP_ERR_NULL, "null bits");
+    RpUnit *r = unit("rti", "f32", NULL);
+    CHECK(rp_unit_output_width(r, 0) == 1 && rp_unit_output_width(r, 2) == 32 && rp_unit_output_width(r, 5) == 0, "output widths");
+    size_t ns = rp_unit_stages(r), bits = 0;
+    for (size_t i = 0; i < ns; i++) bits += rp_unit_stage_width(r, i);
+    CHECK(bits == 1673, "the f32 recip-mul stage row is 1673 bits, got %zu", bits);
+    rp_unit_free(r);
+    rp_unit_free(q);
+    rp_unit_free(h);
+    rp_unit_free(a);
+}
+
 static uint64_t lcg(uint64_t *s) {
     *s = *s * 6364136223846793005ull + 1442695040888963407ull;
     return *s >> 11;
@@ -174,6 +199,7 @@ int main(void) {
     rti_by_hand();
     slab_by_hand();
     op_by_hand();
+    encode_decode();
     const char *fmts[] = {"f32", "fp16", "bf16", "e8m16", "q16.16", "q8.24:divide", "e5m10:ftz"};
     const int widths[] = {32, 16, 16, 25, 32, 32, 16};
     for (int k = 0; k < 7; k++) {
