@@ -124,8 +124,9 @@ int32_t rp_encode(const struct RpUnit *u, double x, uint64_t *bits);
 int32_t rp_decode(const struct RpUnit *u, uint64_t bits, double *x);
 
 // One test: `inputs` (`n_inputs` = [`rp_unit_inputs`] values) → `outputs` (`n_outputs` ≥
-// [`rp_unit_outputs`]); when `stages` is not null, every stage signal into it (`n_stages` ≥
-// [`rp_unit_stages`]).
+// [`rp_unit_outputs`]); when `stages` is not null and `n_stages` is not 0, every stage signal
+// into it (`n_stages` ≥ [`rp_unit_stages`]; a DPI caller, whose array is never null, passes
+// 0 for none).
 //
 // # Safety
 // Each pointer is null or points to as many `uint64_t` as its length says (`outputs` and

@@ -297,8 +297,9 @@ pub unsafe extern "C" fn rp_decode(u: *const RpUnit, bits: u64, x: *mut f64) -> 
 }
 
 /// One test: `inputs` (`n_inputs` = [`rp_unit_inputs`] values) → `outputs` (`n_outputs` ≥
-/// [`rp_unit_outputs`]); when `stages` is not null, every stage signal into it (`n_stages` ≥
-/// [`rp_unit_stages`]).
+/// [`rp_unit_outputs`]); when `stages` is not null and `n_stages` is not 0, every stage signal
+/// into it (`n_stages` ≥ [`rp_unit_stages`]; a DPI caller, whose array is never null, passes
+/// 0 for none).
 ///
 /// # Safety
 /// Each pointer is null or points to as many `uint64_t` as its length says (`outputs` and
@@ -313,6 +314,7 @@ pub unsafe extern "C" fn rp_eval(
     stages: *mut u64,
     n_stages: usize,
 ) -> i32 {
+    let stages = if n_stages == 0 { std::ptr::null_mut() } else { stages };
     guard(|| unsafe { eval(u, None, inputs, n_inputs, outputs, n_outputs, stages, n_stages) })
 }
 

@@ -177,6 +177,7 @@ static void errors(void) {
     CHECK(rp_eval(r, in, 17, out, 4, NULL, 0) == RP_ERR_LENGTH, "room for 4 outputs");
     uint64_t st[4];
     CHECK(rp_eval(r, in, 17, out, 5, st, 4) == RP_ERR_LENGTH, "room for 4 stage signals");
+    CHECK(rp_eval(r, in, 17, out, 5, st, 0) == RP_OK, "n_stages 0: no stage signals asked for");
     CHECK(rp_eval_batch(r, 2, in, 17, out, 10) == RP_ERR_LENGTH, "2 rows in 17 values");
     CHECK(rp_eval_batch(r, SIZE_MAX, in, 17, out, 10) == RP_ERR_LENGTH, "a count that overflows");
     uint64_t raw[18];
