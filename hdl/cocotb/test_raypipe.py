@@ -1,0 +1,171 @@
+"""cocotb testbench: a reference DUT of raypipe's HDL kit (rti or slab) driven with random
+stimulus and scored by raypipe's Python model (`import raypipe`), every output and stage
+signal, with the care rules of the set's manifest. Run by hdl/cocotb/run.py, which sets:
+
+  RAYPIPE_SET      a set of the unit and format (its manifest gives the row layout and care rules)
+  RAYPIPE_OPTIONS  the unit's CLI options      RAYPIPE_N  vectors     RAYPIPE_SEED  the seed
+
+Stimulus per vector: aimed rays (45 %), random geometry (15 %), aimed rays with one to three
+inputs replaced by an edge encoding (30 %: ±0, ±inf, NaNs with random sign and payload,
+subnormals, ±min normal, ±max), ties (10 %: rti dy·e2z exactly halfway between neighbours).
+"""
+
+import json
+import os
+import random
+from collections import deque
+
+import cocotb
+from cocotb.clock import Clock
+from cocotb.triggers import FallingEdge, RisingEdge
+
+import raypipe
+
+
+def fields(manifest, suffix):
+    f = next(f for f in manifest["files"] if f["name"].endswith(suffix))
+    return f["fields"]
+
+
+def pack(values, widths):
+    word = 0
+    for v, w in zip(values, widths):
+        word = (word << w) | (int(v) & ((1 << w) - 1))
+    return word
+
+
+def unpack(word, widths):
+    out = []
+    for w in reversed(widths):
+        out.append(word & ((1 << w) - 1))
+        word >>= w
+    return out[::-1]
+
+
+class Stimulus:
+    def __init__(self, model, manifest, rng):
+        self.m, self.rng = model, rng
+        p = manifest["params"]
+        self.exp, self.man, self.w = int(p["exp"]), int(p["man"]), model.width
+        self.rti = len(model.inputs) == 17
+
+    def edge(self):
+        r, e, m, w = self.rng, self.exp, self.man, self.w
+        s = r.randrange(2) << (w - 1)
+        top = (1 << e) - 1
+        frac = r.getrandbits(m) | 1
+        return s | r.choice([
+            0, top << m, (top << m) | frac, frac, ((top - 1) << m) | ((1 << m) - 1), 1 << m, 1, (1 << m) - 1,
+            (r.randrange(1, top) << m) | r.getrandbits(m),
+        ])
+
+    def vector(self):
+        r = self.rng
+        u = lambda a, b: r.uniform(a, b)
+        mode = r.randrange(100)
+        kind = "aimed" if mode < 45 else "random" if mode < 60 else "edge" if mode < 90 else "tie"
+        o = [u(-2, 2) for _ in range(3)]
+        if self.rti:
+            v = [u(-1, 1) for _ in range(9)]
+            a = u(0, 1)
+            b = u(0, 1 - a)
+            p = [v[i] + a * (v[3 + i] - v[i]) + b * (v[6 + i] - v[i]) for i in range(3)]
+            d = [u(-1, 1) for _ in range(3)] if kind == "random" else [p[i] - o[i] for i in range(3)]
+            x = o + d + [0.0, u(0.5, 4.0)] + v
+            if kind == "tie":
+                k = r.randrange(1, self.man + 1)
+                x[4], x[10], x[16] = 1 + 2.0**-k, 0.0, 1 + 2.0 ** -(self.man + 1 - k)
+        else:
+            c = [u(-1, 1) for _ in range(3)]
+            h = [u(0.01, 0.5) for _ in range(3)]
+            p = [c[i] + u(-1, 1) * h[i] for i in range(3)]
+            d = [u(-1, 1) for _ in range(3)] if kind == "random" else [p[i] - o[i] for i in range(3)]
+            x = o + d + [0.0, u(0.5, 4.0)] + [c[i] - h[i] for i in range(3)] + [c[i] + h[i] for i in range(3)]
+        row = [self.m.encode(t) for t in x]
+        if kind == "edge":
+            for _ in range(r.randrange(1, 4)):
+                row[r.randrange(len(row))] = self.edge()
+        return row, kind
+
+
+def differs(got, want, flds, outs):
+    """The first field that differs (the manifest's order), skipping fields whose care_when flag
+    is 0 in the expected outputs; None if none."""
+    for g, w, f in zip(got, want, flds):
+        cw = f.get("care_when")
+        if cw is not None and not outs[cw]:
+            continue
+        if g != w:
+            return f"{f['name']} (stage {f.get('stage')})"
+    return None
+
+
+@cocotb.test()
+async def random_vectors(dut):
+    set_dir = os.environ["RAYPIPE_SET"]
+    manifest = json.load(open(os.path.join(set_dir, "manifest.json")))
+    n = int(os.environ.get("RAYPIPE_N", "1000"))
+    seed = int(os.environ.get("RAYPIPE_SEED", "1"))
+    model = raypipe.Unit(manifest["unit"], manifest["format"], os.environ.get("RAYPIPE_OPTIONS", ""))
+    in_f, out_f, stg_f = fields(manifest, "_inputs.hex"), fields(manifest, "_expected.hex"), fields(manifest, "_stages.hex")
+    in_w, out_w, stg_w = [f["width"] for f in in_f], [f["width"] for f in out_f], [f["width"] for f in stg_f]
+    assert [f["name"] for f in stg_f] == model.stage_names, "the model's stage signals are not the set's"
+    lat = int(manifest["latency"])
+    stim = Stimulus(model, manifest, random.Random(seed))
+    dut._log.info(f"raypipe {raypipe.version()}: unit {manifest['unit']}, format {manifest['format']}, "
+                  f"{n} random vectors, seed {seed}, latency {lat}")
+
+    cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start())
+    dut.rst_n.value = 0
+    dut.in_valid.value = 0
+    dut.in_row.value = 0
+    for _ in range(2):
+        await FallingEdge(dut.clk)
+    dut.rst_n.value = 1
+
+    pending = deque()
+    results = {"passed": 0, "failed": 0}
+    edge = 0
+
+    async def monitor():
+        nonlocal edge
+        while True:
+            await RisingEdge(dut.clk)
+            edge += 1
+            await FallingEdge(dut.clk)
+            if pending and pending[0][0] == edge:
+                _, kind, want_out, want_stg = pending.popleft()
+                if not dut.out_valid.value:
+                    why = "no out_valid"
+                else:
+                    got_out = unpack(int(dut.out_row.value), out_w)
+                    got_stg = unpack(int(dut.stg_row.value), stg_w)
+                    outs = {f["name"]: v for f, v in zip(out_f, want_out)}
+                    why = differs(got_out, want_out, out_f, outs) or differs(got_stg, want_stg, stg_f, outs)
+                if why:
+                    results["failed"] += 1
+                    if results["failed"] <= 10:
+                        dut._log.error(f"FAIL ({kind} vector, edge {edge}): first field to differ: {why}")
+                else:
+                    results["passed"] += 1
+            elif dut.out_valid.value:
+                results["failed"] += 1
+                dut._log.error(f"FAIL: out_valid at edge {edge}, where no vector is due")
+
+    cocotb.start_soon(monitor())
+    for _ in range(n):
+        row, kind = stim.vector()
+        r = model.eval(row, stages=True)
+        dut.in_row.value = pack([0] + row, in_w)
+        dut.in_valid.value = 1
+        # captured at the next rising edge, out LATENCY edges later
+        pending.append((edge + 1 + lat, kind, [r[k] for k in model.outputs], list(r["stages"].values())))
+        await FallingEdge(dut.clk)
+    dut.in_valid.value = 0
+    for _ in range(lat + 4):
+        await FallingEdge(dut.clk)
+    if pending:
+        results["failed"] += len(pending)
+        dut._log.error(f"FAIL: {len(pending)} vectors never came out")
+    print(f"{results['passed']} passed, {results['failed']} failed", flush=True)
+    assert results["failed"] == 0, f"{results['failed']} of {n} vectors failed"

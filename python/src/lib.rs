@@ -1,0 +1,219 @@
+//! raypipe's models for Python (`import raypipe`): unit handles with numpy batch calls (the
+//! SIMD kernels, the GIL released), single tests as dicts with every stage signal, the format
+//! parser and the vector-set reader. The arithmetic is the C ABI's (`raypipe_capi::unit`).
+
+use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyIOError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use raypipe_capi::unit::{Kind, Unit as CUnit};
+
+/// One unit (rti, slab or op) in one format with its options, as the CLI names them.
+#[pyclass(frozen, module = "raypipe._raypipe")]
+struct Unit {
+    u: CUnit,
+    input_names: Vec<&'static str>,
+    output_names: Vec<&'static str>,
+}
+
+const RTI_IN: [&str; 17] =
+    ["ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax", "v0x", "v0y", "v0z", "v1x", "v1y", "v1z", "v2x", "v2y", "v2z"];
+const SLAB_IN: [&str; 14] =
+    ["ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax", "minx", "miny", "minz", "maxx", "maxy", "maxz"];
+
+#[pymethods]
+impl Unit {
+    /// `Unit("rti", "e8m16:ftz", "--cull")`; options: rti `--cull`, `--det-threshold X`,
+    /// `--tie first|last`; slab `--variant V`. A bad name or option raises ValueError.
+    #[new]
+    #[pyo3(signature = (unit, format, options = ""))]
+    fn new(unit: &str, format: &str, options: &str) -> PyResult<Self> {
+        let u = CUnit::new(unit, format, options).map_err(PyValueError::new_err)?;
+        let (input_names, output_names) = match u.kind {
+            Kind::Rti => (RTI_IN.to_vec(), vec!["valid", "hit", "t", "u", "v"]),
+            Kind::Slab => (SLAB_IN.to_vec(), vec!["hit", "t_near", "t_far"]),
+            Kind::Op => (vec!["op", "a", "b"], vec!["result", "cmp"]),
+        };
+        Ok(Unit { u, input_names, output_names })
+    }
+
+    /// The format's canonical name.
+    #[getter]
+    fn format(&self) -> String {
+        self.u.format.clone()
+    }
+    /// Bits of one encoding.
+    #[getter]
+    fn width(&self) -> u32 {
+        self.u.width
+    }
+    /// The input row's field names, in order.
+    #[getter]
+    fn inputs(&self) -> Vec<&'static str> {
+        self.input_names.clone()
+    }
+    /// The output row's field names, in order.
+    #[getter]
+    fn outputs(&self) -> Vec<&'static str> {
+        self.output_names.clone()
+    }
+    /// The stage signals' names, in the order of the vector set's stage file.
+    #[getter]
+    fn stage_names(&self) -> Vec<String> {
+        self.u.stage_names.clone()
+    }
+
+    /// One test: an input row (encodings) to a dict of the outputs, and, with `stages=True`,
+    /// `"stages"`: a dict of every stage signal in pipeline order.
+    #[pyo3(signature = (row, stages = false))]
+    fn eval<'py>(&self, py: Python<'py>, row: Vec<u64>, stages: bool) -> PyResult<Bound<'py, PyDict>> {
+        let mut out = vec![0u64; self.u.kind.outputs()];
+        let mut st = Vec::new();
+        let want = stages && self.u.has_stages;
+        if stages && !self.u.has_stages {
+            return Err(PyValueError::new_err(
+                "the directed slab variant's signal set depends on the data: no stage signals",
+            ));
+        }
+        self.u.eval(&row, &mut out, want.then_some(&mut st)).map_err(PyValueError::new_err)?;
+        let d = PyDict::new(py);
+        for (name, v) in self.output_names.iter().zip(&out) {
+            d.set_item(name, v)?;
+        }
+        if want {
+            let s = PyDict::new(py);
+            for (name, v) in self.u.stage_names.iter().zip(&st) {
+                s.set_item(name, v)?;
+            }
+            d.set_item("stages", s)?;
+        }
+        Ok(d)
+    }
+
+    /// Many tests: a (n, inputs) uint64 array of encodings to a (n, outputs) uint64 array, on
+    /// the SIMD kernels where the format has them (the GIL is released meanwhile).
+    fn eval_batch<'py>(
+        &self,
+        py: Python<'py>,
+        rows: PyReadonlyArray2<'py, u64>,
+    ) -> PyResult<Bound<'py, PyArray2<u64>>> {
+        let (n, ni, no) = (rows.shape()[0], rows.shape()[1], self.u.kind.outputs());
+        if ni != self.u.kind.inputs() {
+            return Err(PyValueError::new_err(format!(
+                "rows have {ni} columns; the {:?} unit takes {}",
+                self.u.kind,
+                self.u.kind.inputs()
+            )));
+        }
+        let out = PyArray2::<u64>::zeros(py, [n, no], false);
+        {
+            // the rows in place when C-contiguous, else a contiguous copy
+            let copy;
+            let input: &[u64] = match rows.as_slice() {
+                Ok(s) => s,
+                Err(_) => {
+                    copy = rows.as_array().iter().copied().collect::<Vec<u64>>();
+                    &copy
+                }
+            };
+            let mut w = out.readwrite();
+            let dst = w.as_slice_mut().expect("a new array is contiguous");
+            let u = &self.u;
+            py.allow_threads(|| u.batch(input, dst)).map_err(PyValueError::new_err)?;
+        }
+        Ok(out)
+    }
+
+    /// The format's encoding of `x` (its conversion's rounding: to nearest, ties to even).
+    fn encode(&self, x: f64) -> u64 {
+        self.u.encode(x)
+    }
+
+    /// The value of an encoding.
+    fn decode(&self, bits: u64) -> PyResult<f64> {
+        if self.u.width < 64 && bits >> self.u.width != 0 {
+            return Err(PyValueError::new_err(format!("{bits:#x} has bits above the format's {} bits", self.u.width)));
+        }
+        Ok(self.u.decode(bits))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("raypipe.Unit({:?}, {:?})", format!("{:?}", self.u.kind).to_lowercase(), self.u.format)
+    }
+}
+
+/// A format name parsed: `{"name", "width", "kind": "float" | "fixed", "exp_bits" and
+/// "man_bits" | "int_bits" and "frac_bits", "contract": {...}}`; ValueError if bad.
+#[pyfunction]
+fn parse_format<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
+    use datapath::Format;
+    let any: datapath::AnyFormat = name.parse().map_err(|e: String| PyValueError::new_err(e))?;
+    let d = PyDict::new(py);
+    let (name, width, kind, c) = datapath::with_format!(&any, |f| (f.name(), f.width(), f.kind(), f.contract()));
+    d.set_item("name", name)?;
+    d.set_item("width", width)?;
+    match kind {
+        datapath::format::FormatKind::Float(l) => {
+            d.set_item("kind", "float")?;
+            d.set_item("exp_bits", l.exp_bits)?;
+            d.set_item("man_bits", l.man_bits)?;
+        }
+        datapath::format::FormatKind::Fixed { int_bits, frac_bits } => {
+            d.set_item("kind", "fixed")?;
+            d.set_item("int_bits", int_bits)?;
+            d.set_item("frac_bits", frac_bits)?;
+        }
+    }
+    let cd = PyDict::new(py);
+    for (k, v) in [
+        ("encoding", c.encoding),
+        ("rounding", c.rounding),
+        ("subnormals", c.subnormals),
+        ("nan", c.nan),
+        ("overflow", c.overflow),
+        ("division", c.division),
+        ("compare", c.compare),
+    ] {
+        cd.set_item(k, v)?;
+    }
+    d.set_item("contract", cd)?;
+    Ok(d)
+}
+
+/// A vector set written by `raypipe vectors`: `{"manifest": dict, "files": {name: (rows,
+/// fields) uint64 array}}`, every file checked against the manifest's sha256.
+#[pyfunction]
+fn read_set<'py>(py: Python<'py>, dir: std::path::PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    let text = std::fs::read_to_string(dir.join("manifest.json"))
+        .map_err(|e| PyIOError::new_err(format!("{}: {e}", dir.join("manifest.json").display())))?;
+    let m: vectors::manifest::Manifest =
+        serde_json::from_str(&text).map_err(|e| PyValueError::new_err(format!("manifest.json: {e}")))?;
+    let files = vectors::gen::read_files(&dir, &m).map_err(PyValueError::new_err)?;
+    let json = py.import("json")?;
+    let d = PyDict::new(py);
+    d.set_item("manifest", json.call_method1("loads", (text,))?)?;
+    let fd = PyDict::new(py);
+    for (fm, rows) in m.files.iter().zip(files) {
+        let cols = fm.fields.len();
+        let flat: Vec<u64> = rows.iter().flatten().copied().collect();
+        let arr = numpy::PyArray1::from_vec(py, flat).reshape([rows.len(), cols])?;
+        fd.set_item(&fm.name, arr)?;
+    }
+    d.set_item("files", fd)?;
+    Ok(d)
+}
+
+/// raypipe's version.
+#[pyfunction]
+fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+#[pymodule]
+fn _raypipe(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Unit>()?;
+    m.add_function(wrap_pyfunction!(parse_format, m)?)?;
+    m.add_function(wrap_pyfunction!(read_set, m)?)?;
+    m.add_function(wrap_pyfunction!(version, m)?)?;
+    Ok(())
+}
