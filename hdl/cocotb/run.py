@@ -45,9 +45,13 @@ def main():
         runner = get_runner("icarus")
         runner.build(sources=sources, hdl_toplevel=top, build_args=["-g2012"], defines={d: 1 for d in a.define},
                      build_dir=os.path.join(work, "build"), always=True, timescale=("1ns", "1ps"))
-        env = {"RAYPIPE_SET": set_dir, "RAYPIPE_OPTIONS": a.options, "RAYPIPE_N": str(a.n), "RAYPIPE_SEED": str(a.seed)}
-        results = runner.test(hdl_toplevel=top, test_module="test_raypipe", test_dir=os.path.dirname(os.path.abspath(__file__)),
-                              build_dir=os.path.join(work, "build"), extra_env=env)
+        here = os.path.dirname(os.path.abspath(__file__))
+        env = {"RAYPIPE_SET": set_dir, "RAYPIPE_OPTIONS": a.options, "RAYPIPE_N": str(a.n), "RAYPIPE_SEED": str(a.seed),
+               "PYTHONPATH": os.pathsep.join([here] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])}
+        # everything the run writes (results.xml, the simulator's files) stays in the temporary directory
+        results = runner.test(hdl_toplevel=top, test_module="test_raypipe", test_dir=work,
+                              build_dir=os.path.join(work, "build"), extra_env=env,
+                              results_xml=os.path.join(work, "results.xml"))
         from cocotb_tools.runner import get_results
 
         tests, fails = get_results(results)
