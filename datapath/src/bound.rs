@@ -330,3 +330,55 @@ fn block_body(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: 
         te[i] = b.t_err;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{Bnd, Ctx};
+
+    fn ctx() -> Ctx<f64> {
+        // binary32's unit roundoff, and error floors large enough to show in every sum
+        Ctx { u: 2f64.powi(-24), eta: 2f64.powi(-20), add_eta: 2f64.powi(-21), max: 1e30, overflow: false }
+    }
+
+    /// Each step adds exactly the error terms the module documentation states, worked by hand:
+    /// x ± y: e = ex + ey + u·(|x ± y| + ex + ey) + add_eta; x × y: e = |x|·ey + |y|·ex + ex·ey
+    /// + u·(|x·y| + that) + eta; the monomial sums add (±) and multiply (×).
+    #[test]
+    fn each_step_adds_the_documented_error_terms() {
+        let mut c = ctx();
+        let (u, eta, add_eta) = (c.u, c.eta, c.add_eta);
+        let x = Bnd { v: 1.5, a: 1.5, e: 0.25 };
+        let y = Bnd { v: -0.5, a: 0.75, e: 0.125 };
+        let s = c.add(x, y);
+        assert_eq!((s.v, s.a), (1.0, 2.25));
+        assert_eq!(s.e, 0.375 + u * (1.0 + 0.375) + add_eta);
+        let d = c.sub(x, y);
+        assert_eq!((d.v, d.a), (2.0, 2.25));
+        assert_eq!(d.e, 0.375 + u * (2.0 + 0.375) + add_eta);
+        let p = c.mul(x, y);
+        // e0 = 1.5·0.125 + 0.5·0.25 + 0.25·0.125 = 0.1875 + 0.125 + 0.03125
+        let e0 = 0.34375;
+        assert_eq!((p.v, p.a), (-0.75, 1.125));
+        assert_eq!(p.e, e0 + u * (0.75 + e0) + eta);
+        assert!(!c.overflow);
+    }
+
+    /// The overflow flag rises when |v| + e exceeds the largest magnitude (or is NaN), even
+    /// when |v| alone does not, and stays raised.
+    #[test]
+    fn overflow_is_flagged_by_value_plus_bound_and_stays() {
+        let mut c = ctx();
+        c.check(Bnd { v: 0.75e30, a: 0.75e30, e: 0.25e30 });
+        assert!(!c.overflow, "|v| + e = max is not above max");
+        c.check(Bnd { v: 0.75e30, a: 0.75e30, e: 0.5e30 });
+        assert!(c.overflow, "|v| + e above max");
+        c.check(Bnd { v: 1.0, a: 1.0, e: 0.0 });
+        assert!(c.overflow, "the flag stays raised");
+        let mut c = ctx();
+        c.check(Bnd { v: -1.0, a: 1.0, e: 1.5e30 });
+        assert!(c.overflow, "a bound alone above max");
+        let mut c = ctx();
+        c.check(Bnd { v: f64::NAN, a: 0.0, e: 0.0 });
+        assert!(c.overflow, "NaN");
+    }
+}
