@@ -56,20 +56,31 @@ const char *rp_last_error(void);
 // pointer (each may be null: that is an error code, not a crash).
 int32_t rp_unit_new(const char *unit, const char *format, const char *options, struct RpUnit **out);
 
+// Creates a traverse unit handle into `*out` from the vector set in directory `set_dir`
+// (written by `raypipe vectors --unit traverse`): the tree is read from the set's BRAM images
+// (every file checked against the manifest's sha256, every address word against the next
+// level), with the set's format, slab variant and N. Its rows: inputs ox oy oz dx dy dz tmin
+// tmax (8), outputs the set's `traverse_expected.hex` row (count, N leaf ids, passes, box
+// tests, each level's 2-bit history state); no stage signals. Free it with [`rp_unit_free`].
+//
+// # Safety
+// `set_dir` a NUL-terminated string (or null: an error code), `out` writable (or null).
+int32_t rp_traverse_open(const char *set_dir, struct RpUnit **out);
+
 // Frees a handle from [`rp_unit_new`] (null: nothing happens).
 //
 // # Safety
 // `u` is null or a handle not yet freed; it is not used afterwards.
 void rp_unit_free(struct RpUnit *u);
 
-// Values in one input row of the unit (rti 17, slab 14, op 3); 0 for a null handle.
+// Values in one input row of the unit (rti 17, slab 14, op 3, traverse 8); 0 for a null handle.
 //
 // # Safety
 // `u` is null or a live handle.
 size_t rp_unit_inputs(const struct RpUnit *u);
 
 // Values in one output row of the unit (rti 5: valid, hit, t, u, v; slab 3: hit, t_near,
-// t_far; op 2: result, cmp); 0 for a null handle.
+// t_far; op 2: result, cmp; traverse: the set's expected row); 0 for a null handle.
 //
 // # Safety
 // `u` is null or a live handle.

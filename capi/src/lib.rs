@@ -174,6 +174,29 @@ pub unsafe extern "C" fn rp_unit_new(
     })
 }
 
+/// Creates a traverse unit handle into `*out` from the vector set in directory `set_dir`
+/// (written by `raypipe vectors --unit traverse`): the tree is read from the set's BRAM images
+/// (every file checked against the manifest's sha256, every address word against the next
+/// level), with the set's format, slab variant and N. Its rows: inputs ox oy oz dx dy dz tmin
+/// tmax (8), outputs the set's `traverse_expected.hex` row (count, N leaf ids, passes, box
+/// tests, each level's 2-bit history state); no stage signals. Free it with [`rp_unit_free`].
+///
+/// # Safety
+/// `set_dir` a NUL-terminated string (or null: an error code), `out` writable (or null).
+#[no_mangle]
+pub unsafe extern "C" fn rp_traverse_open(set_dir: *const c_char, out: *mut *mut RpUnit) -> i32 {
+    guard(|| {
+        if out.is_null() {
+            return Err(Fail(RP_ERR_NULL, "out is a null pointer".into()));
+        }
+        let d = unsafe { text(set_dir, "set_dir")? };
+        let h = unit::Unit::open_set(std::path::Path::new(d)).map_err(arg)?;
+        // SAFETY: out is non-null and writable (the caller's promise)
+        unsafe { *out = Box::into_raw(Box::new(RpUnit(h))) };
+        Ok(())
+    })
+}
+
 /// Frees a handle from [`rp_unit_new`] (null: nothing happens).
 ///
 /// # Safety
@@ -186,7 +209,7 @@ pub unsafe extern "C" fn rp_unit_free(u: *mut RpUnit) {
     }
 }
 
-/// Values in one input row of the unit (rti 17, slab 14, op 3); 0 for a null handle.
+/// Values in one input row of the unit (rti 17, slab 14, op 3, traverse 8); 0 for a null handle.
 ///
 /// # Safety
 /// `u` is null or a live handle.
@@ -196,13 +219,13 @@ pub unsafe extern "C" fn rp_unit_inputs(u: *const RpUnit) -> usize {
 }
 
 /// Values in one output row of the unit (rti 5: valid, hit, t, u, v; slab 3: hit, t_near,
-/// t_far; op 2: result, cmp); 0 for a null handle.
+/// t_far; op 2: result, cmp; traverse: the set's expected row); 0 for a null handle.
 ///
 /// # Safety
 /// `u` is null or a live handle.
 #[no_mangle]
 pub unsafe extern "C" fn rp_unit_outputs(u: *const RpUnit) -> usize {
-    unsafe { handle(u) }.map_or(0, |h| h.kind.outputs())
+    unsafe { handle(u) }.map_or(0, |h| h.outputs())
 }
 
 /// Stage signals in one stage row of the unit (0 for op, for the directed slab variant, whose
@@ -339,7 +362,7 @@ unsafe fn eval(
             return Err(Fail(RP_ERR_UNIT, format!("a {:?} call on a {:?} unit", k, h.kind)));
         }
     }
-    let (ni, no, ns) = (h.kind.inputs(), h.kind.outputs(), h.stage_names.len());
+    let (ni, no, ns) = (h.kind.inputs(), h.outputs(), h.stage_names.len());
     if n_inputs != ni {
         return Err(Fail(RP_ERR_LENGTH, format!("{n_inputs} inputs for a {:?} unit, which takes {ni}", h.kind)));
     }
@@ -432,7 +455,7 @@ pub unsafe extern "C" fn rp_eval_batch(
 ) -> i32 {
     guard(|| {
         let h = unsafe { handle(u)? };
-        let (ni, no) = (h.kind.inputs(), h.kind.outputs());
+        let (ni, no) = (h.kind.inputs(), h.outputs());
         let (want_in, want_out) = match (count.checked_mul(ni), count.checked_mul(no)) {
             (Some(a), Some(b)) => (a, b),
             _ => return Err(Fail(RP_ERR_LENGTH, format!("count {count} is too large"))),

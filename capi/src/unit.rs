@@ -19,6 +19,10 @@ pub enum Kind {
     /// One operation: inputs op code (0 add, 1 sub, 2 mul, 3 div, 4 lt, 5 le), a, b (3);
     /// outputs result, cmp (2).
     Op,
+    /// BVH traversal (2-bit ray history) over the tree of a traverse vector set's BRAM images:
+    /// inputs o, d, tmin, tmax (8); outputs the set's expected row (count, the first N leaf
+    /// ids, passes, box tests, each level's final history state).
+    Traverse,
 }
 
 impl Kind {
@@ -28,14 +32,7 @@ impl Kind {
             Kind::Rti => 17,
             Kind::Slab => 14,
             Kind::Op => 3,
-        }
-    }
-    /// Values in an output row.
-    pub fn outputs(self) -> usize {
-        match self {
-            Kind::Rti => 5,
-            Kind::Slab => 3,
-            Kind::Op => 2,
+            Kind::Traverse => 8,
         }
     }
 }
@@ -247,6 +244,45 @@ impl<F: Format + Send + Sync + 'static> Eval for OpUnit<F> {
     }
 }
 
+struct TraverseUnit<F: Format> {
+    s: Slab<F>,
+    hw: datapath::bvh::HwTree<Aabb<F::V>>,
+    leaves: usize,
+}
+
+impl<F: Format + Send + Sync + 'static> Eval for TraverseUnit<F>
+where
+    F::V: Send + Sync,
+{
+    fn eval(
+        &self,
+        input: &[u64],
+        out: &mut [u64],
+        stages: Option<&mut Vec<u64>>,
+        names: Option<&mut Vec<(String, u32)>>,
+    ) {
+        if let Some(n) = names {
+            n.clear();
+        }
+        if let Some(s) = stages {
+            s.clear();
+        }
+        out.copy_from_slice(&vectors::traverse::ray_row(&self.s, &self.hw, self.leaves, input, &NoFault));
+    }
+    fn encode(&self, x: f64) -> u64 {
+        self.s.fmt.to_bits(self.s.fmt.from_f64(x))
+    }
+    fn decode(&self, bits: u64) -> f64 {
+        self.s.fmt.to_f64(self.s.fmt.from_bits(bits))
+    }
+    fn batch(&self, input: &[u64], out: &mut [u64]) {
+        let no = out.len() / (input.len() / 8).max(1);
+        for (row, o) in input.chunks_exact(8).zip(out.chunks_exact_mut(no.max(1))) {
+            self.eval(row, o, None, None);
+        }
+    }
+}
+
 /// One model in one format with its options (immutable: share it across threads freely).
 pub struct Unit {
     /// The unit.
@@ -264,6 +300,11 @@ pub struct Unit {
     /// False for the directed slab variant, whose signal set depends on the data (no stage
     /// file either): its stage signals are not offered.
     pub has_stages: bool,
+    /// Each output's bits (1 for a flag, the format's width for a value, the field's width in
+    /// the set for traverse).
+    pub output_widths: Vec<u32>,
+    /// Each output's name (the expected file's field names).
+    pub output_names: Vec<String>,
     eval: Box<dyn Eval>,
 }
 
@@ -317,6 +358,9 @@ impl Unit {
             "rti" => Kind::Rti,
             "slab" => Kind::Slab,
             "op" => Kind::Op,
+            "traverse" => {
+                return Err("the traverse unit runs over a set's tree: open the set (rp_traverse_open)".into())
+            }
             _ => return Err(format!("unknown unit {unit:?}: rti, slab or op")),
         };
         let any: AnyFormat = format.parse().map_err(|e| format!("format {format:?}: {e}"))?;
@@ -346,8 +390,15 @@ impl Unit {
                 })
             }
             Kind::Op => with_format!(any, |f| Box::new(OpUnit { f })),
+            Kind::Traverse => return Err("the traverse unit runs over a set's tree: open the set".into()),
         };
         let has_stages = kind != Kind::Slab || o.variant.as_deref() != Some("directed");
+        let (output_widths, names): (Vec<u32>, &[&str]) = match kind {
+            Kind::Rti => (vec![1, 1, width, width, width], &["valid", "hit", "t", "u", "v"]),
+            Kind::Slab => (vec![1, width, width], &["hit", "t_near", "t_far"]),
+            _ => (vec![width, 1], &["result", "cmp"]),
+        };
+        let output_names = names.iter().map(|n| n.to_string()).collect();
         let mut u = Unit {
             kind,
             format: name,
@@ -356,9 +407,11 @@ impl Unit {
             stage_widths: Vec::new(),
             stage_cnames: Vec::new(),
             has_stages,
+            output_widths,
+            output_names,
             eval,
         };
-        let (zero, mut out, mut names) = (vec![0u64; kind.inputs()], vec![0u64; kind.outputs()], Vec::new());
+        let (zero, mut out, mut names) = (vec![0u64; kind.inputs()], vec![0u64; u.outputs()], Vec::new());
         if has_stages {
             u.eval.eval(&zero, &mut out, None, Some(&mut names));
         }
@@ -391,14 +444,63 @@ impl Unit {
         Ok(())
     }
 
+    /// Values in an output row.
+    pub fn outputs(&self) -> usize {
+        self.output_widths.len()
+    }
+
     /// The bits of output `i` (1 for a flag, the format's width for a value), if in range.
     pub fn output_width(&self, i: usize) -> Option<u32> {
-        let flags: &[usize] = match self.kind {
-            Kind::Rti => &[0, 1],
-            Kind::Slab => &[0],
-            Kind::Op => &[1],
+        self.output_widths.get(i).copied()
+    }
+
+    /// The traverse unit of the vector set in `dir` (unit traverse): its format, slab variant,
+    /// N and tree, the tree read from the set's BRAM images; every file is checked against the
+    /// manifest's sha256 and every address word against the next level's rows.
+    pub fn open_set(dir: &std::path::Path) -> Result<Self, String> {
+        let path = dir.join("manifest.json");
+        let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let m: vectors::manifest::Manifest =
+            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        if m.unit != "traverse" {
+            return Err(format!("{} is a set of unit {}, not traverse", dir.display(), m.unit));
+        }
+        let contents = vectors::gen::read_files(dir, &m)?;
+        let (root, images) = vectors::gen::tree_images(&m, &contents)?;
+        let banks: Vec<_> = images.into_iter().map(|(a, b)| (a.clone(), b.clone())).collect();
+        let leaves = m.params.get("leaves").copied().ok_or("manifest.json: params has no leaves")? as usize;
+        let variant = m.options.get("variant").map_or("plain", |s| s.as_str()).to_string();
+        let any: AnyFormat = m.format.parse().map_err(|e| format!("manifest.json: format {}: {e}", m.format))?;
+        let expected =
+            m.files.iter().find(|f| f.name == "traverse_expected.hex").ok_or("the set has no traverse_expected.hex")?;
+        let output_widths: Vec<u32> = expected.fields.iter().map(|f| f.width).collect();
+        let output_names: Vec<String> = expected.fields.iter().map(|f| f.name.clone()).collect();
+        let (name, width) = with_format!(&any, |f| (f.name(), f.width()));
+        let eval: Box<dyn Eval> = with_format!(any, |f| {
+            let s = Slab::new(f, SlabConfig::named(&variant)?);
+            let hw = vectors::traverse::tree_from_images(&s, root, &banks)?;
+            Box::new(TraverseUnit { s, hw, leaves })
+        });
+        let u = Unit {
+            kind: Kind::Traverse,
+            format: name,
+            width,
+            stage_names: Vec::new(),
+            stage_widths: Vec::new(),
+            stage_cnames: Vec::new(),
+            has_stages: false,
+            output_widths,
+            output_names,
+            eval,
         };
-        (i < self.kind.outputs()).then(|| if flags.contains(&i) { 1 } else { self.width })
+        // the tree and N must give rows of the set's width
+        let mut out = vec![0u64; u.outputs()];
+        let probe =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| u.eval.eval(&[0; 8], &mut out, None, None)));
+        if probe.is_err() {
+            return Err("the set's tree does not give rows of its traverse_expected.hex layout".into());
+        }
+        Ok(u)
     }
 
     /// The format's encoding of `x`, rounded as the format's conversion from binary64 rounds.
@@ -423,7 +525,7 @@ impl Unit {
     /// checked first.
     pub fn batch(&self, input: &[u64], out: &mut [u64]) -> Result<(), String> {
         let ni = self.kind.inputs();
-        if input.len() % ni != 0 {
+        if !input.len().is_multiple_of(ni) {
             return Err(format!("{} values are not whole rows of {ni}", input.len()));
         }
         // the fast check (an OR over the encodings, op codes apart); the slow one names the row

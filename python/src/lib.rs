@@ -13,11 +13,22 @@ use raypipe_capi::unit::{Kind, Unit as CUnit};
 struct Unit {
     u: CUnit,
     input_names: Vec<&'static str>,
-    output_names: Vec<&'static str>,
 }
 
 const RTI_IN: [&str; 17] =
     ["ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax", "v0x", "v0y", "v0z", "v1x", "v1y", "v1z", "v2x", "v2y", "v2z"];
+impl Unit {
+    fn of(u: CUnit) -> Self {
+        let input_names = match u.kind {
+            Kind::Rti => RTI_IN.to_vec(),
+            Kind::Slab => SLAB_IN.to_vec(),
+            Kind::Op => vec!["op", "a", "b"],
+            Kind::Traverse => RTI_IN[..8].to_vec(),
+        };
+        Unit { u, input_names }
+    }
+}
+
 const SLAB_IN: [&str; 14] =
     ["ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax", "minx", "miny", "minz", "maxx", "maxy", "maxz"];
 
@@ -28,13 +39,15 @@ impl Unit {
     #[new]
     #[pyo3(signature = (unit, format, options = ""))]
     fn new(unit: &str, format: &str, options: &str) -> PyResult<Self> {
-        let u = CUnit::new(unit, format, options).map_err(PyValueError::new_err)?;
-        let (input_names, output_names) = match u.kind {
-            Kind::Rti => (RTI_IN.to_vec(), vec!["valid", "hit", "t", "u", "v"]),
-            Kind::Slab => (SLAB_IN.to_vec(), vec!["hit", "t_near", "t_far"]),
-            Kind::Op => (vec!["op", "a", "b"], vec!["result", "cmp"]),
-        };
-        Ok(Unit { u, input_names, output_names })
+        Ok(Unit::of(CUnit::new(unit, format, options).map_err(PyValueError::new_err)?))
+    }
+
+    /// The traverse unit of a vector set written by `raypipe vectors --unit traverse`: the
+    /// tree read from its BRAM images (checked against the manifest), its format, variant and
+    /// N. Rows: inputs ox … tmax, outputs the set's `traverse_expected.hex` fields.
+    #[staticmethod]
+    fn traverse(set_dir: std::path::PathBuf) -> PyResult<Self> {
+        Ok(Unit::of(CUnit::open_set(&set_dir).map_err(PyValueError::new_err)?))
     }
 
     /// The format's canonical name.
@@ -54,8 +67,8 @@ impl Unit {
     }
     /// The output row's field names, in order.
     #[getter]
-    fn outputs(&self) -> Vec<&'static str> {
-        self.output_names.clone()
+    fn outputs(&self) -> Vec<String> {
+        self.u.output_names.clone()
     }
     /// The stage signals' names, in the order of the vector set's stage file.
     #[getter]
@@ -67,7 +80,7 @@ impl Unit {
     /// `"stages"`: a dict of every stage signal in pipeline order.
     #[pyo3(signature = (row, stages = false))]
     fn eval<'py>(&self, py: Python<'py>, row: Vec<u64>, stages: bool) -> PyResult<Bound<'py, PyDict>> {
-        let mut out = vec![0u64; self.u.kind.outputs()];
+        let mut out = vec![0u64; self.u.outputs()];
         let mut st = Vec::new();
         let want = stages && self.u.has_stages;
         if stages && !self.u.has_stages {
@@ -77,7 +90,7 @@ impl Unit {
         }
         self.u.eval(&row, &mut out, want.then_some(&mut st)).map_err(PyValueError::new_err)?;
         let d = PyDict::new(py);
-        for (name, v) in self.output_names.iter().zip(&out) {
+        for (name, v) in self.u.output_names.iter().zip(&out) {
             d.set_item(name, v)?;
         }
         if want {
@@ -97,7 +110,7 @@ impl Unit {
         py: Python<'py>,
         rows: PyReadonlyArray2<'py, u64>,
     ) -> PyResult<Bound<'py, PyArray2<u64>>> {
-        let (n, ni, no) = (rows.shape()[0], rows.shape()[1], self.u.kind.outputs());
+        let (n, ni, no) = (rows.shape()[0], rows.shape()[1], self.u.outputs());
         if ni != self.u.kind.inputs() {
             return Err(PyValueError::new_err(format!(
                 "rows have {ni} columns; the {:?} unit takes {}",

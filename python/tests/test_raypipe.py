@@ -149,3 +149,27 @@ def test_bad_input_raises_clear_errors():
         raypipe.Unit("slab", "f32", "--variant directed").eval([0] * 14, stages=True)
     with pytest.raises(OSError):
         raypipe.read_set("/nonexistent/raypipe-set")
+
+
+def test_traverse_over_a_written_sets_tree():
+    exe = raypipe_binary()
+    if exe is None:
+        pytest.skip("no raypipe binary (cargo build --release, or set RAYPIPE)")
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "set")
+        subprocess.run([exe, "vectors", "--unit", "traverse", "--format", "fp16", "--count", "4", "--out", out], check=True,
+                       capture_output=True)
+        u = raypipe.Unit.traverse(out)
+        s = raypipe.read_set(out)
+        rays, want = s["files"]["traverse_rays.hex"], s["files"]["traverse_expected.hex"]
+        assert u.inputs == ["ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax"]
+        assert u.outputs == [f["name"] for f in s["manifest"]["files"][1]["fields"]]
+        assert np.array_equal(u.eval_batch(np.ascontiguousarray(rays[:, 1:])), want)
+        r = u.eval([int(x) for x in rays[0, 1:]])
+        assert [r[k] for k in u.outputs] == [int(x) for x in want[0]]
+        with open(os.path.join(out, "tree_root.hex"), "a") as f:
+            f.write("\n")
+        with pytest.raises(ValueError, match="tree_root.hex"):
+            raypipe.Unit.traverse(out)
+    with pytest.raises(ValueError, match="manifest.json"):
+        raypipe.Unit.traverse("/nonexistent/raypipe-set")
