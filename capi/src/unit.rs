@@ -305,6 +305,8 @@ pub struct Unit {
     pub output_widths: Vec<u32>,
     /// Each output's name (the expected file's field names).
     pub output_names: Vec<String>,
+    /// The same RTI unit typed, when the format is f32 (columnar batches of binary32 lanes).
+    pub rti_f32: Option<Rti<datapath::format::Ieee<datapath::format::F32Native>>>,
     eval: Box<dyn Eval>,
 }
 
@@ -373,13 +375,17 @@ impl Unit {
             return Err("--variant is an option of the slab unit".into());
         }
         let (name, width) = with_format!(&any, |f| (f.name(), f.width()));
+        let cfg = RtiConfig {
+            cull: if o.cull { Cull::Backface } else { Cull::TwoSided },
+            det_threshold: o.det_threshold,
+            tie: o.tie.unwrap_or(TieRule::First),
+        };
+        let rti_f32 = match (&any, kind) {
+            (AnyFormat::F32(f), Kind::Rti) => Some(Rti::new(*f, cfg)),
+            _ => None,
+        };
         let eval: Box<dyn Eval> = match kind {
             Kind::Rti => {
-                let cfg = RtiConfig {
-                    cull: if o.cull { Cull::Backface } else { Cull::TwoSided },
-                    det_threshold: o.det_threshold,
-                    tie: o.tie.unwrap_or(TieRule::First),
-                };
                 with_format!(any, |f| Box::new(RtiUnit { rti: Rti::new(f, cfg) }))
             }
             Kind::Slab => {
@@ -409,6 +415,7 @@ impl Unit {
             has_stages,
             output_widths,
             output_names,
+            rti_f32,
             eval,
         };
         let (zero, mut out, mut names) = (vec![0u64; kind.inputs()], vec![0u64; u.outputs()], Vec::new());
@@ -491,6 +498,7 @@ impl Unit {
             has_stages: false,
             output_widths,
             output_names,
+            rti_f32: None,
             eval,
         };
         // the tree and N must give rows of the set's width

@@ -2,7 +2,7 @@
 //! SIMD kernels, the GIL released), single tests as dicts with every stage signal, the format
 //! parser and the vector-set reader. The arithmetic is the C ABI's (`raypipe_capi::unit`).
 
-use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyIOError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -122,9 +122,11 @@ impl Unit {
         {
             // the rows in place when C-contiguous, else a contiguous copy
             let copy;
+            // (as_slice also accepts a Fortran-ordered array, whose memory order is not the
+            // rows' order: only a C-contiguous one is read in place)
             let input: &[u64] = match rows.as_slice() {
-                Ok(s) => s,
-                Err(_) => {
+                Ok(s) if rows.is_c_contiguous() => s,
+                _ => {
                     copy = rows.as_array().iter().copied().collect::<Vec<u64>>();
                     &copy
                 }
@@ -135,6 +137,120 @@ impl Unit {
             py.allow_threads(|| u.batch(input, dst)).map_err(PyValueError::new_err)?;
         }
         Ok(out)
+    }
+
+    /// Many f32 RTI tests from columns: a (17, n) float32 array (C-contiguous: read in place; one row per
+    /// input, in the order of `inputs`) to a dict of output columns (`valid`, `hit`: bool;
+    /// `t`, `u`, `v`: float32), run through the binary32 kernels in L1-sized chunks with the
+    /// GIL released: the columnar layout the kernels read, with no per-row conversion.
+    /// `out`: a dict of those five arrays (length n) to write into, reused across calls.
+    #[pyo3(signature = (cols, out = None))]
+    fn eval_columns<'py>(
+        &self,
+        py: Python<'py>,
+        cols: PyReadonlyArray2<'py, f32>,
+        out: Option<Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        use datapath::rti::{HitsSoa, RaysSoa, TrisSoa};
+        let rti = self
+            .u
+            .rti_f32
+            .as_ref()
+            .ok_or_else(|| PyValueError::new_err("eval_columns runs rti units in f32; use eval_batch"))?;
+        if cols.shape()[0] != 17 {
+            return Err(PyValueError::new_err(format!("{} columns; the rti unit takes 17", cols.shape()[0])));
+        }
+        let n = cols.shape()[1];
+        // in place when C-contiguous, else a copy in the logical order (as_slice would also
+        // accept a Fortran-ordered array, in the wrong order)
+        let copy;
+        let src: &[f32] = match cols.as_slice() {
+            Ok(s) if cols.is_c_contiguous() => s,
+            _ => {
+                copy = cols.as_array().iter().copied().collect::<Vec<f32>>();
+                &copy
+            }
+        };
+        // the output columns: the caller's (`out`, reused across calls: no fresh pages to
+        // fault in), or new ones
+        let given = |name: &str| -> PyResult<Option<Bound<'py, PyAny>>> {
+            match &out {
+                Some(d) => d.get_item(name),
+                None => Ok(None),
+            }
+        };
+        let pick_b = |name: &str| -> PyResult<Bound<'py, PyArray1<bool>>> {
+            let Some(a) = given(name)? else { return Ok(PyArray1::<bool>::zeros(py, n, false)) };
+            let a = a
+                .downcast_into::<PyArray1<bool>>()
+                .map_err(|_| PyValueError::new_err(format!("out[{name:?}] must be a bool array")))?;
+            match a.len() == n {
+                true => Ok(a),
+                false => Err(PyValueError::new_err(format!("out[{name:?}] has {} values, not {n}", a.len()))),
+            }
+        };
+        let pick_f = |name: &str| -> PyResult<Bound<'py, PyArray1<f32>>> {
+            let Some(a) = given(name)? else { return Ok(PyArray1::<f32>::zeros(py, n, false)) };
+            let a = a
+                .downcast_into::<PyArray1<f32>>()
+                .map_err(|_| PyValueError::new_err(format!("out[{name:?}] must be a float32 array")))?;
+            match a.len() == n {
+                true => Ok(a),
+                false => Err(PyValueError::new_err(format!("out[{name:?}] has {} values, not {n}", a.len()))),
+            }
+        };
+        let (valid, hit) = (pick_b("valid")?, pick_b("hit")?);
+        let (t, u, v) = (pick_f("t")?, pick_f("u")?, pick_f("v")?);
+        {
+            let (mut wv, mut wh, mut wt, mut wu, mut ww) =
+                (valid.readwrite(), hit.readwrite(), t.readwrite(), u.readwrite(), v.readwrite());
+            let contiguous = |_| PyValueError::new_err("the out arrays must be contiguous");
+            let (ov, oh, ot, ou, ow) = (
+                wv.as_slice_mut().map_err(contiguous)?,
+                wh.as_slice_mut().map_err(contiguous)?,
+                wt.as_slice_mut().map_err(contiguous)?,
+                wu.as_slice_mut().map_err(contiguous)?,
+                ww.as_slice_mut().map_err(contiguous)?,
+            );
+            py.allow_threads(|| {
+                const CHUNK: usize = 1024;
+                let col = |k: usize| &src[k * n..(k + 1) * n];
+                let (mut rays, mut tris) = (RaysSoa::<f32>::with_capacity(CHUNK), TrisSoa::<f32>::with_capacity(CHUNK));
+                let mut hits = HitsSoa::<f32>::with_len(CHUNK);
+                let mut start = 0;
+                while start < n {
+                    let end = (start + CHUNK).min(n);
+                    let fill = |dst: &mut Vec<f32>, k: usize| {
+                        dst.clear();
+                        dst.extend_from_slice(&col(k)[start..end]);
+                    };
+                    for a in 0..3 {
+                        fill(&mut rays.o[a], a);
+                        fill(&mut rays.d[a], 3 + a);
+                        for j in 0..3 {
+                            fill(&mut tris.v[j][a], 8 + 3 * j + a);
+                        }
+                    }
+                    fill(&mut rays.tmin, 6);
+                    fill(&mut rays.tmax, 7);
+                    hits.resize(end - start);
+                    datapath::simd::rti_batch_f32(rti, &rays, &tris, &mut hits);
+                    ov[start..end].copy_from_slice(&hits.valid);
+                    oh[start..end].copy_from_slice(&hits.hit);
+                    ot[start..end].copy_from_slice(&hits.t);
+                    ou[start..end].copy_from_slice(&hits.u);
+                    ow[start..end].copy_from_slice(&hits.v);
+                    start = end;
+                }
+            });
+        }
+        let d = PyDict::new(py);
+        d.set_item("valid", valid)?;
+        d.set_item("hit", hit)?;
+        d.set_item("t", t)?;
+        d.set_item("u", u)?;
+        d.set_item("v", v)?;
+        Ok(d)
     }
 
     /// The format's encoding of `x` (its conversion's rounding: to nearest, ties to even).

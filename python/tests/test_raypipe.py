@@ -173,3 +173,36 @@ def test_traverse_over_a_written_sets_tree():
             raypipe.Unit.traverse(out)
     with pytest.raises(ValueError, match="manifest.json"):
         raypipe.Unit.traverse("/nonexistent/raypipe-set")
+
+
+def test_eval_columns_equals_eval_batch_and_reuses_out():
+    u = raypipe.Unit("rti", "f32", "--det-threshold 0.001")
+    rng = np.random.default_rng(9)
+    n = 5000
+    cols = rng.uniform(-2, 2, size=(17, n)).astype(np.float32)
+    cols[6], cols[7] = 0.0, 3.0
+    cols[:, :50] = np.float32(np.nan)  # NaNs in every input of the first 50 tests
+    rows = np.ascontiguousarray(cols.T).view(np.uint32).astype(np.uint64)
+    want = u.eval_batch(rows)
+    out = {k: np.zeros(n, dtype=bool) for k in ("valid", "hit")}
+    out.update({k: np.zeros(n, dtype=np.float32) for k in "tuv"})
+    got = u.eval_columns(cols, out=out)
+    assert got["t"] is out["t"]
+    assert np.array_equal(got["valid"], want[:, 0] == 1) and np.array_equal(got["hit"], want[:, 1] == 1)
+    for k, c in (("t", 2), ("u", 3), ("v", 4)):
+        assert np.array_equal(got[k].view(np.uint32), want[:, c].astype(np.uint32)), k
+    assert got["hit"].sum() > 0
+    fresh = u.eval_columns(cols)
+    assert np.array_equal(fresh["t"].view(np.uint32), want[:, 2].astype(np.uint32))
+    with pytest.raises(ValueError, match="f32"):
+        raypipe.Unit("rti", "fp16").eval_columns(cols)
+    with pytest.raises(ValueError, match="17"):
+        u.eval_columns(cols[:16].copy())
+    with pytest.raises(ValueError, match="not 5000"):
+        u.eval_columns(cols, out={"t": np.zeros(10, dtype=np.float32)})
+    with pytest.raises(ValueError, match="float32"):
+        u.eval_columns(cols, out={"t": np.zeros(n, dtype=np.float64)})
+    # a Fortran-ordered array is read in its logical order (copied), not its memory order
+    f = u.eval_columns(np.asfortranarray(cols))
+    assert np.array_equal(f["t"].view(np.uint32), want[:, 2].astype(np.uint32))
+    assert np.array_equal(u.eval_batch(np.asfortranarray(rows)), want)
