@@ -363,6 +363,40 @@ mod tests {
         assert!(!c.overflow);
     }
 
+    /// The quotient's bound, worked by hand from the module documentation (every value below
+    /// is exact in binary64, so the order of the operations does not matter): num = 3 ± 0.5,
+    /// det = −2 ± 0.25, D = 1.75: q = −1.5, Δ₁ = (0.5 + 1.5·0.25) / 1.75 = 0.5, |q| + Δ₁ = 2;
+    /// recip-mul adds (2u + u²)·2 + eta·(3 + 0.5)·(1 + u) + eta, divide adds u·2 + eta; a det
+    /// not clear of zero gives +∞; 1/D and |q| + Δ₁ + extra above max raise the overflow flag.
+    #[test]
+    fn the_quotient_bound_is_the_documented_one() {
+        use crate::format::DivMode;
+        let num = Bnd { v: 3.0, a: 0.0, e: 0.5 };
+        let det = Bnd { v: -2.0, a: 0.0, e: 0.25 };
+        let mut c = ctx();
+        let (u, eta) = (c.u, c.eta);
+        let r = c.quot(num, det, 1.75, true, DivMode::RecipMul);
+        assert_eq!(r, 0.5 + (2.0 * u + u * u) * 2.0 + eta * 3.5 * (1.0 + u) + eta);
+        assert!(!c.overflow);
+        let r = c.quot(num, det, 1.75, true, DivMode::Divide);
+        assert_eq!(r, 0.5 + u * 2.0 + eta);
+        assert!(!c.overflow);
+        assert_eq!(c.quot(num, det, -0.5, false, DivMode::Divide), f64::INFINITY);
+        assert!(!c.overflow, "no bound, no overflow claim");
+        // |q| + Δ₁ + extra = 2.0… above a max of 2
+        let mut c = Ctx { max: 2.0, ..ctx() };
+        c.quot(num, det, 1.75, true, DivMode::Divide);
+        assert!(c.overflow);
+        // recip-mul: 1/D above max (D = 0.25: 4 > max 3) even where the quotient is not
+        let mut c = Ctx { max: 3.0, ..ctx() };
+        let small = Bnd { v: 0.125, a: 0.0, e: 0.0 };
+        c.quot(small, Bnd { v: -1.0, a: 0.0, e: 0.75 }, 0.25, true, DivMode::RecipMul);
+        assert!(c.overflow, "the reciprocal 1/D = 4 exceeds max");
+        let mut c = Ctx { max: 3.0, ..ctx() };
+        c.quot(small, Bnd { v: -1.0, a: 0.0, e: 0.75 }, 0.25, true, DivMode::Divide);
+        assert!(!c.overflow, "divide forms no reciprocal");
+    }
+
     /// The overflow flag rises when |v| + e exceeds the largest magnitude (or is NaN), even
     /// when |v| alone does not, and stays raised.
     #[test]
