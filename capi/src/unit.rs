@@ -49,10 +49,6 @@ trait Eval: Send + Sync {
         stages: Option<&mut Vec<u64>>,
         names: Option<&mut Vec<(String, u32)>>,
     );
-    /// The format's encoding of `x` (rounded as the format's conversion rounds).
-    fn encode(&self, x: f64) -> u64;
-    /// The value of an encoding.
-    fn decode(&self, bits: u64) -> f64;
     /// `out` rows for `input` rows (row-major), on the SIMD kernels where the format has them.
     fn batch(&self, input: &[u64], out: &mut [u64]);
 }
@@ -67,6 +63,23 @@ struct SlabUnit<F: Format> {
 
 struct OpUnit<F: Format> {
     f: F,
+}
+
+/// A format's conversions from and to binary64, behind one object for every unit.
+trait Codec: Send + Sync {
+    /// The format's encoding of `x` (rounded as the format's conversion rounds).
+    fn encode(&self, x: f64) -> u64;
+    /// The value of an encoding.
+    fn decode(&self, bits: u64) -> f64;
+}
+
+impl<F: Format + Send + Sync> Codec for F {
+    fn encode(&self, x: f64) -> u64 {
+        self.to_bits(self.from_f64(x))
+    }
+    fn decode(&self, bits: u64) -> f64 {
+        self.to_f64(self.from_bits(bits))
+    }
 }
 
 /// Rows per SIMD batch (the columns stay in cache).
@@ -107,12 +120,6 @@ where
             *n = names_of(&rec, self.rti.fmt.width());
         }
         copy_rows(out, vectors::gen::rti_out_rows(&self.rti, &ray, &tri, &NoFault), stages);
-    }
-    fn encode(&self, x: f64) -> u64 {
-        self.rti.fmt.to_bits(self.rti.fmt.from_f64(x))
-    }
-    fn decode(&self, bits: u64) -> f64 {
-        self.rti.fmt.to_f64(self.rti.fmt.from_bits(bits))
     }
     fn batch(&self, input: &[u64], out: &mut [u64]) {
         let f = &self.rti.fmt;
@@ -171,12 +178,6 @@ where
         }
         copy_rows(out, vectors::gen::slab_out_rows(&self.s, input, &NoFault), stages);
     }
-    fn encode(&self, x: f64) -> u64 {
-        self.s.fmt.to_bits(self.s.fmt.from_f64(x))
-    }
-    fn decode(&self, bits: u64) -> f64 {
-        self.s.fmt.to_f64(self.s.fmt.from_bits(bits))
-    }
     fn batch(&self, input: &[u64], out: &mut [u64]) {
         let f = &self.s.fmt;
         // one set of columns for every chunk (cleared, its capacity kept)
@@ -231,12 +232,6 @@ impl<F: Format + Send + Sync + 'static> Eval for OpUnit<F> {
         }
         copy_rows(out, vectors::gen::op_out_rows(&self.f, input, &NoFault), stages);
     }
-    fn encode(&self, x: f64) -> u64 {
-        self.f.to_bits(self.f.from_f64(x))
-    }
-    fn decode(&self, bits: u64) -> f64 {
-        self.f.to_f64(self.f.from_bits(bits))
-    }
     fn batch(&self, input: &[u64], out: &mut [u64]) {
         for (row, o) in input.chunks_exact(3).zip(out.chunks_exact_mut(2)) {
             self.eval(row, o, None, None);
@@ -269,12 +264,6 @@ where
         }
         out.copy_from_slice(&vectors::traverse::ray_row(&self.s, &self.hw, self.leaves, input, &NoFault));
     }
-    fn encode(&self, x: f64) -> u64 {
-        self.s.fmt.to_bits(self.s.fmt.from_f64(x))
-    }
-    fn decode(&self, bits: u64) -> f64 {
-        self.s.fmt.to_f64(self.s.fmt.from_bits(bits))
-    }
     fn batch(&self, input: &[u64], out: &mut [u64]) {
         let no = out.len() / (input.len() / 8).max(1);
         for (row, o) in input.chunks_exact(8).zip(out.chunks_exact_mut(no.max(1))) {
@@ -305,6 +294,8 @@ pub struct Unit {
     pub output_widths: Vec<u32>,
     /// Each output's name (the expected file's field names).
     pub output_names: Vec<String>,
+    /// The format's conversions.
+    codec: Box<dyn Codec>,
     /// The same RTI unit typed, when the format is f32 (columnar batches of binary32 lanes).
     pub rti_f32: Option<Rti<datapath::format::Ieee<datapath::format::F32Native>>>,
     eval: Box<dyn Eval>,
@@ -416,6 +407,7 @@ impl Unit {
             output_widths,
             output_names,
             rti_f32,
+            codec: with_format!(any, |f| Box::new(f) as Box<dyn Codec>),
             eval,
         };
         let (zero, mut out, mut names) = (vec![0u64; kind.inputs()], vec![0u64; u.outputs()], Vec::new());
@@ -499,6 +491,7 @@ impl Unit {
             output_widths,
             output_names,
             rti_f32: None,
+            codec: with_format!(any, |f| Box::new(f) as Box<dyn Codec>),
             eval,
         };
         // the tree and N must give rows of the set's width
@@ -513,13 +506,13 @@ impl Unit {
 
     /// The format's encoding of `x`, rounded as the format's conversion from binary64 rounds.
     pub fn encode(&self, x: f64) -> u64 {
-        self.eval.encode(x)
+        self.codec.encode(x)
     }
 
     /// The value of encoding `bits` as binary64 (exact for every format of at most 53
     /// significant bits).
     pub fn decode(&self, bits: u64) -> f64 {
-        self.eval.decode(bits)
+        self.codec.decode(bits)
     }
 
     /// One row's outputs and, when `stages` is given, its stage signals (the row is checked).

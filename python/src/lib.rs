@@ -173,34 +173,9 @@ impl Unit {
         };
         // the output columns: the caller's (`out`, reused across calls: no fresh pages to
         // fault in), or new ones
-        let given = |name: &str| -> PyResult<Option<Bound<'py, PyAny>>> {
-            match &out {
-                Some(d) => d.get_item(name),
-                None => Ok(None),
-            }
-        };
-        let pick_b = |name: &str| -> PyResult<Bound<'py, PyArray1<bool>>> {
-            let Some(a) = given(name)? else { return Ok(PyArray1::<bool>::zeros(py, n, false)) };
-            let a = a
-                .downcast_into::<PyArray1<bool>>()
-                .map_err(|_| PyValueError::new_err(format!("out[{name:?}] must be a bool array")))?;
-            match a.len() == n {
-                true => Ok(a),
-                false => Err(PyValueError::new_err(format!("out[{name:?}] has {} values, not {n}", a.len()))),
-            }
-        };
-        let pick_f = |name: &str| -> PyResult<Bound<'py, PyArray1<f32>>> {
-            let Some(a) = given(name)? else { return Ok(PyArray1::<f32>::zeros(py, n, false)) };
-            let a = a
-                .downcast_into::<PyArray1<f32>>()
-                .map_err(|_| PyValueError::new_err(format!("out[{name:?}] must be a float32 array")))?;
-            match a.len() == n {
-                true => Ok(a),
-                false => Err(PyValueError::new_err(format!("out[{name:?}] has {} values, not {n}", a.len()))),
-            }
-        };
-        let (valid, hit) = (pick_b("valid")?, pick_b("hit")?);
-        let (t, u, v) = (pick_f("t")?, pick_f("u")?, pick_f("v")?);
+        let (valid, hit) = (out_column::<bool>(py, &out, "valid", n)?, out_column::<bool>(py, &out, "hit", n)?);
+        let t = out_column::<f32>(py, &out, "t", n)?;
+        let (u, v) = (out_column::<f32>(py, &out, "u", n)?, out_column::<f32>(py, &out, "v", n)?);
         {
             let (mut wv, mut wh, mut wt, mut wu, mut ww) =
                 (valid.readwrite(), hit.readwrite(), t.readwrite(), u.readwrite(), v.readwrite());
@@ -271,6 +246,29 @@ impl Unit {
     }
 }
 
+/// The output column `name` of length `n`: the caller's array in `out` (checked: its type
+/// and length), or a new one.
+fn out_column<'py, T: numpy::Element>(
+    py: Python<'py>,
+    out: &Option<Bound<'py, PyDict>>,
+    name: &str,
+    n: usize,
+) -> PyResult<Bound<'py, PyArray1<T>>> {
+    let given = match out {
+        Some(d) => d.get_item(name)?,
+        None => None,
+    };
+    let Some(a) = given else { return Ok(PyArray1::<T>::zeros(py, n, false)) };
+    let what = if std::any::type_name::<T>() == "bool" { "a bool" } else { "a float32" };
+    let a = a
+        .downcast_into::<PyArray1<T>>()
+        .map_err(|_| PyValueError::new_err(format!("out[{name:?}] must be {what} array")))?;
+    match a.len() == n {
+        true => Ok(a),
+        false => Err(PyValueError::new_err(format!("out[{name:?}] has {} values, not {n}", a.len()))),
+    }
+}
+
 /// A format name parsed: `{"name", "width", "kind": "float" | "fixed", "exp_bits" and
 /// "man_bits" | "int_bits" and "frac_bits", "contract": {...}}`; ValueError if bad.
 #[pyfunction]
@@ -278,7 +276,8 @@ fn parse_format<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>
     use datapath::Format;
     let any: datapath::AnyFormat = name.parse().map_err(|e: String| PyValueError::new_err(e))?;
     let d = PyDict::new(py);
-    let (name, width, kind, c) = datapath::with_format!(&any, |f| (f.name(), f.width(), f.kind(), f.contract()));
+    let (name, width, kind, contract) =
+        datapath::with_format!(&any, |f| (f.name(), f.width(), f.kind(), vectors::gen::contract_map(f)));
     d.set_item("name", name)?;
     d.set_item("width", width)?;
     match kind {
@@ -294,15 +293,7 @@ fn parse_format<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>
         }
     }
     let cd = PyDict::new(py);
-    for (k, v) in [
-        ("encoding", c.encoding),
-        ("rounding", c.rounding),
-        ("subnormals", c.subnormals),
-        ("nan", c.nan),
-        ("overflow", c.overflow),
-        ("division", c.division),
-        ("compare", c.compare),
-    ] {
+    for (k, v) in contract {
         cd.set_item(k, v)?;
     }
     d.set_item("contract", cd)?;

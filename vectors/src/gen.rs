@@ -98,7 +98,8 @@ pub struct VectorSet {
     pub files: Vec<(String, String)>,
 }
 
-fn contract_map<F: Format>(f: &F) -> BTreeMap<String, String> {
+/// A format's contract as the manifest's `contract` object: clause name → its words.
+pub fn contract_map<F: Format>(f: &F) -> BTreeMap<String, String> {
     let c = f.contract();
     [
         ("encoding", c.encoding),
