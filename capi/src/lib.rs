@@ -101,17 +101,23 @@ unsafe fn handle<'a>(u: *const RpUnit) -> Result<&'a unit::Unit, Fail> {
     Ok(unsafe { &(*u).0 })
 }
 
-/// `n` values at `p`, checked for null and alignment.
-///
-/// # Safety
-/// `p` is null or points to `n` readable `uint64_t`.
-unsafe fn slice<'a>(p: *const u64, n: usize, what: &str) -> Result<&'a [u64], Fail> {
+/// `p` (naming `what`) is not null and aligned for `u64`.
+fn check_ptr(p: *const u64, what: &str) -> Result<(), Fail> {
     if p.is_null() {
         return Err(Fail(RP_ERR_NULL, format!("{what} is a null pointer")));
     }
     if !(p as usize).is_multiple_of(std::mem::align_of::<u64>()) {
         return Err(Fail(RP_ERR_ALIGN, format!("{what} is not aligned to 8 bytes")));
     }
+    Ok(())
+}
+
+/// `n` values at `p`, checked for null and alignment.
+///
+/// # Safety
+/// `p` is null or points to `n` readable `uint64_t`.
+unsafe fn slice<'a>(p: *const u64, n: usize, what: &str) -> Result<&'a [u64], Fail> {
+    check_ptr(p, what)?;
     // SAFETY: non-null, aligned, n values (the caller's promise)
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
 }
@@ -121,12 +127,7 @@ unsafe fn slice<'a>(p: *const u64, n: usize, what: &str) -> Result<&'a [u64], Fa
 /// # Safety
 /// `p` is null or points to `n` writable `uint64_t` not otherwise borrowed.
 unsafe fn slice_mut<'a>(p: *mut u64, n: usize, what: &str) -> Result<&'a mut [u64], Fail> {
-    if p.is_null() {
-        return Err(Fail(RP_ERR_NULL, format!("{what} is a null pointer")));
-    }
-    if !(p as usize).is_multiple_of(std::mem::align_of::<u64>()) {
-        return Err(Fail(RP_ERR_ALIGN, format!("{what} is not aligned to 8 bytes")));
-    }
+    check_ptr(p, what)?;
     // SAFETY: non-null, aligned, n values, exclusive (the caller's promise)
     Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
 }
@@ -310,11 +311,9 @@ pub unsafe extern "C" fn rp_decode(u: *const RpUnit, bits: u64, x: *mut f64) -> 
         if x.is_null() {
             return Err(Fail(RP_ERR_NULL, "x is a null pointer".into()));
         }
-        if h.width < 64 && bits >> h.width != 0 {
-            return Err(arg(format!("{bits:#x} has bits above the format's {} bits", h.width)));
-        }
+        let value = h.decode(bits).map_err(arg)?;
         // SAFETY: non-null and writable (the caller's promise)
-        unsafe { *x = h.decode(bits) };
+        unsafe { *x = value };
         Ok(())
     })
 }

@@ -49,6 +49,10 @@ trait Eval: Send + Sync {
         stages: Option<&mut Vec<u64>>,
         names: Option<&mut Vec<(String, u32)>>,
     );
+    /// The unit as an f32 RTI unit, when it is one (columnar batches of binary32 lanes).
+    fn rti_f32(&self) -> Option<&Rti<F32Format>> {
+        None
+    }
     /// `out` rows for `input` rows (row-major), on the SIMD kernels where the format has them.
     fn batch(&self, input: &[u64], out: &mut [u64]);
 }
@@ -81,6 +85,9 @@ impl<F: Format + Send + Sync> Codec for F {
         self.to_f64(self.from_bits(bits))
     }
 }
+
+/// The f32 format (binary32 lanes).
+type F32Format = datapath::format::Ieee<datapath::format::F32Native>;
 
 /// Rows per SIMD batch (the columns stay in cache).
 const CHUNK: usize = 1024;
@@ -120,6 +127,9 @@ where
             *n = names_of(&rec, self.rti.fmt.width());
         }
         copy_rows(out, vectors::gen::rti_out_rows(&self.rti, &ray, &tri, &NoFault), stages);
+    }
+    fn rti_f32(&self) -> Option<&Rti<F32Format>> {
+        (&self.rti as &dyn std::any::Any).downcast_ref()
     }
     fn batch(&self, input: &[u64], out: &mut [u64]) {
         let f = &self.rti.fmt;
@@ -296,8 +306,6 @@ pub struct Unit {
     pub output_names: Vec<String>,
     /// The format's conversions.
     codec: Box<dyn Codec>,
-    /// The same RTI unit typed, when the format is f32 (columnar batches of binary32 lanes).
-    pub rti_f32: Option<Rti<datapath::format::Ieee<datapath::format::F32Native>>>,
     eval: Box<dyn Eval>,
 }
 
@@ -371,10 +379,6 @@ impl Unit {
             det_threshold: o.det_threshold,
             tie: o.tie.unwrap_or(TieRule::First),
         };
-        let rti_f32 = match (&any, kind) {
-            (AnyFormat::F32(f), Kind::Rti) => Some(Rti::new(*f, cfg)),
-            _ => None,
-        };
         let eval: Box<dyn Eval> = match kind {
             Kind::Rti => {
                 with_format!(any, |f| Box::new(RtiUnit { rti: Rti::new(f, cfg) }))
@@ -406,7 +410,6 @@ impl Unit {
             has_stages,
             output_widths,
             output_names,
-            rti_f32,
             codec: with_format!(any, |f| Box::new(f) as Box<dyn Codec>),
             eval,
         };
@@ -436,11 +439,19 @@ impl Unit {
                 if b > 5 {
                     return Err(format!("op code {b}: 0 add, 1 sub, 2 mul, 3 div, 4 lt, 5 le"));
                 }
-            } else if self.width < 64 && b >> self.width != 0 {
-                return Err(format!("input {i} ({b:#x}) has bits above the format's {} bits", self.width));
+            } else {
+                self.check_bits(b).map_err(|e| format!("input {i}: {e}"))?;
             }
         }
         Ok(())
+    }
+
+    /// An encoding of the format: no bits above its width.
+    pub fn check_bits(&self, b: u64) -> Result<(), String> {
+        match self.width < 64 && b >> self.width != 0 {
+            true => Err(format!("{b:#x} has bits above the format's {} bits", self.width)),
+            false => Ok(()),
+        }
     }
 
     /// Values in an output row.
@@ -490,7 +501,6 @@ impl Unit {
             has_stages: false,
             output_widths,
             output_names,
-            rti_f32: None,
             codec: with_format!(any, |f| Box::new(f) as Box<dyn Codec>),
             eval,
         };
@@ -510,9 +520,60 @@ impl Unit {
     }
 
     /// The value of encoding `bits` as binary64 (exact for every format of at most 53
-    /// significant bits).
-    pub fn decode(&self, bits: u64) -> f64 {
-        self.codec.decode(bits)
+    /// significant bits); an error when `bits` is not an encoding of the format.
+    pub fn decode(&self, bits: u64) -> Result<f64, String> {
+        self.check_bits(bits)?;
+        Ok(self.codec.decode(bits))
+    }
+
+    /// f32 RTI tests from columns: `cols` holds the 17 input columns of `n` tests one after the
+    /// other (in the order of the input row); the outputs go to `valid`, `hit`, `t`, `u`, `v`
+    /// (n each). The columns stream through the binary32 kernels in L1-sized chunks: the
+    /// layout the kernels read, no per-row conversion. An error for a unit that is not f32 RTI
+    /// or lengths that do not fit.
+    pub fn rti_columns_f32(
+        &self,
+        cols: &[f32],
+        valid: &mut [bool],
+        hit: &mut [bool],
+        t: &mut [f32],
+        u: &mut [f32],
+        v: &mut [f32],
+    ) -> Result<(), String> {
+        let rti = self.eval.rti_f32().ok_or("columnar batches run rti units in f32")?;
+        let n = valid.len();
+        if cols.len() != 17 * n || [hit.len(), t.len(), u.len(), v.len()].iter().any(|&l| l != n) {
+            return Err(format!("{} column values and outputs of {n}: not 17 columns of {n}", cols.len()));
+        }
+        let col = |k: usize| &cols[k * n..(k + 1) * n];
+        let (mut rays, mut tris) = (RaysSoa::<f32>::with_capacity(CHUNK), TrisSoa::<f32>::with_capacity(CHUNK));
+        let mut hits = HitsSoa::<f32>::with_len(CHUNK);
+        let mut start = 0;
+        while start < n {
+            let end = (start + CHUNK).min(n);
+            let fill = |dst: &mut Vec<f32>, k: usize| {
+                dst.clear();
+                dst.extend_from_slice(&col(k)[start..end]);
+            };
+            for a in 0..3 {
+                fill(&mut rays.o[a], a);
+                fill(&mut rays.d[a], 3 + a);
+                for j in 0..3 {
+                    fill(&mut tris.v[j][a], 8 + 3 * j + a);
+                }
+            }
+            fill(&mut rays.tmin, 6);
+            fill(&mut rays.tmax, 7);
+            hits.resize(end - start);
+            datapath::simd::rti_batch_f32(rti, &rays, &tris, &mut hits);
+            valid[start..end].copy_from_slice(&hits.valid);
+            hit[start..end].copy_from_slice(&hits.hit);
+            t[start..end].copy_from_slice(&hits.t);
+            u[start..end].copy_from_slice(&hits.u);
+            v[start..end].copy_from_slice(&hits.v);
+            start = end;
+        }
+        Ok(())
     }
 
     /// One row's outputs and, when `stages` is given, its stage signals (the row is checked).

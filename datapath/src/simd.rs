@@ -1397,12 +1397,6 @@ mod isa {
         pub fn blend(a: __m256d, b: __m256d, m: M) -> __m256d {
             _mm256_blendv_pd(a, b, m)
         }
-        /// `m ? min(lo, a) : lo` per lane.
-        #[inline]
-        #[target_feature(enable = "avx2")]
-        pub fn min_where(lo: __m256d, a: __m256d, m: M) -> __m256d {
-            _mm256_blendv_pd(lo, _mm256_min_pd(lo, a), m)
-        }
         /// `sign(x) ? b : a` per lane.
         #[inline]
         #[target_feature(enable = "avx2")]

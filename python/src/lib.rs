@@ -151,12 +151,6 @@ impl Unit {
         cols: PyReadonlyArray2<'py, f32>,
         out: Option<Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        use datapath::rti::{HitsSoa, RaysSoa, TrisSoa};
-        let rti = self
-            .u
-            .rti_f32
-            .as_ref()
-            .ok_or_else(|| PyValueError::new_err("eval_columns runs rti units in f32; use eval_batch"))?;
         if cols.shape()[0] != 17 {
             return Err(PyValueError::new_err(format!("{} columns; the rti unit takes 17", cols.shape()[0])));
         }
@@ -187,37 +181,8 @@ impl Unit {
                 wu.as_slice_mut().map_err(contiguous)?,
                 ww.as_slice_mut().map_err(contiguous)?,
             );
-            py.allow_threads(|| {
-                const CHUNK: usize = 1024;
-                let col = |k: usize| &src[k * n..(k + 1) * n];
-                let (mut rays, mut tris) = (RaysSoa::<f32>::with_capacity(CHUNK), TrisSoa::<f32>::with_capacity(CHUNK));
-                let mut hits = HitsSoa::<f32>::with_len(CHUNK);
-                let mut start = 0;
-                while start < n {
-                    let end = (start + CHUNK).min(n);
-                    let fill = |dst: &mut Vec<f32>, k: usize| {
-                        dst.clear();
-                        dst.extend_from_slice(&col(k)[start..end]);
-                    };
-                    for a in 0..3 {
-                        fill(&mut rays.o[a], a);
-                        fill(&mut rays.d[a], 3 + a);
-                        for j in 0..3 {
-                            fill(&mut tris.v[j][a], 8 + 3 * j + a);
-                        }
-                    }
-                    fill(&mut rays.tmin, 6);
-                    fill(&mut rays.tmax, 7);
-                    hits.resize(end - start);
-                    datapath::simd::rti_batch_f32(rti, &rays, &tris, &mut hits);
-                    ov[start..end].copy_from_slice(&hits.valid);
-                    oh[start..end].copy_from_slice(&hits.hit);
-                    ot[start..end].copy_from_slice(&hits.t);
-                    ou[start..end].copy_from_slice(&hits.u);
-                    ow[start..end].copy_from_slice(&hits.v);
-                    start = end;
-                }
-            });
+            let m = &self.u;
+            py.allow_threads(|| m.rti_columns_f32(src, ov, oh, ot, ou, ow)).map_err(PyValueError::new_err)?;
         }
         let d = PyDict::new(py);
         d.set_item("valid", valid)?;
@@ -235,10 +200,7 @@ impl Unit {
 
     /// The value of an encoding.
     fn decode(&self, bits: u64) -> PyResult<f64> {
-        if self.u.width < 64 && bits >> self.u.width != 0 {
-            return Err(PyValueError::new_err(format!("{bits:#x} has bits above the format's {} bits", self.u.width)));
-        }
-        Ok(self.u.decode(bits))
+        self.u.decode(bits).map_err(PyValueError::new_err)
     }
 
     fn __repr__(&self) -> String {
