@@ -6,6 +6,7 @@
 
 pub mod arch;
 pub mod bvh;
+pub mod camera;
 pub mod explain;
 pub mod faults;
 pub mod judge;

@@ -400,6 +400,18 @@ enum Cmd {
         /// Triangles per leaf at most.
         #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=255))]
         leaf_size: u32,
+        /// Eye position X,Y,Z (default: the automatic view, which frames the scene's bounding box from in front, to the right and above, or stands inside an enclosed scene).
+        #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+        eye: Option<[f64; 3]>,
+        /// The point at the image centre X,Y,Z (default: the bounding box's centre).
+        #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+        look_at: Option<[f64; 3]>,
+        /// Up direction X,Y,Z.
+        #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,1,0")]
+        up: [f64; 3],
+        /// Vertical field of view in degrees, in (0, 180).
+        #[arg(long, default_value_t = 45.0, allow_hyphen_values = true)]
+        fov: f64,
         /// Output directory for render.png and diff.png.
         #[arg(long, default_value = "render-out")]
         out: PathBuf,
@@ -617,6 +629,17 @@ enum Cmd {
 
 fn parse_format(s: &str) -> Result<AnyFormat, String> {
     s.parse()
+}
+
+/// A point or direction X,Y,Z (finite numbers).
+fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let v = parse_list("X,Y,Z", s, 3)?;
+    Ok([v[0], v[1], v[2]])
+}
+
+/// A point or direction as the command line takes it back.
+fn vec3(v: [f64; 3]) -> String {
+    format!("{},{},{}", v[0], v[1], v[2])
 }
 
 fn parse_list(what: &str, s: &str, n: usize) -> Result<Vec<f64>, String> {
@@ -958,17 +981,26 @@ fn run() -> Result<Outcome, String> {
             }
             Ok(Outcome::Pass)
         }
-        Some(Cmd::Render { scene, format, variant, width, height, leaf_size, out, json }) => {
-            let dir = OutDir::check(&out, &raypipe::render::FILES)?;
+        Some(Cmd::Render { scene, format, variant, width, height, leaf_size, eye, look_at, up, fov, out, json }) => {
             with_format!(format, |f| SlabConfig::named_for(&variant, &f).map(|_| ()))?;
             let scene = load_scene(scene.as_deref())?;
-            let rep =
-                with_format!(format, |f| raypipe::render::render(f, &variant, &scene, width, height, leaf_size, &dir))?;
+            let auto = raypipe::camera::Camera::auto(&scene, fov, width as f64 / height as f64);
+            let camera = raypipe::camera::Camera {
+                eye: eye.unwrap_or(auto.eye),
+                look_at: look_at.unwrap_or(auto.look_at),
+                up,
+                fov,
+            };
+            camera.check()?;
+            let dir = OutDir::check(&out, &raypipe::render::FILES)?;
+            let rep = with_format!(format, |f| raypipe::render::render(
+                f, &variant, &scene, &camera, width, height, leaf_size, &dir
+            ))?;
             emit(json, &rep, |rep| {
                 format!(
                     "raypipe render: scene {}, format {}, slab variant {}: {} pixels, golden hits {}, holes (golden hit, pipeline miss) {}, false hits {}, other triangle {}; wrote {}/render.png and {}/diff.png (red: hole, blue: false hit, yellow: other triangle)",
                     scene.name, rep.format, rep.variant, rep.pixels, rep.golden_hits, rep.holes, rep.false_hits, rep.other_triangle, out.display(), out.display()
-                ) + &format!("\nboxes the slab unit culled on the way to the golden closest hit: {}{}\n", rep.culled,
+                ) + &format!("\ncamera: --eye {} --look-at {} --up {} --fov {}", vec3(rep.camera.eye), vec3(rep.camera.look_at), vec3(rep.camera.up), rep.camera.fov) + &format!("\nboxes the slab unit culled on the way to the golden closest hit: {}{}\n", rep.culled,
                     if rep.conservative { if rep.culled > 0 { " (VIOLATION: the variant is conservative in this format)" } else { " (the variant is conservative in this format: must be 0)" } } else { "" })
             })?;
             Ok(Outcome::from(!(rep.conservative && rep.culled > 0)))

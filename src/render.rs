@@ -4,6 +4,7 @@
 //! test, f64 Möller–Trumbore), written as a shaded PNG and a diff PNG.
 
 use crate::bvh::build;
+use crate::camera::Camera;
 use crate::scene::Scene;
 use datapath::bvh::history_traverse;
 use datapath::rti::{Capture, Rti, RtiConfig};
@@ -35,6 +36,8 @@ pub struct RenderReport {
     pub culled: u64,
     /// The slab variant promises never to miss in this format (then `culled` must be 0).
     pub conservative: bool,
+    /// The camera the image was taken with.
+    pub camera: Camera,
 }
 
 /// The files [`render`] writes (checked before the work starts).
@@ -63,16 +66,20 @@ fn shade(scene: &Scene, tri: usize, d: [f64; 3]) -> u8 {
     (40.0 + 215.0 * c) as u8
 }
 
-/// Renders `width × height` primary rays; writes `render.png` and `diff.png` into `out`.
+/// Renders `width × height` primary rays from `camera`; writes `render.png` and `diff.png`
+/// into `out`.
+#[allow(clippy::too_many_arguments)]
 pub fn render<F: Format>(
     f: F,
     variant: &str,
     scene: &Scene,
+    camera: &Camera,
     width: u32,
     height: u32,
     leaf_size: u32,
     out: &vectors::outdir::OutDir,
 ) -> Result<RenderReport, String> {
+    camera.check()?;
     let sc = SlabConfig::named_for(variant, &f)?;
     let slab = Slab::new(f, sc);
     let rti = Rti::new(f, RtiConfig::default());
@@ -82,10 +89,6 @@ pub fn render<F: Format>(
     let boxes: Vec<_> =
         b.nodes.iter().map(|n| slab.store_box(n.min, n.max)).collect::<Result<_, _>>().map_err(|e| e.to_string())?;
     let tris: Vec<_> = scene.tris.iter().map(|t| rti.tri(t.v)).collect();
-    let (lo, hi) = scene.bounds();
-    let c: [f64; 3] = std::array::from_fn(|a| (lo[a] + hi[a]) / 2.0);
-    let ext = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max).max(1e-6);
-    let eye = [c[0], c[1], lo[2] - 1.5 * ext];
     let mut img = vec![0u8; (width * height * 3) as usize];
     let mut diff = vec![0u8; (width * height * 3) as usize];
     let mut rep = RenderReport {
@@ -98,6 +101,7 @@ pub fn render<F: Format>(
         other_triangle: 0,
         culled: 0,
         conservative: sc.is_conservative(&f),
+        camera: *camera,
     };
     let mut leaf_of = vec![u32::MAX; scene.tris.len()];
     for (l, tris) in b.leaf_tris.iter().enumerate() {
@@ -107,9 +111,7 @@ pub fn render<F: Format>(
     }
     for j in 0..height {
         for i in 0..width {
-            let sx = ((i as f64 + 0.5) / width as f64 - 0.5) * 0.8;
-            let sy = (0.5 - (j as f64 + 0.5) / height as f64) * 0.8 * height as f64 / width as f64;
-            let ray = Ray64 { o: eye, d: [sx, sy, 1.0], tmin: 0.0, tmax: f64::INFINITY };
+            let ray = Ray64 { o: camera.eye, d: camera.ray_dir(i, j, width, height), tmin: 0.0, tmax: f64::INFINITY };
             // the pipeline: slab-unit traversal, then the leaves' triangles through the min-capture
             let sr = slab.prepare(ray.o, ray.d, ray.tmin, ray.tmax);
             let leaves = history_traverse(&hw, usize::MAX, |&n| {

@@ -7,7 +7,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn raypipe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe")).args(args).output().expect("run raypipe")
+    Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .current_dir(std::env::temp_dir())
+        .args(args)
+        .output()
+        .expect("run raypipe")
 }
 
 /// A fresh, empty temporary directory for one test.
@@ -105,6 +109,7 @@ fn an_interrupted_write_leaves_nothing_and_its_leftover_is_cleaned() {
     // SIGINT at any moment of a run: no partial directory is left, and a set in place is whole
     for wait_ms in [5u64, 40, 120, 300, 600] {
         let mut child = Command::new(env!("CARGO_BIN_EXE_raypipe"))
+            .current_dir(std::env::temp_dir())
             .args([
                 "vectors",
                 "--unit",
@@ -204,6 +209,7 @@ fn a_non_utf8_argument_is_a_clear_error() {
     use std::os::unix::ffi::OsStrExt;
     let bad = std::ffi::OsStr::from_bytes(b"/tmp/raypipe-\xff\xfe");
     let o = Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .current_dir(std::env::temp_dir())
         .args(["vectors", "--unit", "op", "--format", "f32", "--out"])
         .arg(bad)
         .output()

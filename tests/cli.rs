@@ -5,7 +5,11 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn raypipe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe")).args(args).output().expect("run raypipe")
+    Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .current_dir(std::env::temp_dir())
+        .args(args)
+        .output()
+        .expect("run raypipe")
 }
 
 fn text(o: &Output) -> (String, String) {
@@ -300,6 +304,45 @@ fn render_writes_the_image_and_the_diff() {
         &raypipe(&["render", "--variant", "x", "--width", "4", "--height", "4"]),
         "unknown slab variant",
     );
+    // the camera: given in full (and echoed back), or refused with a clear error
+    let o = raypipe(&[
+        "render",
+        "--width",
+        "8",
+        "--height",
+        "6",
+        "--eye",
+        "0.5,0.3,-2",
+        "--look-at",
+        "0.5,0.3,0",
+        "--up",
+        "0,1,0",
+        "--fov",
+        "30",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["camera"]["eye"], serde_json::json!([0.5, 0.3, -2.0]));
+    assert_eq!(v["camera"]["look_at"], serde_json::json!([0.5, 0.3, 0.0]));
+    assert_eq!(v["camera"]["fov"], 30.0);
+    for (args, needle) in [
+        (&["--eye", "1,1,1", "--look-at", "1,1,1"][..], "same point"),
+        (&["--up", "0,0,0"][..], "--up is zero"),
+        (&["--eye", "0,5,0", "--look-at", "0,0,0"][..], "parallel"),
+        (&["--fov", "180"][..], "--fov 180"),
+        (&["--fov", "-5"][..], "--fov -5"),
+        (&["--eye", "1,2"][..], "expected 3"),
+        (&["--look-at", "1,x,2"][..], "not a number"),
+        (&["--eye", "inf,0,0"][..], "finite"),
+    ] {
+        let mut a = vec!["render", "--width", "4", "--height", "4"];
+        a.extend_from_slice(args);
+        assert_clear_error(&raypipe(&a), needle);
+    }
 }
 
 #[test]

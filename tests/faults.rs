@@ -5,7 +5,11 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn raypipe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe")).args(args).output().expect("run raypipe")
+    Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .current_dir(std::env::temp_dir())
+        .args(args)
+        .output()
+        .expect("run raypipe")
 }
 
 fn json(o: &Output) -> serde_json::Value {
@@ -361,6 +365,7 @@ fn a_closed_stdout_pipe_is_not_a_panic() {
     use std::os::unix::process::ExitStatusExt;
     use std::process::Stdio;
     let mut child = Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .current_dir(std::env::temp_dir())
         .args(["faults", "--unit", "op", "--json"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())

@@ -6,7 +6,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn raypipe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe")).args(args).output().expect("run raypipe")
+    Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .current_dir(std::env::temp_dir())
+        .args(args)
+        .output()
+        .expect("run raypipe")
 }
 
 fn dir(name: &str) -> PathBuf {
@@ -100,6 +104,7 @@ fn a_slurm_array_task_names_its_shard() {
     let mut a = RUN.to_vec();
     a.extend(["--shard", "slurm", "--partial", p.to_str().unwrap()]);
     let o = Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .current_dir(std::env::temp_dir())
         .args(&a)
         .env("SLURM_ARRAY_TASK_ID", "1")
         .env("SLURM_ARRAY_TASK_COUNT", "2")
@@ -110,6 +115,7 @@ fn a_slurm_array_task_names_its_shard() {
     assert_eq!((v["shard"]["k"].as_u64(), v["shard"]["n"].as_u64()), (Some(1), Some(2)));
     // outside a Slurm task
     let o = Command::new(env!("CARGO_BIN_EXE_raypipe"))
+        .current_dir(std::env::temp_dir())
         .args(&a)
         .env_remove("SLURM_ARRAY_TASK_ID")
         .env_remove("SLURM_ARRAY_TASK_COUNT")
