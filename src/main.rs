@@ -214,6 +214,17 @@ struct VerifyArgs {
 
 #[derive(Subcommand)]
 enum Cmd {
+    /// Print a shell completion script (bash, zsh, fish, elvish or powershell) on stdout.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff) of raypipe, or of one of its commands, on stdout.
+    Man {
+        /// A command (e.g. verify); none: the page of raypipe itself, which lists them.
+        command: Option<String>,
+    },
     /// Run every format's RTI model against the golden reference (the default command).
     Verify(VerifyArgs),
     /// Print every stage signal of one ray–triangle (or ray–box) test beside the references.
@@ -827,6 +838,31 @@ fn run() -> Result<Outcome, String> {
             rti: RtiArgs { cull: false, det_threshold: 0.0, tie: Tie::First },
         }),
         Some(Cmd::Verify(a)) => run_verify(a),
+        Some(Cmd::Completions { shell }) => {
+            use clap::CommandFactory;
+            clap_complete::generate(shell, &mut Cli::command(), "raypipe", &mut std::io::stdout());
+            Ok(Outcome::Pass)
+        }
+        Some(Cmd::Man { command }) => {
+            use clap::CommandFactory;
+            let mut cli = Cli::command();
+            cli.build();
+            let page = match command {
+                None => cli,
+                Some(name) => {
+                    let names: Vec<String> = cli.get_subcommands().map(|c| c.get_name().to_string()).collect();
+                    let sub = cli.find_subcommand(&name).ok_or_else(|| {
+                        format!("raypipe man: no command '{name}'; the commands: {}", names.join(", "))
+                    })?;
+                    // the page of `raypipe NAME` is named raypipe-NAME(1)
+                    sub.clone().name(format!("raypipe-{name}")).bin_name(format!("raypipe {name}"))
+                }
+            };
+            let mut roff = Vec::new();
+            clap_mangen::Man::new(page).render(&mut roff).map_err(|e| e.to_string())?;
+            std::io::Write::write_all(&mut std::io::stdout(), &roff).map_err(|e| e.to_string())?;
+            Ok(Outcome::Pass)
+        }
         Some(Cmd::Explain { unit, format, ray, tri, aabb, variant, tmin, tmax, rti, json }) => {
             let cfg = rti.config()?;
             let r = parse_list("--ray", &ray, 6)?;

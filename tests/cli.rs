@@ -603,3 +603,65 @@ fn speed_cap_limits_every_kernel_it_names() {
     assert!(!out.contains("Avx512"), "{out}");
     assert_clear_error(&raypipe(&["speed", "--cap", "avx3"]), "--cap");
 }
+
+/// Shell completions and man pages come from the same clap definitions as the parser: every
+/// command is in them, and the scripts parse in the shells installed here.
+#[test]
+fn completions_and_man_pages_cover_every_command() {
+    let commands = [
+        "verify", "explain", "traverse", "ops", "merge", "arch", "stats", "render", "vectors", "faults", "plan",
+        "report", "speed", "stress", "stages",
+    ];
+    for shell in ["bash", "zsh", "fish", "elvish", "powershell"] {
+        let o = raypipe(&["completions", shell]);
+        let (out, err) = text(&o);
+        assert!(o.status.success(), "{shell}: {err}");
+        for c in commands {
+            assert!(out.contains(c), "{shell} completions lack {c}");
+        }
+        // a shell that is installed checks the script's syntax
+        let sh = match shell {
+            "bash" | "zsh" => Some(shell),
+            _ => None,
+        };
+        if let Some(sh) = sh {
+            let dir = std::env::temp_dir().join(format!("raypipe-cli-{}-compl", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let f = dir.join(format!("raypipe.{sh}"));
+            std::fs::write(&f, &out).unwrap();
+            if let Ok(st) = std::process::Command::new(sh).arg("-n").arg(&f).status() {
+                assert!(st.success(), "{sh} -n rejects the completion script");
+            }
+        }
+    }
+    let (page, _) = text(&raypipe(&["man"]));
+    assert!(page.starts_with(".ie") || page.contains(".TH raypipe 1"), "{page}");
+    for c in commands {
+        assert!(page.contains(c), "the man page lacks {c}");
+        let o = raypipe(&["man", c]);
+        let (sub, err) = text(&o);
+        assert!(o.status.success(), "man {c}: {err}");
+        assert!(sub.contains(&format!(".TH raypipe-{c} 1")), "man {c}: {sub}");
+    }
+    assert!(text(&raypipe(&["man", "render"])).0.contains("look\\-at"));
+    assert_clear_error(&raypipe(&["man", "nope"]), "no command 'nope'");
+    assert_eq!(raypipe(&["completions", "tcsh"]).status.code(), Some(2));
+}
+
+/// `--help` names every value a choice accepts.
+#[test]
+fn help_lists_every_accepted_value() {
+    let help = |c: &str| text(&raypipe(&[c, "--help"])).0;
+    let v = help("vectors");
+    for unit in ["rti", "slab", "op", "traverse", "capture"] {
+        assert!(v.contains(unit), "vectors --help lacks unit {unit}");
+    }
+    for c in ["render", "explain", "traverse"] {
+        let h = help(c);
+        for variant in datapath::slab::SLAB_VARIANTS {
+            assert!(h.contains(variant), "{c} --help lacks slab variant {variant}");
+        }
+    }
+    assert!(help("speed").contains("avx512fp16"));
+    assert!(help("completions").contains("fish"));
+}
