@@ -948,10 +948,12 @@ fn run() -> Result<Outcome, String> {
             }
             match parts[0].command.as_str() {
                 "report" => {
-                    let rep = raypipe::report::finish(raypipe::partial::merge_data(
+                    let mut rep = raypipe::report::finish(raypipe::partial::merge_data(
                         &parts,
                         raypipe::report::ReportData::merge,
                     )?)?;
+                    // the timings come from the shards' machines; the merge names its own
+                    rep.command = command_as_typed();
                     if let Some(dir) = &dir {
                         for f in raypipe::report::write(&rep, dir)? {
                             eprintln!("wrote {}", f.display());
@@ -1252,7 +1254,8 @@ fn run() -> Result<Outcome, String> {
                 );
                 return shard_done(json, path, p);
             }
-            let rep = raypipe::report::report(&cfg, &scenes)?;
+            let mut rep = raypipe::report::report(&cfg, &scenes)?;
+            rep.command = command_as_typed();
             let files = raypipe::report::write(&rep, dir.as_ref().expect("checked when there is no partial"))?;
             emit(json, &rep, raypipe::report::markdown)?;
             for f in files {
@@ -1316,6 +1319,15 @@ fn run() -> Result<Outcome, String> {
 
 /// The command line as recorded in a vector set's manifest: without `--threads`, which does
 /// not change a single byte of the set.
+/// The command line as a user types it: `raypipe` and the arguments, without `--threads`.
+fn command_as_typed() -> String {
+    let c = command_without_threads();
+    match c.split_once(' ') {
+        Some((_, rest)) => format!("raypipe {rest}"),
+        None => "raypipe".to_string(),
+    }
+}
+
 fn command_without_threads() -> String {
     let mut out = Vec::new();
     let mut args = std::env::args();

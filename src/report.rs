@@ -100,6 +100,12 @@ pub struct Report {
     pub points: Vec<Point>,
     /// Format–variant pairs not run: the variant promises conservativeness the format cannot give.
     pub refused: Vec<String>,
+    /// The command line (set by the CLI; empty from the library).
+    #[serde(default)]
+    pub command: String,
+    /// The machine the timings were taken on (CPU model, cores, ISA).
+    #[serde(default)]
+    pub machine: String,
 }
 
 /// Scene rays against their target and 31 sampled triangles: (tests, false misses, false hits)
@@ -325,12 +331,21 @@ pub fn finish(d: ReportData) -> Result<Report, String> {
         seed: d.seed,
         points,
         refused: st.refused.clone(),
+        command: String::new(),
+        machine: crate::machine::machine(),
     })
 }
 
 /// The report as README-ready markdown.
 pub fn markdown(r: &Report) -> String {
-    let mut s = format!(
+    let mut s = String::new();
+    if !r.command.is_empty() {
+        s += &format!(
+            "`{}` on {} (ns/test is measured there; every other column is a count).\n\n",
+            r.command, r.machine
+        );
+    }
+    s += &format!(
         "Scenes: {}; {} rays per scene, {} stress cases per class, seed {}. Pareto: ★.\n\n",
         r.scenes.join(", "),
         r.rays,

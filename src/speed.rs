@@ -57,6 +57,8 @@ pub struct SpeedReport {
     /// The widest kernel allowed (`--cap`), when capped.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cap: Option<String>,
+    /// The machine: CPU model, cores, instruction-set extensions.
+    pub machine: String,
 }
 
 /// The RTI batch path of each format family (the SIMD kernels of `datapath::simd`).
@@ -503,6 +505,7 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         peak16_gops: (peak16 > 0.0).then_some(peak16 / 1e9),
         rows,
         cap: None,
+        machine: crate::machine::machine(),
     }
 }
 
@@ -531,7 +534,8 @@ fn half_mt(r: &[half::f16; 6], v: &[half::f16; 9]) -> bool {
 pub fn render(s: &SpeedReport) -> String {
     let p16 = s.peak16_gops.map_or(String::new(), |p| format!(", {p:.1} G lane-ops/s (binary16, AVX512-FP16)"));
     let mut out = format!(
-        "raypipe speed: {} pairs (built-in scene, seed {}), one thread; kernels{}: f32 {}, fp16 {}; measured no-FMA peak {:.1} G lane-ops/s (binary32){p16}\n\n",
+        "raypipe speed on {}: {} pairs (built-in scene, seed {}), one thread; kernels{}: f32 {}, fp16 {}; measured no-FMA peak {:.1} G lane-ops/s (binary32){p16}\n\n",
+        s.machine,
         s.pairs,
         s.seed,
         s.cap.as_ref().map_or(String::new(), |c| format!(" (capped at {c})")),

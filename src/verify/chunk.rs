@@ -80,6 +80,7 @@ struct RtiAcc {
     ulps: Hist,
     rels: Hist,
     first: First<(u64, u64), String>,
+    disagree: First<(u64, u64), String>,
     model_ns: u64,
 }
 
@@ -89,6 +90,7 @@ impl Merge for RtiAcc {
         self.ulps.merge(o.ulps);
         self.rels.merge(o.rels);
         self.first.merge(o.first);
+        self.disagree.merge(o.disagree);
         self.model_ns += o.model_ns;
     }
 }
@@ -301,6 +303,14 @@ where
             c[3] += mhit as u64;
             c[4] += (gh && !mhit) as u64;
             c[5] += (!gh && mhit) as u64;
+            if mhit != gh {
+                let tri = &self.scene.tris[blk[k] as usize];
+                acc.disagree.offer((ray_index, (base + k) as u64), || {
+                    let what = if gh { "false miss" } else { "false hit" };
+                    let how = if dec { "decisive" } else { "within the error bound" };
+                    format!("{what} ({how}): {}", explain_cmd(&self.name, ray, tri, self.scene.scale))
+                });
+            }
             if dec {
                 // the property of crate::judge::Judged::violation
                 let why = if mhit != gh {
@@ -484,6 +494,7 @@ impl FormatAcc {
                 mtests_per_s: rate(c[0], acc.model_ns),
                 judged_mtests_per_s: rate(c[0], self.wall_ns),
                 first_violation: acc.first.into_inner(),
+                first_disagreement: acc.disagree.into_inner(),
             }
         });
         let slab = self

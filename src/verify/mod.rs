@@ -89,6 +89,9 @@ pub struct FormatReport {
     pub divide_skipped: u64,
     /// The first property failure, as an `explain` command line.
     pub first_violation: Option<String>,
+    /// The first test (by ray, then test) where the model's hit/miss differs from the exact
+    /// decision, decisive or not, as an `explain` command line.
+    pub first_disagreement: Option<String>,
 }
 
 /// The whole run.
@@ -276,6 +279,11 @@ pub fn render(r: &VerifyReport) -> String {
         .collect::<Vec<_>>()
         .join(", ");
     s += "\n";
+    for f in r.formats.iter() {
+        if let Some(d) = &f.first_disagreement {
+            s += &format!("first disagreement, {}: {d}\n", f.format);
+        }
+    }
     s += &render_slab(&r.slab);
     if r.passed && !r.inconclusive.is_empty() {
         s += &format!(
