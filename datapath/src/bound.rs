@@ -415,4 +415,57 @@ mod tests {
         c.check(Bnd { v: f64::NAN, a: 0.0, e: 0.0 });
         assert!(c.overflow, "NaN");
     }
+
+    /// The block verdict equals the scalar `RtiBound::new` + `verdict` on every lane, on every
+    /// kernel this machine has (bits of `t_err` included), for ordinary and degenerate lanes.
+    #[test]
+    fn the_block_verdict_is_the_scalar_verdict_on_every_kernel() {
+        use super::{verdict_block, BlockOpts, BlockRay, RtiBound};
+        use crate::format::{DivMode, ErrorModel};
+        use crate::rti::Cull;
+        use crate::simd::{kernels_here, with_kernel_cap};
+        let mut r = crate::rng::SplitMix64::new(3);
+        let n = 37;
+        // every third lane a triangle around the ray's crossing of z = 0 (a hit), a degenerate
+        // one (v2 at the origin) every ninth, random ones otherwise
+        let around = [-1.0, -1.0, 0.0, 2.0, -1.0, 0.0, -1.0, 2.0, 0.0];
+        let cols: [Vec<f64>; 9] = std::array::from_fn(|k| {
+            (0..n)
+                .map(|i| match i % 9 {
+                    0 | 3 | 6 => around[k] + (r.unit() - 0.5) * 0.1,
+                    4 if k >= 6 => 0.0,
+                    _ => r.unit() * 2.0 - 1.0,
+                })
+                .collect()
+        });
+        let em = ErrorModel { u: 2f64.powi(-24), eta: 2f64.powi(-140), add_eta: 2f64.powi(-149), max: 3.4e38 };
+        let (mut seen_hit, mut seen_miss) = (false, false);
+        for (cull, thr, tmin, tmax) in [
+            (Cull::TwoSided, 0.0, 0.0, f64::INFINITY),
+            (Cull::Backface, 1e-3, 0.5, 4.0),
+            (Cull::TwoSided, 0.1, 1.0, 1.5),
+        ] {
+            let opts = BlockOpts { em, div: DivMode::Divide, cull, det_threshold: thr };
+            let ray = BlockRay { o: [0.1, -0.2, -3.0], d: [0.05, 0.1, 1.0], tmin, tmax };
+            let want: Vec<(bool, bool, u64)> = (0..n)
+                .map(|i| {
+                    let v = std::array::from_fn(|p| std::array::from_fn(|a| cols[3 * p + a][i]));
+                    let b = RtiBound::<f64>::new(em, DivMode::Divide, ray.o, ray.d, v);
+                    let vd = b.verdict(cull, thr, tmin, tmax);
+                    (vd.decisive, vd.hit, b.t_err.to_bits())
+                })
+                .collect();
+            seen_hit |= want.iter().any(|w| w.0 && w.1);
+            seen_miss |= want.iter().any(|w| w.0 && !w.1);
+            for k in kernels_here() {
+                let (mut dec, mut hit, mut te) = (vec![false; n], vec![true; n], vec![f64::NAN; n]);
+                let c: [&[f64]; 9] = std::array::from_fn(|j| cols[j].as_slice());
+                with_kernel_cap(k, || verdict_block(k, opts, ray, c, &mut dec, &mut hit, &mut te));
+                for i in 0..n {
+                    assert_eq!((dec[i], hit[i], te[i].to_bits()), want[i], "{k:?} lane {i}");
+                }
+            }
+        }
+        assert!(seen_hit && seen_miss, "the lanes hold decisive hits and misses");
+    }
 }
