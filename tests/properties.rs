@@ -134,7 +134,7 @@ fn the_reference_filter_is_decisive_only_where_exact_arithmetic_agrees() {
     use datapath::format::DivMode;
     use golden::{intersect_exact, Faces};
     let mut r = SplitMix64::new(0x5eed);
-    let mut c = |r: &mut SplitMix64| r.unit() * 2.0 - 1.0;
+    let c = |r: &mut SplitMix64| r.unit() * 2.0 - 1.0;
     let (mut decisive, mut n, mut hits) = (0u32, 0u32, 0u32);
     for k in 0..20_000u32 {
         let v: [[f64; 3]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| c(&mut r)));
