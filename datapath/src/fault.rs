@@ -112,3 +112,26 @@ impl<F: Format> Fault<F> for NoFault {
         cmp.eval(f, a, b)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{Logic, NoFault};
+
+    /// The fault-free control logic is the identity on bits and limits and the IEEE `<` on
+    /// distances (false when either is NaN), at every site.
+    #[test]
+    fn the_fault_free_logic_is_the_plain_logic() {
+        let vals = [f64::NEG_INFINITY, -1.0, -0.0, 0.0, 1e-300, 1.0, 2.0, f64::INFINITY, f64::NAN];
+        for a in vals {
+            for b in vals {
+                assert_eq!(NoFault.less("site", a, b), a < b, "{a} < {b}");
+            }
+        }
+        for v in [0usize, 1, 2, 7, 64, usize::MAX] {
+            assert_eq!(NoFault.limit("n_limit", v), v);
+        }
+        for v in [false, true] {
+            assert_eq!(NoFault.flag("take", v), v);
+        }
+    }
+}
