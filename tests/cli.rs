@@ -25,6 +25,13 @@ fn temp_file(name: &str, contents: &str) -> PathBuf {
     p
 }
 
+/// The JSON a successful run printed.
+fn success_json(o: &Output) -> serde_json::Value {
+    let (out, err) = text(o);
+    assert!(o.status.success(), "{err}");
+    serde_json::from_str(&out).unwrap()
+}
+
 fn assert_clear_error(o: &Output, needle: &str) {
     let (out, err) = text(o);
     assert_eq!(o.status.code(), Some(2), "stdout: {out}\nstderr: {err}");
@@ -288,9 +295,7 @@ fn render_writes_the_image_and_the_diff() {
         dir.to_str().unwrap(),
         "--json",
     ]);
-    let (out, err) = text(&o);
-    assert!(o.status.success(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let v = success_json(&o);
     assert_eq!(v["pixels"], 48 * 32);
     assert!(v["golden_hits"].as_u64().unwrap() > 300);
     // f32 on this scene: no holes at this resolution
@@ -323,9 +328,7 @@ fn render_writes_the_image_and_the_diff() {
         dir.to_str().unwrap(),
         "--json",
     ]);
-    let (out, err) = text(&o);
-    assert!(o.status.success(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let v = success_json(&o);
     assert_eq!(v["camera"]["eye"], serde_json::json!([0.5, 0.3, -2.0]));
     assert_eq!(v["camera"]["look_at"], serde_json::json!([0.5, 0.3, 0.0]));
     assert_eq!(v["camera"]["fov"], 30.0);
