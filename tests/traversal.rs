@@ -101,6 +101,23 @@ fn check_all_n(nodes: &[NodeDesc], outcome: &dyn Fn(u32) -> Option<f64>) -> Resu
         if !want.leaves.is_empty() && h.passes == 0 {
             return Err("history counted no pass".into());
         }
+        // both restart from the root after every pass but the last, and each restart resumes
+        // at a level of the tree: passes = restarts + 1, every back distance within the depth
+        for (name, r) in [("history", &h), ("trail", &t)] {
+            if r.passes > 0 && r.passes as usize != r.back_distances.len() + 1 {
+                return Err(format!("{name} N={n}: {} passes, {} restarts", r.passes, r.back_distances.len()));
+            }
+            if let Some(d) = r.back_distances.iter().find(|&&d| d as usize > hw.depth()) {
+                return Err(format!("{name} N={n}: back distance {d} deeper than the tree ({})", hw.depth()));
+            }
+        }
+        // the 1-bit trail retraces the 2-bit history's passes
+        if (t.passes, &t.back_distances) != (h.passes, &h.back_distances) {
+            return Err(format!(
+                "trail N={n}: passes {} back distances {:?}, history {} {:?}",
+                t.passes, t.back_distances, h.passes, h.back_distances
+            ));
+        }
     }
     Ok(())
 }

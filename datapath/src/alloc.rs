@@ -282,4 +282,11 @@ mod tests {
         assert!(r.is_err());
         assert_eq!(PLACEMENT.with(Cell::get), Placement::Staggered);
     }
+
+    /// The library's own test binary keeps the system allocator: `is_global` must say so (the
+    /// CLI's and `datapath/tests/alloc.rs`'s binaries install `Staggered` and see `true`).
+    #[test]
+    fn is_global_is_false_under_the_system_allocator() {
+        assert!(!super::is_global());
+    }
 }
