@@ -280,3 +280,46 @@ fn layout_with_real_boxes_in_a_narrow_storage_format() {
         }
     }
 }
+
+/// The history traversal under the `resume` fault (the pass resumes at the *shallowest* level
+/// in state 10 instead of the deepest), traced by hand on a balanced 8-leaf tree where every
+/// box is hit at the same entry t (so the left child is always the nearer):
+///
+/// | pass | resume | path (level 0, 1, 2) | leaf | history after |
+/// |---|---|---|---|---|
+/// | 1 | – | near, near, near | 0 | 10 10 10 |
+/// | 2 | level 0 | far (→ 11, deeper → 00), near, near | 4 | 11 10 10 |
+/// | 3 | level 1 | far, far (→ 11, deeper → 00), near | 6 | 11 11 10 |
+/// | 4 | level 2 | far, far, far (→ 11) | 7 | 11 11 11 |
+///
+/// Every pass ends at a leaf on level 2, so the back distances are 2 − 0, 2 − 1, 2 − 2.
+#[test]
+fn the_resume_fault_skips_the_subtrees_the_hand_trace_says() {
+    use datapath::bvh::{hist, history_traverse_faulty};
+    use datapath::fault::{Logic, NoFault};
+    struct Shallowest;
+    impl Logic for Shallowest {
+        fn flag(&self, site: &'static str, v: bool) -> bool {
+            if site == "resume" {
+                false
+            } else {
+                v
+            }
+        }
+    }
+    let inner = |l, r| NodeDesc { children: Some([l, r]), leaf: 0, min: [0.0; 3], max: [1.0; 3] };
+    let leaf = |id| NodeDesc { children: None, leaf: id, min: [0.0; 3], max: [1.0; 3] };
+    let mut nodes = vec![inner(1, 2), inner(3, 4), inner(5, 6)];
+    nodes.extend((0..4).map(|k| inner(7 + 2 * k, 8 + 2 * k)));
+    nodes.extend((0..8).map(leaf));
+    let hw = HwTree::build(&nodes, 0, 8, |i, _| Ok::<u32, String>(i)).unwrap();
+    let all = |_: &u32| Some(0.0);
+    let good = history_traverse_faulty(&hw, 100, all, &NoFault);
+    assert_eq!(good.leaves, (0..8).collect::<Vec<u32>>());
+    let bad = history_traverse_faulty(&hw, 100, all, &Shallowest);
+    assert_eq!(bad.leaves, [0, 4, 6, 7]);
+    assert_eq!(bad.passes, 4);
+    assert_eq!(bad.back_distances, [2, 1, 0]);
+    assert_eq!(bad.box_tests, 1 + 4 * 6);
+    assert_eq!(bad.state, [hist::DONE; 3]);
+}
