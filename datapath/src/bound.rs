@@ -231,7 +231,8 @@ impl<T: Lane> RtiBound<T> {
             & clear(self.tp.v, self.tp.err());
         let t = self.t();
         let (lo, hi) = (T::splat(tmin), T::splat(tmax));
-        // a valid case also decides t against the finite ends of [tmin, tmax]
+        // a valid case also decides t against the finite ends of [tmin, tmax] (an infinite
+        // or NaN end decides every finite t alike: no clearance from t's error is needed)
         let hit = valid & t.ge(lo) & t.le(hi);
         let t_clear = (T::mask(!tmin.is_finite()) | clear(t - lo, self.t_err))
             & (T::mask(!tmax.is_finite()) | clear(t - hi, self.t_err));
@@ -418,6 +419,34 @@ mod tests {
 
     /// The block verdict equals the scalar `RtiBound::new` + `verdict` on every lane, on every
     /// kernel this machine has (bits of `t_err` included), for ordinary and degenerate lanes.
+    #[test]
+    fn an_infinite_or_nan_end_of_the_t_range_needs_no_clearance() {
+        use super::RtiBound;
+        use crate::format::{DivMode, ErrorModel};
+        use crate::rti::Cull;
+        // a ray along +z from z = −3 through the middle of a triangle in z = 0: t = 3, clear
+        let em = ErrorModel { u: 2f64.powi(-24), eta: 2f64.powi(-140), add_eta: 2f64.powi(-149), max: 3.4e38 };
+        let v = [[-1.0, -1.0, 0.0], [2.0, -1.0, 0.0], [-1.0, 2.0, 0.0]];
+        let b = RtiBound::<f64>::new(em, DivMode::Divide, [0.0, 0.0, -3.0], [0.0, 0.0, 1.0], v);
+        assert_eq!(b.t(), 3.0);
+        assert!(b.t_err > 0.0 && b.t_err < 1e-5);
+        let verdict = |tmin, tmax| {
+            let vd = b.verdict(Cull::TwoSided, 0.0, tmin, tmax);
+            (vd.decisive, vd.hit)
+        };
+        // an infinite end decides every finite t the same way; so does a NaN end (t ≥ NaN and
+        // t ≤ NaN are false for every t): no clearance from t's error is asked of either
+        assert_eq!(verdict(0.0, f64::INFINITY), (true, true));
+        assert_eq!(verdict(f64::NEG_INFINITY, f64::INFINITY), (true, true));
+        assert_eq!(verdict(0.0, f64::NAN), (true, false));
+        assert_eq!(verdict(f64::NAN, 10.0), (true, false));
+        // a finite end within t's error of t is not decisive; one clear of it is
+        assert!(!verdict(0.0, 3.0).0);
+        assert!(!verdict(3.0, 10.0).0);
+        assert_eq!(verdict(2.0, 4.0), (true, true));
+        assert_eq!(verdict(3.5, 4.0), (true, false));
+    }
+
     #[test]
     fn the_block_verdict_is_the_scalar_verdict_on_every_kernel() {
         use super::{verdict_block, BlockOpts, BlockRay, RtiBound};
