@@ -39,8 +39,6 @@ pub trait Lane:
     fn gt(self, o: Self) -> Self::M {
         o.lt(self)
     }
-    /// Lanes that are finite.
-    fn finite(self) -> Self::M;
     /// `m ? a : b` per lane.
     fn select(m: Self::M, a: Self, b: Self) -> Self;
 }
@@ -66,10 +64,6 @@ impl Lane for f64 {
     #[inline(always)]
     fn lt(self, o: Self) -> bool {
         self < o
-    }
-    #[inline(always)]
-    fn finite(self) -> bool {
-        self.is_finite()
     }
     #[inline(always)]
     fn select(m: bool, a: Self, b: Self) -> Self {
