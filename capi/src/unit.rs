@@ -253,6 +253,8 @@ struct TraverseUnit<F: Format> {
     s: Slab<F>,
     hw: datapath::bvh::HwTree<Aabb<F::V>>,
     leaves: usize,
+    /// Values in an output row (the expected file's fields).
+    outputs: usize,
 }
 
 impl<F: Format + Send + Sync + 'static> Eval for TraverseUnit<F>
@@ -275,8 +277,7 @@ where
         out.copy_from_slice(&vectors::traverse::ray_row(&self.s, &self.hw, self.leaves, input, &NoFault));
     }
     fn batch(&self, input: &[u64], out: &mut [u64]) {
-        let no = out.len() / (input.len() / 8).max(1);
-        for (row, o) in input.chunks_exact(8).zip(out.chunks_exact_mut(no.max(1))) {
+        for (row, o) in input.chunks_exact(8).zip(out.chunks_exact_mut(self.outputs)) {
             self.eval(row, o, None, None);
         }
     }
@@ -489,7 +490,7 @@ impl Unit {
         let eval: Box<dyn Eval> = with_format!(any, |f| {
             let s = Slab::new(f, SlabConfig::named(&variant)?);
             let hw = vectors::traverse::tree_from_images(&s, root, &banks)?;
-            Box::new(TraverseUnit { s, hw, leaves })
+            Box::new(TraverseUnit { s, hw, leaves, outputs: output_names.len() })
         });
         let u = Unit {
             kind: Kind::Traverse,
@@ -586,9 +587,17 @@ impl Unit {
     /// The outputs of `n` rows (`input`: n × inputs, `out`: n × outputs, row-major), every row
     /// checked first.
     pub fn batch(&self, input: &[u64], out: &mut [u64]) -> Result<(), String> {
-        let ni = self.kind.inputs();
+        let (ni, no) = (self.kind.inputs(), self.outputs());
         if !input.len().is_multiple_of(ni) {
             return Err(format!("{} values are not whole rows of {ni}", input.len()));
+        }
+        if out.len() != input.len() / ni * no {
+            return Err(format!(
+                "{} input rows take {} outputs, got room for {}",
+                input.len() / ni,
+                input.len() / ni * no,
+                out.len()
+            ));
         }
         // the fast check (an OR over the encodings, op codes apart); the slow one names the row
         let w = self.width.min(63);

@@ -123,3 +123,33 @@ fn other_sets_and_bad_paths_are_clear_errors() {
     // SAFETY: null is an error code, not a crash
     assert_eq!(unsafe { rp_traverse_open(std::ptr::null(), &mut u) }, RP_ERR_NULL);
 }
+
+#[test]
+fn a_batch_whose_output_room_is_not_its_rows_is_refused() {
+    use raypipe_capi::unit::Unit as U;
+    let set = generate(&request("f32")).unwrap();
+    let dir = std::env::temp_dir().join(format!("raypipe-capi-trav-room-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    write_set(&set, &dir).unwrap();
+    let u = U::open_set(&dir).unwrap();
+    let rows = set_rows(&set).unwrap();
+    let input: Vec<u64> = rows[0].iter().take(3).flat_map(|r| r[1..].to_vec()).collect();
+    let no = u.outputs();
+    let mut exact = vec![0u64; 3 * no];
+    u.batch(&input, &mut exact).unwrap();
+    assert_eq!(exact, rows[1][..3].concat());
+    for room in [3 * no - 1, 3 * no + 1, 4 * no, 0] {
+        let mut out = vec![0u64; room];
+        let e = u.batch(&input, &mut out).unwrap_err();
+        assert!(e.contains("take") && e.contains(&room.to_string()), "{room}: {e}");
+    }
+    for (unit, fmt) in [("rti", "f32"), ("slab", "fp16"), ("op", "bf16")] {
+        let u = U::new(unit, fmt, "").unwrap();
+        let (ni, no) = (u.kind.inputs(), u.outputs());
+        let input = vec![0u64; 2 * ni];
+        assert!(u.batch(&input, &mut vec![0u64; 2 * no]).is_ok(), "{unit}");
+        assert!(u.batch(&input, &mut vec![0u64; 2 * no - 1]).is_err(), "{unit}");
+        assert!(u.batch(&input, &mut vec![0u64; 3 * no]).is_err(), "{unit}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
