@@ -417,8 +417,8 @@ mod tests {
         assert!(c.overflow, "NaN");
     }
 
-    /// The block verdict equals the scalar `RtiBound::new` + `verdict` on every lane, on every
-    /// kernel this machine has (bits of `t_err` included), for ordinary and degenerate lanes.
+    /// The verdict of a clear hit against [tmin, tmax] ends that are infinite, NaN, within t's
+    /// error of t, or clear of it.
     #[test]
     fn an_infinite_or_nan_end_of_the_t_range_needs_no_clearance() {
         use super::RtiBound;
@@ -447,6 +447,8 @@ mod tests {
         assert_eq!(verdict(3.5, 4.0), (true, false));
     }
 
+    /// The block verdict equals the scalar `RtiBound::new` + `verdict` on every lane, on every
+    /// kernel this machine has (bits of `t_err` included), for ordinary and degenerate lanes.
     #[test]
     fn the_block_verdict_is_the_scalar_verdict_on_every_kernel() {
         use super::{verdict_block, BlockOpts, BlockRay, RtiBound};
