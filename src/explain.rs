@@ -61,6 +61,9 @@ pub struct RtiTrace {
     pub golden: GoldenRti,
     /// The error bound's verdict.
     pub bound: BoundRti,
+    /// The bank fault the model ran with (`--inject`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub injected: Option<String>,
 }
 
 /// The golden RTI result.
@@ -117,10 +120,25 @@ fn flag(name: &str, b: bool) -> Value {
 
 /// The stage-by-stage trace of one ray–triangle test.
 pub fn trace_rti<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> RtiTrace {
+    trace_rti_faulty(rti, ray, tri, None)
+}
+
+/// [`trace_rti`] of the model running with a fault of the bank (`verify --inject`; None: the
+/// model itself).
+pub fn trace_rti_faulty<F: Format>(
+    rti: &Rti<F>,
+    ray: &Ray64,
+    tri: &Tri64,
+    inject: Option<&'static faults::bank::Spec>,
+) -> RtiTrace {
     let f = &rti.fmt;
     let (rq, tq) = quantise(rti, ray, tri);
     let mut rec = Recorder::new();
-    let out = rti.trace(&rti.ray(ray.o, ray.d, ray.tmin, ray.tmax), &rti.tri(tri.v), &mut rec);
+    let (mray, mtri) = (rti.ray(ray.o, ray.d, ray.tmin, ray.tmax), rti.tri(tri.v));
+    let out = match inject {
+        Some(spec) => rti.trace_faulty(&mray, &mtri, &mut rec, &faults::inject::Injected::new(spec)),
+        None => rti.trace(&mray, &mtri, &mut rec),
+    };
     // the same datapath in binary64 on the quantised inputs
     let twin_fmt = Ieee::new(Soft(FloatLayout::BINARY64), FpOpts { div: f.div_mode(), ..FpOpts::default() });
     let twin = Rti::new(twin_fmt, RtiConfig { cull: rti.cull, det_threshold: f.to_f64(rti.det_thr), tie: rti.tie });
@@ -207,6 +225,7 @@ pub fn trace_rti<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> RtiTrace 
             tp_err: b.tp.err(),
             t_err: b.t_err,
         },
+        injected: inject.map(|x| x.name.to_string()),
     }
 }
 
@@ -214,6 +233,9 @@ pub fn trace_rti<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> RtiTrace 
 pub fn render_rti(t: &RtiTrace) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "format {}  ({} bits per value)", t.format, t.width);
+    if let Some(name) = &t.injected {
+        let _ = writeln!(s, "injected fault: {name} (the model's signals below are the faulty datapath's)");
+    }
     let _ = writeln!(s, "inputs (quantised; hex = the bits an RTL testbench drives):");
     for v in &t.inputs {
         let _ = writeln!(s, "  {:<5} {:>24} {}", v.name, v.value, v.bits);

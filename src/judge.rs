@@ -157,6 +157,57 @@ mod tests {
         assert_eq!(reference(&r, &down(f64::NAN, 0.5), &TRI, true), (true, true));
     }
 
+    /// The property, case by case: nothing is asked of a test that is not decisive; a decisive
+    /// one fails on a hit/miss that differs from the reference, and on a shared hit whose t
+    /// error exceeds the bound (plus 1e-12 relative of t for the f64 evaluation of the error).
+    #[test]
+    fn a_violation_is_a_decisive_disagreement_or_a_t_beyond_its_bound() {
+        let golden = MtResult { hit: true, t: 2.0, ..golden::intersect(&down(0.25, 0.25), &TRI, Faces::default()) };
+        let j = Judged {
+            hit: true,
+            t: 2.0 + 1e-6,
+            golden,
+            reference_hit: true,
+            fell_through: false,
+            decisive: true,
+            exact_hit: true,
+            t_err: 1e-6,
+            ulp: 2f64.powi(-22),
+        };
+        assert_eq!(j.t_error(), (2.0 + 1e-6) - 2.0);
+        assert_eq!(j.violation(), None, "t error at the bound");
+        let slack = 2.0 * 1e-12;
+        assert_eq!(Judged { t: 2.0 + 1e-6 + slack * 0.5, ..j }.violation(), None, "within the f64 slack");
+        let over = Judged { t: 2.0 - 1e-6 - slack * 4.0, ..j };
+        assert!(over.violation().unwrap().starts_with("t error "), "{:?}", over.violation());
+        // exactly on the bound (2^-20 = t_err + 2·1e-12 in f64): not a violation
+        let on = Judged { t: 2.0 + 2f64.powi(-20), t_err: 2f64.powi(-20) - slack, ..j };
+        assert_eq!(on.t_err + on.golden.t.abs() * 1e-12, on.t_error());
+        assert_eq!(on.violation(), None);
+        let miss = Judged { hit: false, ..j };
+        assert_eq!(miss.violation().as_deref(), Some("hit/miss: model false exact true"));
+        let false_hit = Judged { reference_hit: false, exact_hit: false, ..j };
+        assert_eq!(false_hit.violation().as_deref(), Some("hit/miss: model true exact false"));
+        // the reference and the bound's exact decision disagree: reported too
+        assert!(Judged { exact_hit: false, ..j }.violation().unwrap().starts_with("hit/miss"));
+        // a shared miss has no t to judge; a non-decisive test is never a violation
+        assert_eq!(Judged { hit: false, reference_hit: false, exact_hit: false, t: 9.0, ..j }.violation(), None);
+        assert_eq!(Judged { decisive: false, hit: false, t: 9.0, ..j }.violation(), None);
+        assert_eq!(Judged { decisive: false, ..over }.violation(), None);
+    }
+
+    /// The golden's faces follow the unit's culling and its det threshold (as the format
+    /// stores it).
+    #[test]
+    fn the_golden_faces_are_the_units() {
+        let f = Ieee::new(F32Native, FpOpts::default());
+        assert_eq!(faces(&rti()), Faces { cull: false, det_threshold: 0.0 });
+        let culled = Rti::new(f, RtiConfig { cull: Cull::Backface, det_threshold: 0.1, ..RtiConfig::default() });
+        assert_eq!(faces(&culled), Faces { cull: true, det_threshold: 0.1f32 as f64 });
+        let two = Rti::new(f, RtiConfig { cull: Cull::TwoSided, det_threshold: 0.25, ..RtiConfig::default() });
+        assert_eq!(faces(&two), Faces { cull: false, det_threshold: 0.25 });
+    }
+
     /// The judge uses the reference: an on-edge test's reference hit is the exact one, and
     /// fell_through says so.
     #[test]

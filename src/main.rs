@@ -208,6 +208,10 @@ struct VerifyArgs {
     /// Write this shard's partial result to FILE (JSON) for `raypipe merge`.
     #[arg(long)]
     partial: Option<PathBuf>,
+    /// Run the RTI model with this fault of the bank (a name `raypipe faults --unit rti`
+    /// lists): a model wrong on purpose, to see the judge catch it on this scene.
+    #[arg(long)]
+    inject: Option<String>,
     #[command(flatten)]
     rti: RtiArgs,
 }
@@ -258,6 +262,9 @@ enum Cmd {
         /// Print the trace as JSON (every signal's value and bits, the references, the verdict).
         #[arg(long)]
         json: bool,
+        /// Run the RTI model with this fault of the bank (as `verify --inject`).
+        #[arg(long)]
+        inject: Option<String>,
     },
     /// The 2-bit ray history and 1-bit trail traversals against the stack traversal on a scene's BVH.
     Traverse {
@@ -735,6 +742,7 @@ fn load_scene(path: Option<&std::path::Path>) -> Result<Scene, String> {
 
 fn run_verify(a: VerifyArgs) -> Result<Outcome, String> {
     let rti = a.rti.config()?;
+    let inject = a.inject.as_deref().map(rti_fault).transpose()?;
     let scene = load_scene(a.scene.as_deref())?;
     let plan = a.plan.as_deref().map(raypipe::plan::load).transpose()?;
     if let Some(p) = &plan {
@@ -750,6 +758,7 @@ fn run_verify(a: VerifyArgs) -> Result<Outcome, String> {
     let mut cfg = VerifyConfig::new(formats, a.rays as usize, a.seed, rti, a.sample as usize);
     cfg.engine = engine::Engine::new(a.chunk).with_threads(a.threads.map(|t| t as usize)).with_shard(shard);
     cfg.progress = !a.quiet;
+    cfg.inject = inject;
     if let Some(path) = &a.partial {
         let data = raypipe::verify::accumulate(&cfg, &scene);
         let (args, hash) = (raypipe::verify::args(&cfg), raypipe::partial::scene_hash(&scene));
@@ -759,6 +768,20 @@ fn run_verify(a: VerifyArgs) -> Result<Outcome, String> {
     let rep = verify(&cfg, &scene);
     emit(a.json, &rep, render)?;
     Ok(rep.outcome())
+}
+
+/// The RTI fault of the bank named `name` (`verify --inject`).
+fn rti_fault(name: &str) -> Result<&'static faults::bank::Spec, String> {
+    match faults::bank::by_name(name) {
+        Some(x) if x.unit == "rti" => Ok(x),
+        Some(x) => Err(format!(
+            "--inject {name}: a {} fault; verify injects RTI faults (raypipe faults --unit rti lists them)",
+            x.unit
+        )),
+        None => {
+            Err(format!("--inject {name}: no such fault in the bank (raypipe faults --unit rti lists the RTI faults)"))
+        }
+    }
 }
 
 /// The shard of a run from `--shard` (checked against `--partial` before any work: a shard
@@ -835,6 +858,7 @@ fn run() -> Result<Outcome, String> {
             quiet: false,
             shard: None,
             partial: None,
+            inject: None,
             rti: RtiArgs { cull: false, det_threshold: 0.0, tie: Tie::First },
         }),
         Some(Cmd::Verify(a)) => run_verify(a),
@@ -863,8 +887,12 @@ fn run() -> Result<Outcome, String> {
             std::io::Write::write_all(&mut std::io::stdout(), &roff).map_err(|e| e.to_string())?;
             Ok(Outcome::Pass)
         }
-        Some(Cmd::Explain { unit, format, ray, tri, aabb, variant, tmin, tmax, rti, json }) => {
+        Some(Cmd::Explain { unit, format, ray, tri, aabb, variant, tmin, tmax, rti, json, inject }) => {
             let cfg = rti.config()?;
+            let inject = inject.as_deref().map(rti_fault).transpose()?;
+            if inject.is_some() && unit != "rti" {
+                return Err("--inject: explain injects RTI faults (--unit rti)".into());
+            }
             let r = parse_list("--ray", &ray, 6)?;
             check_interval(tmin, tmax)?;
             let ray = Ray64 { o: [r[0], r[1], r[2]], d: [r[3], r[4], r[5]], tmin, tmax };
@@ -872,7 +900,12 @@ fn run() -> Result<Outcome, String> {
                 "rti" => {
                     let t = parse_list("--tri", tri.as_deref().ok_or("--unit rti needs --tri")?, 9)?;
                     let tri = Tri64 { v: [[t[0], t[1], t[2]], [t[3], t[4], t[5]], [t[6], t[7], t[8]]] };
-                    let t = with_format!(format, |f| raypipe::explain::trace_rti(&Rti::new(f, cfg), &ray, &tri));
+                    let t = with_format!(format, |f| raypipe::explain::trace_rti_faulty(
+                        &Rti::new(f, cfg),
+                        &ray,
+                        &tri,
+                        inject
+                    ));
                     emit(json, &t, raypipe::explain::render_rti)?;
                 }
                 "slab" => {

@@ -59,10 +59,16 @@ pub fn test_list(n: usize, sample: usize, seed: u64, i: u64, target: usize, out:
 
 /// The `explain` command line of one test, in the scene's normalised coordinates.
 pub fn explain_cmd(fmt: &str, ray: &Ray64, tri: &Tri64, scale: f64) -> String {
+    explain_cmd_faulty(fmt, ray, tri, scale, None)
+}
+
+/// [`explain_cmd`] of a model running with a bank fault (`--inject NAME` added).
+pub fn explain_cmd_faulty(fmt: &str, ray: &Ray64, tri: &Tri64, scale: f64, inject: Option<&str>) -> String {
     let j = |xs: &[f64]| xs.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(",");
     let tv: Vec<f64> = tri.v.iter().flatten().copied().collect();
+    let x = inject.map(|n| format!(" --inject {n}")).unwrap_or_default();
     format!(
-        "raypipe explain --format {fmt} --ray {},{} --tri {}  # scene coordinates x {scale:?}",
+        "raypipe explain --format {fmt} --ray {},{} --tri {}{x}  # scene coordinates x {scale:?}",
         j(&ray.o),
         j(&ray.d),
         j(&tv)
@@ -236,6 +242,11 @@ where
         (acc, sacc)
     }
 
+    /// The `explain` command of one test of this run.
+    fn explain(&self, ray: &Ray64, tri: &Tri64) -> String {
+        explain_cmd_faulty(&self.name, ray, tri, self.scene.scale, self.cfg.inject.map(|x| x.name))
+    }
+
     #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
     fn rti_block(
         &self,
@@ -271,6 +282,15 @@ where
         let t0 = Instant::now();
         simd::rti_batch(&self.rti, &s.rays, &s.tris, &mut s.out);
         acc.model_ns += t0.elapsed().as_nanos() as u64;
+        if let Some(spec) = self.cfg.inject {
+            // a deliberately wrong model: the bank fault's stage model, lane by lane
+            let x = faults::inject::Injected::new(spec);
+            for (k, &ti) in blk.iter().enumerate() {
+                x.next_test();
+                let o = self.rti.trace_faulty(mray, &self.mtris[ti as usize], &mut datapath::probe::NoProbe, &x);
+                (s.out.valid[k], s.out.hit[k], s.out.t[k], s.out.u[k], s.out.v[k]) = (o.valid, o.hit, o.t, o.u, o.v);
+            }
+        }
         intersect_block(self.level, rq, self.faces, cols(&s.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
         let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
         verdict_block(
@@ -308,7 +328,7 @@ where
                 acc.disagree.offer((ray_index, (base + k) as u64), || {
                     let what = if gh { "false miss" } else { "false hit" };
                     let how = if dec { "decisive" } else { "within the error bound" };
-                    format!("{what} ({how}): {}", explain_cmd(&self.name, ray, tri, self.scene.scale))
+                    format!("{what} ({how}): {}", self.explain(ray, tri))
                 });
             }
             if dec {
@@ -323,9 +343,7 @@ where
                 if let Some(why) = why {
                     c[6] += 1;
                     let tri = &self.scene.tris[blk[k] as usize];
-                    acc.first.offer((ray_index, (base + k) as u64), || {
-                        format!("{why}: {}", explain_cmd(&self.name, ray, tri, self.scene.scale))
-                    });
+                    acc.first.offer((ray_index, (base + k) as u64), || format!("{why}: {}", self.explain(ray, tri)));
                 }
             }
             if mhit && gh {

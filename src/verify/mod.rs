@@ -29,6 +29,9 @@ pub struct VerifyConfig {
     pub engine: engine::Engine,
     /// Show progress on stderr (when it is a terminal and the run lasts over a second).
     pub progress: bool,
+    /// An RTI fault of the bank (`faults::bank`) the model runs with: a deliberately wrong
+    /// model, to see the judge catch it on this scene (None: the model itself).
+    pub inject: Option<&'static faults::bank::Spec>,
 }
 
 /// Rays per chunk of `verify` by default: 16 rays × 512 tests keep a chunk's columns in L2.
@@ -37,7 +40,16 @@ pub const CHUNK_RAYS: u64 = 16;
 impl VerifyConfig {
     /// A configuration with every core, the default chunk and no progress output.
     pub fn new(formats: Vec<AnyFormat>, rays: usize, seed: u64, rti: RtiConfig, sample: usize) -> Self {
-        VerifyConfig { formats, rays, seed, rti, sample, engine: engine::Engine::new(CHUNK_RAYS), progress: false }
+        VerifyConfig {
+            formats,
+            rays,
+            seed,
+            rti,
+            sample,
+            engine: engine::Engine::new(CHUNK_RAYS),
+            progress: false,
+            inject: None,
+        }
     }
 }
 
@@ -117,6 +129,9 @@ pub struct VerifyReport {
     pub passed: bool,
     /// Formats in which no test was decisive: the property was not tested there.
     pub inconclusive: Vec<String>,
+    /// The bank fault the model ran with (`--inject`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub injected: Option<String>,
 }
 
 impl VerifyReport {
@@ -154,6 +169,9 @@ pub struct VerifyData {
     pub tests_per_ray: usize,
     /// Per format, in the run's order.
     pub formats: Vec<chunk::FormatAcc>,
+    /// The bank fault the model ran with, if any.
+    #[serde(default)]
+    pub injected: Option<String>,
 }
 
 impl VerifyData {
@@ -161,6 +179,9 @@ impl VerifyData {
     pub fn merge(&mut self, o: VerifyData) -> Result<(), String> {
         if self.formats.len() != o.formats.len() {
             return Err("partials disagree on the formats".into());
+        }
+        if self.injected != o.injected {
+            return Err("partials disagree on the injected fault".into());
         }
         for (a, b) in self.formats.iter_mut().zip(o.formats) {
             a.merge(b)?;
@@ -183,6 +204,7 @@ pub fn accumulate(cfg: &VerifyConfig, scene: &Scene) -> VerifyData {
             .iter()
             .map(|f| with_format!(*f, |f| chunk::accumulate_format(f, cfg, scene, true)))
             .collect(),
+        injected: cfg.inject.map(|x| x.name.to_string()),
     }
 }
 
@@ -207,6 +229,7 @@ pub fn finish(d: VerifyData) -> VerifyReport {
         inconclusive: formats.iter().filter(|f| f.decisive == 0).map(|f| f.format.clone()).collect(),
         formats,
         slab,
+        injected: d.injected,
     }
 }
 
@@ -218,6 +241,7 @@ pub fn args(cfg: &VerifyConfig) -> serde_json::Value {
         "seed": cfg.seed,
         "rti": format!("{:?}", cfg.rti),
         "sample": cfg.sample,
+        "inject": cfg.inject.map(|x| x.name),
     })
 }
 
@@ -232,6 +256,10 @@ pub fn render(r: &VerifyReport) -> String {
         "raypipe verify: scene {} ({} triangles, coordinates x {:?}), {} rays, seed {}, {} tests per ray\n\n",
         r.scene, r.triangles, r.scale, r.rays, r.seed, r.tests_per_ray
     );
+    if let Some(name) = &r.injected {
+        let what = faults::bank::by_name(name).map_or("", |x| x.what);
+        s += &format!("injected fault: {name} ({what}): the model is wrong on purpose; the run must fail\n\n");
+    }
     s += &format!(
         "{:<16} {:>9} {:>9} {:>7} {:>8} {:>8} {:>7} {:>7} {:>6} {:>10} {:>10} {:>9} {:>9} {:>8} {:>9}\n",
         "format",
