@@ -120,3 +120,45 @@ fn the_cli_injects_names_refuses_and_explains() {
         assert!(String::from_utf8_lossy(&o.stderr).contains("--inject"), "{bad:?}");
     }
 }
+
+/// Sharded runs of an injected model merge into the unsharded injected run; an injected
+/// shard does not merge with a clean one.
+#[test]
+fn injected_shards_merge_into_the_injected_run() {
+    let d = std::env::temp_dir().join(format!("raypipe-inject-shards-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    let base = ["verify", "--rays", "40", "--format", "f32", "--quiet", "--json", "--inject", "rti.uv.first"];
+    let part = |k: u32, inject: bool| {
+        let p = d.join(format!("p{k}{inject}.json")).display().to_string();
+        let shard = format!("{k}/2");
+        let mut a: Vec<&str> = base[..if inject { 9 } else { 7 }].to_vec();
+        a.extend(["--shard", &shard, "--partial", &p]);
+        let o = raypipe(&a);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        p
+    };
+    let (a, b, clean) = (part(0, true), part(1, true), part(1, false));
+    let untimed_json = |o: &std::process::Output| {
+        let mut v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        for key in ["formats", "slab"] {
+            for r in v[key].as_array_mut().unwrap() {
+                let r = r.as_object_mut().unwrap();
+                r.remove("mtests_per_s");
+                r.remove("judged_mtests_per_s");
+            }
+        }
+        v
+    };
+    let whole = raypipe(&base);
+    let merged = raypipe(&["merge", "--json", &a, &b]);
+    assert_eq!(merged.status.code(), Some(1));
+    assert_eq!(whole.status.code(), Some(1));
+    let m = untimed_json(&merged);
+    assert_eq!(m["injected"], "rti.uv.first");
+    assert_eq!(m, untimed_json(&whole));
+    let mixed = raypipe(&["merge", "--json", &a, &clean]);
+    assert_eq!(mixed.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&mixed.stderr).contains("differs"), "{}", String::from_utf8_lossy(&mixed.stderr));
+    std::fs::remove_dir_all(&d).unwrap();
+}
