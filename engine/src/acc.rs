@@ -287,6 +287,16 @@ mod tests {
         h
     }
 
+    /// −0 counts as +0: one bucket, the one of +0, and the maximum +0.
+    #[test]
+    fn negative_zero_is_zero() {
+        let h = hist(&[-0.0, 0.0, -0.0]);
+        assert_eq!((h.count(), h.invalid(), h.buckets()), (3, 0, 1));
+        assert_eq!(h.rank_bucket(0), Some((0.0, 0.0)));
+        assert_eq!(h.max().to_bits(), 0f64.to_bits());
+        assert_eq!(h.median().to_bits(), 0f64.to_bits());
+    }
+
     #[test]
     fn median_is_the_bucket_below_the_exact_upper_median() {
         let xs = [3.0, 0.5, 1.0, 1.0009765625, 7.25, 0.0, 2.0];

@@ -141,6 +141,13 @@ mod tests {
     use super::*;
     use crate::{Counts, First, Hist};
 
+    /// A shard prints as `K/N` (the form `--shard` takes and `merge` names missing ones in).
+    #[test]
+    fn a_shard_prints_as_k_slash_n() {
+        assert_eq!(Shard { k: 2, n: 3 }.to_string(), "2/3");
+        assert_eq!(Shard::ALL.to_string(), "0/1");
+    }
+
     /// A toy workload: item i contributes i mod 7 to a counter, a histogram value and a
     /// "violation" when i mod 97 == 13.
     fn toy(engine: &Engine, n: u64) -> (Counts<2>, Hist, First<u64, String>) {
