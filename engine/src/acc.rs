@@ -295,6 +295,8 @@ mod tests {
         assert_eq!(h.rank_bucket(0), Some((0.0, 0.0)));
         assert_eq!(h.max().to_bits(), 0f64.to_bits());
         assert_eq!(h.median().to_bits(), 0f64.to_bits());
+        assert_eq!(hist(&[1.0, 2.0, 2.0, 1e300]).buckets(), 3);
+        assert_eq!(Hist::default().buckets(), 0);
     }
 
     #[test]
