@@ -299,6 +299,32 @@ mod tests {
         assert_eq!(Hist::default().buckets(), 0);
     }
 
+    /// Merging adds the counts of buckets both sides hold; a bitmap keeps one bit per index
+    /// in word i / 64; options merge their contents.
+    #[test]
+    fn merges_add_overlapping_buckets_and_contents() {
+        let mut a = hist(&[1.0, 2.0, 2.0]);
+        a.merge(hist(&[2.0, 2.0, 2.0, 3.0]));
+        assert_eq!((a.count(), a.buckets()), (7, 3));
+        // ranks 0 = 1.0, 1..=5 = 2.0, 6 = 3.0
+        assert_eq!(a.rank_bucket(0).map(|b| b.0), Some(1.0));
+        assert_eq!(a.rank_bucket(5).map(|b| b.0), Some(2.0));
+        assert_eq!(a.rank_bucket(6).map(|b| b.0), Some(3.0));
+        let mut b = Bits::default();
+        for i in [0, 63, 64, 130] {
+            b.insert(i);
+        }
+        assert_eq!(b.0, [1 | 1 << 63, 1, 1 << 2]);
+        let mut o = Some(Counts([1u64, 2]));
+        o.merge(Some(Counts([10, 20])));
+        assert_eq!(o, Some(Counts([11, 22])));
+        o.merge(None);
+        assert_eq!(o, Some(Counts([11, 22])));
+        let mut n: Option<Counts<2>> = None;
+        n.merge(Some(Counts([5, 6])));
+        assert_eq!(n, Some(Counts([5, 6])));
+    }
+
     #[test]
     fn median_is_the_bucket_below_the_exact_upper_median() {
         let xs = [3.0, 0.5, 1.0, 1.0009765625, 7.25, 0.0, 2.0];
