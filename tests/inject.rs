@@ -2,6 +2,9 @@
 //! must fail `verify`, with its violations counted and the first one named with an `explain`
 //! command that reproduces it; the reference side of the run does not change.
 
+mod common;
+
+use common::{untimed, untimed_value};
 use raypipe::scene::Scene;
 use raypipe::verify::{verify, VerifyConfig};
 use std::process::Command;
@@ -11,24 +14,6 @@ fn cfg(inject: Option<&str>) -> VerifyConfig {
         VerifyConfig::new(vec!["f32".parse().unwrap(), "fp16".parse().unwrap()], 48, 3, Default::default(), 512);
     c.inject = inject.map(|n| faults::bank::by_name(n).unwrap());
     c
-}
-
-/// The report as JSON without the timing fields.
-fn untimed(r: &raypipe::verify::VerifyReport) -> serde_json::Value {
-    fn strip(v: &mut serde_json::Value) {
-        match v {
-            serde_json::Value::Object(m) => {
-                m.remove("mtests_per_s");
-                m.remove("judged_mtests_per_s");
-                m.values_mut().for_each(strip);
-            }
-            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
-            _ => {}
-        }
-    }
-    let mut v = serde_json::to_value(r).unwrap();
-    strip(&mut v);
-    v
 }
 
 #[test]
@@ -139,17 +124,7 @@ fn injected_shards_merge_into_the_injected_run() {
         p
     };
     let (a, b, clean) = (part(0, true), part(1, true), part(1, false));
-    let untimed_json = |o: &std::process::Output| {
-        let mut v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        for key in ["formats", "slab"] {
-            for r in v[key].as_array_mut().unwrap() {
-                let r = r.as_object_mut().unwrap();
-                r.remove("mtests_per_s");
-                r.remove("judged_mtests_per_s");
-            }
-        }
-        v
-    };
+    let untimed_json = |o: &std::process::Output| untimed_value(serde_json::from_slice(&o.stdout).unwrap());
     let whole = raypipe(&base);
     let merged = raypipe(&["merge", "--json", &a, &b]);
     assert_eq!(merged.status.code(), Some(1));

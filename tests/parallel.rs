@@ -1,29 +1,14 @@
 //! Multi-core runs give the same results as one thread: the streaming engine's reports do not
 //! depend on the thread count or the chunk size, and they equal the scalar per-test judge.
 
+mod common;
+
+use common::untimed;
 use raypipe::scene::Scene;
 use raypipe::verify::{verify, verify_slab, VerifyConfig};
 
 fn pool(n: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap()
-}
-
-/// The report as JSON without the timing fields.
-fn untimed<T: serde::Serialize>(r: &T) -> serde_json::Value {
-    fn strip(v: &mut serde_json::Value) {
-        match v {
-            serde_json::Value::Object(m) => {
-                m.remove("mtests_per_s");
-                m.remove("judged_mtests_per_s");
-                m.values_mut().for_each(strip);
-            }
-            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
-            _ => {}
-        }
-    }
-    let mut v = serde_json::to_value(r).unwrap();
-    strip(&mut v);
-    v
 }
 
 fn cfg(formats: &[&str], rays: usize, seed: u64) -> VerifyConfig {

@@ -50,3 +50,26 @@ pub fn raw_inputs(r: &mut SplitMix64, f: &AnyFormat) -> [u64; 17] {
         std::array::from_fn(|_| if r.below(5) == 0 { r.next_u64() } else { f.to_bits(f.from_f64(r.range(-1.0, 1.0))) })
     })
 }
+
+/// A report as JSON without its timing fields (`mtests_per_s`, `judged_mtests_per_s` at any
+/// depth): what two runs of the same work must agree on.
+pub fn untimed<T: serde::Serialize>(r: &T) -> serde_json::Value {
+    untimed_value(serde_json::to_value(r).unwrap())
+}
+
+/// [`untimed`] of JSON already parsed.
+pub fn untimed_value(mut v: serde_json::Value) -> serde_json::Value {
+    fn strip(v: &mut serde_json::Value) {
+        match v {
+            serde_json::Value::Object(m) => {
+                m.remove("mtests_per_s");
+                m.remove("judged_mtests_per_s");
+                m.values_mut().for_each(strip);
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    strip(&mut v);
+    v
+}
