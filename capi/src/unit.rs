@@ -591,13 +591,9 @@ impl Unit {
         if !input.len().is_multiple_of(ni) {
             return Err(format!("{} values are not whole rows of {ni}", input.len()));
         }
-        if out.len() != input.len() / ni * no {
-            return Err(format!(
-                "{} input rows take {} outputs, got room for {}",
-                input.len() / ni,
-                input.len() / ni * no,
-                out.len()
-            ));
+        let rows = input.len() / ni;
+        if out.len() != rows * no {
+            return Err(format!("{rows} input rows take {} outputs, got room for {}", rows * no, out.len()));
         }
         // the fast check (an OR over the encodings, op codes apart); the slow one names the row
         let w = self.width.min(63);

@@ -57,13 +57,9 @@ pub fn test_list(n: usize, sample: usize, seed: u64, i: u64, target: usize, out:
     out.extend((1..sample).map(|_| r.below(n as u64) as u32));
 }
 
-/// The `explain` command line of one test, in the scene's normalised coordinates.
-pub fn explain_cmd(fmt: &str, ray: &Ray64, tri: &Tri64, scale: f64) -> String {
-    explain_cmd_faulty(fmt, ray, tri, scale, None)
-}
-
-/// [`explain_cmd`] of a model running with a bank fault (`--inject NAME` added).
-pub fn explain_cmd_faulty(fmt: &str, ray: &Ray64, tri: &Tri64, scale: f64, inject: Option<&str>) -> String {
+/// The `explain` command line of one test, in the scene's normalised coordinates (with
+/// `--inject NAME` when the model runs with that bank fault).
+pub fn explain_cmd(fmt: &str, ray: &Ray64, tri: &Tri64, scale: f64, inject: Option<&str>) -> String {
     let j = |xs: &[f64]| xs.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(",");
     let tv: Vec<f64> = tri.v.iter().flatten().copied().collect();
     let x = inject.map(|n| format!(" --inject {n}")).unwrap_or_default();
@@ -244,7 +240,7 @@ where
 
     /// The `explain` command of one test of this run.
     fn explain(&self, ray: &Ray64, tri: &Tri64) -> String {
-        explain_cmd_faulty(&self.name, ray, tri, self.scene.scale, self.cfg.inject.map(|x| x.name))
+        explain_cmd(&self.name, ray, tri, self.scene.scale, self.cfg.inject.map(|x| x.name))
     }
 
     #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
@@ -280,17 +276,22 @@ where
             }
         }
         let t0 = Instant::now();
-        simd::rti_batch(&self.rti, &s.rays, &s.tris, &mut s.out);
-        acc.model_ns += t0.elapsed().as_nanos() as u64;
-        if let Some(spec) = self.cfg.inject {
-            // a deliberately wrong model: the bank fault's stage model, lane by lane
-            let x = faults::inject::Injected::new(spec);
-            for (k, &ti) in blk.iter().enumerate() {
-                x.next_test();
-                let o = self.rti.trace_faulty(mray, &self.mtris[ti as usize], &mut datapath::probe::NoProbe, &x);
-                (s.out.valid[k], s.out.hit[k], s.out.t[k], s.out.u[k], s.out.v[k]) = (o.valid, o.hit, o.t, o.u, o.v);
+        match self.cfg.inject {
+            None => {
+                simd::rti_batch(&self.rti, &s.rays, &s.tris, &mut s.out);
+            }
+            Some(spec) => {
+                // a deliberately wrong model: the bank fault's stage model, lane by lane
+                let x = faults::inject::Injected::new(spec);
+                for (k, &ti) in blk.iter().enumerate() {
+                    x.next_test();
+                    let o = self.rti.trace_faulty(mray, &self.mtris[ti as usize], &mut datapath::probe::NoProbe, &x);
+                    (s.out.valid[k], s.out.hit[k], s.out.t[k], s.out.u[k], s.out.v[k]) =
+                        (o.valid, o.hit, o.t, o.u, o.v);
+                }
             }
         }
+        acc.model_ns += t0.elapsed().as_nanos() as u64;
         intersect_block(self.level, rq, self.faces, cols(&s.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
         let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
         verdict_block(
