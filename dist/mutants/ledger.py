@@ -15,6 +15,13 @@ import subprocess
 OUTCOMES = ("caught", "missed", "timeout", "unviable")
 
 
+def score(n):
+    """The detected share of the viable mutants in percent, one decimal ("" when none is
+    viable), from counts by outcome: a timeout (a test run that hangs fails CI) is detected."""
+    viable = n["caught"] + n["missed"] + n["timeout"]
+    return f"{100 * (n['caught'] + n['timeout']) / viable:.1f}" if viable else ""
+
+
 def git(*args):
     return subprocess.run(["git", *args], check=True, capture_output=True, text=True).stdout
 
