@@ -113,11 +113,13 @@ fn injected_shards_merge_into_the_injected_run() {
     let d = std::env::temp_dir().join(format!("raypipe-inject-shards-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    let base = ["verify", "--rays", "40", "--format", "f32", "--quiet", "--json", "--inject", "rti.uv.first"];
+    let run = ["verify", "--rays", "40", "--format", "f32", "--quiet", "--json"];
+    let fault = ["--inject", "rti.uv.first"];
+    let base: Vec<&str> = run.iter().chain(&fault).copied().collect();
     let part = |k: u32, inject: bool| {
         let p = d.join(format!("p{k}{inject}.json")).display().to_string();
         let shard = format!("{k}/2");
-        let mut a: Vec<&str> = base[..if inject { 9 } else { 7 }].to_vec();
+        let mut a: Vec<&str> = if inject { base.clone() } else { run.to_vec() };
         a.extend(["--shard", &shard, "--partial", &p]);
         let o = raypipe(&a);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
