@@ -77,6 +77,24 @@ impl OpsData {
     }
 }
 
+impl crate::partial::Consistent for OpsData {
+    /// One test per item of the shard, mismatches within the tests, a first mismatch record
+    /// exactly when mismatches are counted.
+    fn check(&self, share: &dyn Fn(u64, u64) -> u64) -> Result<(), String> {
+        use crate::partial::require;
+        let [tests, bad] = self.counts.0;
+        let want = share(0, self.items);
+        require(tests == want, || format!("{tests} tests, but the shard's items are {want}"))?;
+        require(bad <= tests, || format!("{bad} mismatches exceed {tests} tests"))?;
+        require((bad > 0) == self.first.0.is_some(), || {
+            format!(
+                "{bad} mismatches counted but the first-mismatch record is {}",
+                if self.first.0.is_some() { "present" } else { "missing" }
+            )
+        })
+    }
+}
+
 /// The report.
 #[derive(Clone, Debug, Serialize)]
 pub struct OpsReport {

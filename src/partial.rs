@@ -7,16 +7,44 @@
 //! A partial file is JSON: `raypipe_partial` (format version 1), `version` (raypipe's),
 //! `command` (e.g. `verify`), `args` (every option that changes the results, canonical),
 //! `scene_hash` (FNV-1a 64 over the scene's triangle coordinates' binary64 encodings, hex),
-//! `chunk` (items per chunk: the shard split depends on it), `shard` (`k`, `n`) and `data`
-//! (the command's accumulators).
+//! `chunk` (items per chunk: the shard split depends on it), `shard` (`k`, `n`), `data`
+//! (the command's accumulators) and, written last, `digest`: the SHA-256 of the file's bytes
+//! with the digest member removed (see [`seal`]).
+//!
+//! Before a partial is merged it is checked twice (docs/cluster.md, "Integrity"): its digest
+//! must match its bytes (a file damaged in transit or edited by hand), and its data must be
+//! consistent ([`Consistent`]: counts within their totals, a first-violation record exactly
+//! when violations are counted, histogram totals equal to their counts, the test counts those
+//! of the shard's share of the run). The digest is no signature: whoever edits a partial on
+//! purpose can recompute it.
 
 use engine::Shard;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
-/// The partial file format's version.
-pub const FORMAT: u32 = 1;
+/// The partial file format's version (2: the `digest` member and the consistency rules).
+pub const FORMAT: u32 = 2;
+
+/// The member a partial file ends with: `,"digest":"` 64 lowercase hex digits `"}`.
+const DIGEST_KEY: &str = ",\"digest\":\"";
+
+/// What a command's partial data must satisfy before it is merged.
+pub trait Consistent {
+    /// Checks one shard's data; `share(lo, hi)` is how many of the run's items `lo..hi` the
+    /// shard ran (the engine's chunk split of the partial's `chunk` and `shard`).
+    fn check(&self, share: &dyn Fn(u64, u64) -> u64) -> Result<(), String>;
+}
+
+/// An error unless `ok`: the inconsistency `what`.
+pub fn require(ok: bool, what: impl FnOnce() -> String) -> Result<(), String> {
+    if ok {
+        Ok(())
+    } else {
+        Err(what())
+    }
+}
 
 /// One shard's partial result.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -37,6 +65,9 @@ pub struct Partial<T> {
     pub shard: Shard,
     /// The command's accumulators.
     pub data: T,
+    /// The file it was read from (not part of the file).
+    #[serde(skip)]
+    pub file: PathBuf,
 }
 
 impl<T> Partial<T> {
@@ -51,8 +82,43 @@ impl<T> Partial<T> {
             chunk,
             shard,
             data,
+            file: PathBuf::new(),
         }
     }
+}
+
+/// SHA-256 of `bytes` as 64 lowercase hex digits.
+fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The file text of a partial whose JSON (one object, no trailing newline) is `body`: the
+/// body with the member `"digest":"<SHA-256 of body, hex>"` appended as its last member, then
+/// a newline. The digest covers exactly the bytes of `body`.
+pub fn seal(body: &str) -> String {
+    let open = body.strip_suffix('}').expect("a JSON object");
+    format!("{open}{DIGEST_KEY}{}\"}}\n", sha256_hex(body.as_bytes()))
+}
+
+/// The body of a sealed partial file after checking its digest: the text without its final
+/// newline and without the last member `,"digest":"…"`, whose SHA-256 must be that digest.
+pub fn unseal(text: &str) -> Result<String, String> {
+    let t = text.strip_suffix('\n').unwrap_or(text);
+    let at = t.rfind(DIGEST_KEY).ok_or("it has no digest (its last member must be \"digest\")")?;
+    let hex = &t[at + DIGEST_KEY.len()..];
+    let hex = hex.strip_suffix("\"}").ok_or("its digest is not its last member")?;
+    if hex.len() != 64 || !hex.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)) {
+        return Err("its digest is not 64 lowercase hex digits".into());
+    }
+    // the body is the text up to the digest member, closed again
+    let body = format!("{}}}", &t[..at]);
+    let got = sha256_hex(body.as_bytes());
+    if got != hex {
+        return Err(format!(
+            "its digest does not match its content (damaged or edited after it was written): the file says {hex}, its content hashes to {got}"
+        ));
+    }
+    Ok(body)
 }
 
 /// FNV-1a 64 over the binary64 encodings of every triangle coordinate, in order, as 16 hex
@@ -96,10 +162,10 @@ pub fn check_path(path: &Path) -> Result<(), String> {
 /// Writes `p` to `path` atomically (a sibling temporary file renamed into place).
 pub fn write<T: Serialize>(path: &Path, p: &Partial<T>) -> Result<(), String> {
     check_path(path)?;
-    let text = serde_json::to_string(p).map_err(|e| e.to_string())?;
+    let text = seal(&serde_json::to_string(p).map_err(|e| e.to_string())?);
     let name = path.file_name().ok_or_else(|| format!("--partial {}: not a file name", path.display()))?;
     let tmp: PathBuf = path.with_file_name(format!(".{}.raypipe-partial", name.to_string_lossy()));
-    std::fs::write(&tmp, text + "\n").map_err(|e| format!("{}: {e}", tmp.display()))?;
+    std::fs::write(&tmp, text).map_err(|e| format!("{}: {e}", tmp.display()))?;
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         format!("{}: {e}", path.display())
@@ -116,15 +182,23 @@ pub fn read_all(paths: &[PathBuf]) -> Result<Vec<Partial<serde_json::Value>>, St
     let mut parts = Vec::new();
     for p in paths {
         let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
-        let part: Partial<serde_json::Value> = serde_json::from_str(&text)
+        // the format version first (an older partial has no digest), then the digest, then
+        // the content
+        let value: serde_json::Value = serde_json::from_str(&text)
             .map_err(|e| format!("{}: not a raypipe partial (corrupt or truncated?): {e}", p.display()))?;
-        if part.raypipe_partial != FORMAT {
+        let Some(format) = value.get("raypipe_partial") else {
+            return Err(format!("{}: not a raypipe partial (no raypipe_partial member)", p.display()));
+        };
+        if format.as_u64() != Some(FORMAT as u64) {
             return Err(format!(
-                "{}: partial format {} (this raypipe reads {FORMAT})",
-                p.display(),
-                part.raypipe_partial
+                "{}: partial format {format}; this raypipe reads format {FORMAT} only (re-run the shard with this raypipe)",
+                p.display()
             ));
         }
+        let body = unseal(&text).map_err(|e| format!("{}: refused: {e}", p.display()))?;
+        let mut part: Partial<serde_json::Value> = serde_json::from_str(&body)
+            .map_err(|e| format!("{}: not a raypipe partial (corrupt or truncated?): {e}", p.display()))?;
+        part.file = p.clone();
         parts.push((p.clone(), part));
     }
     let (p0, first) = &parts[0];
@@ -175,14 +249,21 @@ pub fn read_all(paths: &[PathBuf]) -> Result<Vec<Partial<serde_json::Value>>, St
     Ok(parts.into_iter().map(|(_, q)| q).collect())
 }
 
-/// The typed data of a checked partial.
-pub fn data<T: DeserializeOwned>(p: &Partial<serde_json::Value>) -> Result<T, String> {
-    serde_json::from_value(p.data.clone())
-        .map_err(|e| format!("shard {}: its data is not a {} result: {e}", p.shard, p.command))
+/// The typed data of a checked partial, refused (naming its file) when it is inconsistent.
+pub fn data<T: DeserializeOwned + Consistent>(p: &Partial<serde_json::Value>) -> Result<T, String> {
+    let d: T = serde_json::from_value(p.data.clone()).map_err(|e| {
+        format!("{} (shard {}): its data is not a {} result: {e}", p.file.display(), p.shard, p.command)
+    })?;
+    let eng = engine::Engine::new(p.chunk.max(1)).with_shard(p.shard);
+    let share = |lo: u64, hi: u64| eng.shard_items(hi) - eng.shard_items(lo.min(hi));
+    d.check(&share)
+        .map_err(|e| format!("{} (shard {}): refused: its content is inconsistent: {e}", p.file.display(), p.shard))?;
+    Ok(d)
 }
 
-/// The checked partials' data, typed and added up in shard order by `add`.
-pub fn merge_data<T: DeserializeOwned>(
+/// The checked partials' data, typed, each checked for consistency, and added up in shard
+/// order by `add`.
+pub fn merge_data<T: DeserializeOwned + Consistent>(
     parts: &[Partial<serde_json::Value>],
     add: impl Fn(&mut T, T) -> Result<(), String>,
 ) -> Result<T, String> {

@@ -212,6 +212,32 @@ impl ReportData {
     }
 }
 
+impl crate::partial::Consistent for ReportData {
+    /// The stress rows and every scene's verify data consistent in themselves (their shares
+    /// of the run use their own chunk sizes, so totals are not checked here), one entry per
+    /// format and scene, and exact-decision mismatches within the exact-decision tests.
+    fn check(&self, _share: &dyn Fn(u64, u64) -> u64) -> Result<(), String> {
+        use crate::partial::require;
+        self.stress.check_rows(None)?;
+        let (nf, ns) = (self.formats.len(), self.scenes.len());
+        require(
+            self.rti_rate.len() == nf
+                && self.verify.len() == nf
+                && self.exact.len() == nf
+                && self.verify.iter().all(|v| v.len() == ns)
+                && self.exact.iter().all(|v| v.len() == ns),
+            || format!("not one entry per format ({nf}) and scene ({ns})"),
+        )?;
+        for v in self.verify.iter().flatten() {
+            v.check_formats(None)?;
+        }
+        for [tests, fm, fh] in self.exact.iter().flatten() {
+            require(fm + fh <= *tests, || format!("exact decisions: {fm} + {fh} mismatches exceed {tests} tests"))?;
+        }
+        Ok(())
+    }
+}
+
 /// The options that change a report's results, for a partial's `args`.
 pub fn args(cfg: &ReportConfig, scenes: &[Scene]) -> serde_json::Value {
     serde_json::json!({

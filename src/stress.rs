@@ -637,6 +637,57 @@ impl StressReport {
     }
 }
 
+impl crate::partial::Consistent for StressReport {
+    /// Every row's counts within their totals, each slab class's tests and unstorable boxes
+    /// those of the shard's cases of that class (one box per case), and `passed` what the
+    /// rows say.
+    fn check(&self, share: &dyn Fn(u64, u64) -> u64) -> Result<(), String> {
+        self.check_rows(Some(share))
+    }
+}
+
+impl StressReport {
+    /// Checks the rows ([`crate::partial::Consistent`]); the slab class totals only with `share`.
+    pub fn check_rows(&self, share: Option<&dyn Fn(u64, u64) -> u64>) -> Result<(), String> {
+        use crate::partial::require;
+        for r in &self.rti {
+            let decided = r.tests.saturating_sub(r.undecided);
+            require(
+                r.undecided <= r.tests && r.false_misses + r.false_hits <= decided && r.undecided_hits <= r.undecided,
+                || format!("rti {} {}: counts do not fit: {r:?}", r.class, r.format),
+            )?;
+        }
+        let count = self.count as u64;
+        for r in &self.slab {
+            let decided = r.tests.saturating_sub(r.undecided);
+            require(
+                r.undecided <= r.tests
+                    && r.exact_hits <= decided
+                    && r.false_misses <= r.exact_hits
+                    && r.false_hits <= decided - r.exact_hits
+                    && r.undecided_hits <= r.undecided,
+                || format!("slab {} {} {}: counts do not fit: {r:?}", r.class, r.format, r.variant),
+            )?;
+            if let Some(share) = share {
+                let class = SLAB_STRESS
+                    .iter()
+                    .position(|c| c.0 == r.class)
+                    .ok_or_else(|| format!("slab class {} does not exist", r.class))?
+                    as u64;
+                let want = share(class * count, (class + 1) * count);
+                require(r.tests + r.unstorable == want, || {
+                    format!(
+                        "slab {} {} {}: {} tests + {} unstorable boxes, but the shard ran {want} cases of the class",
+                        r.class, r.format, r.variant, r.tests, r.unstorable
+                    )
+                })?;
+            }
+        }
+        let passed = self.slab.iter().all(|x| !x.conservative || x.false_misses == 0);
+        require(self.passed == passed, || format!("passed is {} but the rows say {passed}", self.passed))
+    }
+}
+
 /// The options that change a stress run's results, for a partial's `args`.
 pub fn args(cfg: &StressConfig) -> serde_json::Value {
     serde_json::json!({

@@ -234,6 +234,28 @@ impl TraverseReport {
     }
 }
 
+impl crate::partial::Consistent for TraverseReport {
+    /// Every row over the same rays, its per-ray counts within them, and `passed` what the
+    /// rows say.
+    fn check(&self, _share: &dyn Fn(u64, u64) -> u64) -> Result<(), String> {
+        use crate::partial::require;
+        let rays = self.rows.first().map_or(0, |r| r.rays);
+        for r in &self.rows {
+            require(r.rays == rays, || format!("{}: {} rays, the first row {rays}", r.format, r.rays))?;
+            require(
+                r.history_mismatches <= rays
+                    && r.trail_mismatches <= rays
+                    && r.rays_with_leaves <= rays
+                    && r.rays_without_restart <= r.rays_with_leaves
+                    && r.rays_with_leaves <= r.leaves,
+                || format!("{}: per-ray counts do not fit {rays} rays: {r:?}", r.format),
+            )?;
+        }
+        let passed = self.rows.iter().all(|r| r.history_mismatches == 0 && r.trail_mismatches == 0);
+        require(self.passed == passed, || format!("passed is {} but the rows say {passed}", self.passed))
+    }
+}
+
 /// The options that change a traverse run's results, for a partial's `args`.
 pub fn args(cfg: &TraverseConfig) -> serde_json::Value {
     serde_json::json!({

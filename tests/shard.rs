@@ -160,6 +160,8 @@ fn bad_shards_and_partials_are_refused() {
         text.replacen(&format!("\"version\":\"{}\"", env!("CARGO_PKG_VERSION")), "\"version\":\"0.0.1\"", 1),
     )
     .unwrap();
+    refused(&merge(&[parts[0].clone(), parts[1].clone(), old.display().to_string()]), "digest");
+    std::fs::write(&old, reseal(&std::fs::read_to_string(&old).unwrap())).unwrap();
     refused(&merge(&[parts[0].clone(), parts[1].clone(), old.display().to_string()]), "version");
     let cut = d.join("cut.json");
     std::fs::write(&cut, &text[..text.len() / 2]).unwrap();
@@ -175,6 +177,102 @@ fn bad_shards_and_partials_are_refused() {
     refused(&raypipe(&["verify", "--shard", "0/2", "--partial", mine.to_str().unwrap()]), "not replacing it");
     assert_eq!(std::fs::read_to_string(&mine).unwrap(), "{\"my\": \"data\"}");
     refused(&raypipe(&["merge", mine.to_str().unwrap()]), "not a raypipe partial");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// The digest rule of docs/cluster.md, written from the docs: the file without its final
+/// newline ends with the member `,"digest":"<64 hex>"}`; the SHA-256 of the text before that
+/// member followed by `}` is the digest.
+fn reseal(text: &str) -> String {
+    use sha2::Digest as _;
+    let t = text.trim_end_matches('\n');
+    let at = t.rfind(",\"digest\":\"").expect("a digest member");
+    let body = format!("{}}}", &t[..at]);
+    let hex: String = sha2::Sha256::digest(body.as_bytes()).iter().map(|b| format!("{b:02x}")).collect();
+    format!("{},\"digest\":\"{hex}\"}}\n", &t[..at])
+}
+
+/// Edits the partial at `path` through its JSON `data` and writes it back, resealed or not.
+fn edit(path: &str, to: &Path, seal: bool, f: impl FnOnce(&mut serde_json::Value)) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    f(&mut v["data"]);
+    let digest = v.as_object_mut().unwrap().remove("digest").expect("raypipe writes a digest");
+    // the digest member last again, as raypipe writes it
+    let body = serde_json::to_string(&v).unwrap();
+    let edited = format!("{},\"digest\":{digest}}}\n", body.strip_suffix('}').unwrap());
+    std::fs::write(to, if seal { reseal(&edited) } else { edited }).unwrap();
+    to.display().to_string()
+}
+
+/// A partial damaged or edited after it was written is refused by its digest (exit 2, naming
+/// the file); one whose digest was recomputed but whose content is inconsistent is refused by
+/// the consistency rules: violations without a first-violation record, a first-violation
+/// record without violations (a failing shard edited into a pass), counts that do not add up
+/// to the shard's tests, a histogram whose total differs from its count.
+#[test]
+fn tampered_partials_are_refused() {
+    let d = dir("tamper");
+    let run = ["verify", "--rays", "64", "--format", "f32", "--quiet", "--json", "--shard", "0/1", "--partial"];
+    let clean = d.join("clean.json").display().to_string();
+    let mut a = run.to_vec();
+    a.push(&clean);
+    assert!(raypipe(&a).status.success());
+    let failing = d.join("failing.json").display().to_string();
+    let mut a = run.to_vec();
+    a.extend([failing.as_str(), "--inject", "rti.e1x.swap"]);
+    let o = raypipe(&a);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // the untouched partials merge, the clean one passes and the injected one fails
+    assert_eq!(merge(std::slice::from_ref(&clean)).status.code(), Some(0));
+    assert_eq!(merge(std::slice::from_ref(&failing)).status.code(), Some(1));
+    // the sealing rule of the docs reproduces raypipe's own digest
+    let text = std::fs::read_to_string(&clean).unwrap();
+    assert_eq!(reseal(&text), text);
+    let rti = |v: &mut serde_json::Value| v["formats"][0]["rti"].clone();
+    assert!(rti(&mut serde_json::from_str::<serde_json::Value>(&text).unwrap()["data"])["c"].is_array());
+    // five more violations, digest left as it was: the digest refuses it
+    let add5 = |v: &mut serde_json::Value| {
+        let c = &mut v["formats"][0]["rti"]["c"][6];
+        *c = (c.as_u64().unwrap() + 5).into();
+    };
+    let t = d.join("t1.json");
+    refused(&merge(&[edit(&clean, &t, false, add5)]), &format!("{}: refused: its digest does not match", t.display()));
+    // the same with the digest recomputed: no first-violation record
+    refused(&merge(&[edit(&clean, &t, true, add5)]), "violations counted but the first-violation record is missing");
+    // a failing shard edited to pass: the violations zeroed, the record left
+    let zero = |v: &mut serde_json::Value| v["formats"][0]["rti"]["c"][6] = 0.into();
+    refused(
+        &merge(&[edit(&failing, &t, true, zero)]),
+        "0 violations counted but the first-violation record is present",
+    );
+    // (with the record removed too, the partial is a consistent forgery: docs/cluster.md says
+    // the digest and the rules do not stop someone who edits on purpose)
+    // one test fewer than the shard's rays make
+    let fewer = |v: &mut serde_json::Value| {
+        let c = &mut v["formats"][0]["rti"]["c"][0];
+        *c = (c.as_u64().unwrap() - 1).into();
+    };
+    refused(&merge(&[edit(&clean, &t, true, fewer)]), "RTI tests, but the shard's rays make");
+    // a histogram count one more than its buckets hold
+    let hist = |v: &mut serde_json::Value| {
+        let c = &mut v["formats"][0]["rti"]["ulps"]["count"];
+        *c = (c.as_u64().unwrap() + 1).into();
+    };
+    refused(&merge(&[edit(&clean, &t, true, hist)]), "a histogram's buckets hold");
+    // a slab count: more false misses than exact hits
+    let slab = |v: &mut serde_json::Value| {
+        let c = &mut v["formats"][0]["slab"][0][2]["c"];
+        c[2] = (c[1].as_u64().unwrap() + 1).into();
+    };
+    refused(&merge(&[edit(&clean, &t, true, slab)]), "slab counts do not fit");
+    // a partial of the previous format (no digest) is refused by its version
+    let v1 = d.join("v1.json");
+    std::fs::write(&v1, text.replacen("\"raypipe_partial\":2", "\"raypipe_partial\":1", 1)).unwrap();
+    refused(&merge(&[v1.display().to_string()]), "partial format 1; this raypipe reads format 2 only");
+    // an untouched partial re-serialised the same way (members in the same order) still merges
+    let same = d.join("same.json");
+    assert_eq!(merge(&[edit(&clean, &same, true, |_| ())]).status.code(), Some(0));
     std::fs::remove_dir_all(&d).unwrap();
 }
 

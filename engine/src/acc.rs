@@ -168,6 +168,24 @@ impl Hist {
     pub fn buckets(&self) -> usize {
         self.buckets.len()
     }
+
+    /// Checks a histogram read from a file: its buckets add up to its count, and its maximum
+    /// lies in its highest bucket (0 when it is empty).
+    pub fn check(&self) -> Result<(), String> {
+        let total: u64 = self.buckets.values().sum();
+        if total != self.count {
+            return Err(format!("a histogram's buckets hold {total} values, its count says {}", self.count));
+        }
+        let top = self.buckets.iter().next_back().filter(|(_, &n)| n > 0).map(|(&b, _)| b);
+        let max_ok = match top {
+            None => self.max.to_bits() == 0,
+            Some(b) => self.max >= 0.0 && (self.max.to_bits() >> HIST_SHIFT) as u32 == b,
+        };
+        if !max_ok {
+            return Err(format!("a histogram's maximum {:e} is not in its highest bucket", self.max));
+        }
+        Ok(())
+    }
 }
 
 impl Merge for Hist {
@@ -279,6 +297,27 @@ tuple_merge!(A 0, B 1, C 2, D 3);
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A histogram's check: a merged one passes; a count unequal to its buckets, or a maximum
+    /// outside its highest bucket, fails.
+    #[test]
+    fn a_histogram_checks_its_count_and_maximum() {
+        let mut h = Hist::default();
+        assert!(h.check().is_ok());
+        for x in [0.5, 3.0, 3.0, 1e9] {
+            h.add(x);
+        }
+        h.add(f64::NAN);
+        assert!(h.check().is_ok());
+        let mut c = h.clone();
+        c.count += 1;
+        assert!(c.check().unwrap_err().contains("hold 4 values, its count says 5"));
+        let mut m = h.clone();
+        m.max = 3.0;
+        assert!(m.check().is_err());
+        let z = Hist { max: 1.0, ..Default::default() };
+        assert!(z.check().is_err());
+    }
     use proptest::prelude::*;
 
     fn hist(xs: &[f64]) -> Hist {

@@ -488,6 +488,67 @@ impl FormatAcc {
         Ok(())
     }
 
+    /// Checks a format's accumulators read from a partial: every count within its total, hits
+    /// split into shared and false ones, a first violation exactly when violations are
+    /// counted, a first disagreement exactly when false hits or misses are, histogram totals
+    /// equal to the shared hits, and `tests` (when `tests` is known) the tests of the shard's
+    /// rays.
+    pub fn check(&self, tests: Option<u64>) -> Result<(), String> {
+        use crate::partial::require;
+        let name = &self.name;
+        if let Some(a) = &self.rti {
+            let [t, dec, gh, mh, fm, fh, viol, shared, closest, skipped, exact] = a.c.0;
+            let le = |x: u64, y: u64, what: &str, of: &str| {
+                require(x <= y, || format!("{name}: {what} ({x}) exceed {of} ({y})"))
+            };
+            if let Some(want) = tests {
+                require(t == want, || format!("{name}: {t} RTI tests, but the shard's rays make {want}"))?;
+            }
+            le(dec, t, "decisive tests", "tests")?;
+            le(gh, t, "reference hits", "tests")?;
+            le(mh, t, "model hits", "tests")?;
+            le(skipped, t, "skipped divides", "tests")?;
+            le(exact, t - dec, "exact-arithmetic tests", "undecided tests")?;
+            le(viol, dec, "violations", "decisive tests")?;
+            le(closest, t, "closest-hit disagreements", "tests")?;
+            require(gh == shared + fm && mh == shared + fh, || {
+                format!("{name}: hits do not add up: reference {gh} = shared {shared} + false misses {fm}, model {mh} = shared {shared} + false hits {fh}")
+            })?;
+            require((viol > 0) == a.first.0.is_some(), || {
+                format!(
+                    "{name}: {viol} violations counted but the first-violation record is {}",
+                    if a.first.0.is_some() { "present" } else { "missing" }
+                )
+            })?;
+            require((fm + fh > 0) == a.disagree.0.is_some(), || {
+                format!(
+                    "{name}: {} disagreements counted but the first-disagreement record is {}",
+                    fm + fh,
+                    if a.disagree.0.is_some() { "present" } else { "missing" }
+                )
+            })?;
+            for (h, what) in [(&a.ulps, "ulp"), (&a.rels, "relative")] {
+                h.check().map_err(|e| format!("{name}: t {what} errors: {e}"))?;
+                require(h.count() + h.invalid() == shared, || {
+                    format!(
+                        "{name}: the t {what} error histogram holds {} values, shared hits are {shared}",
+                        h.count() + h.invalid()
+                    )
+                })?;
+            }
+        }
+        for (variant, _, a) in &self.slab {
+            let [t, eh, fm, fh, calls] = a.c.0;
+            if let Some(want) = tests {
+                require(t == want, || format!("{name} {variant}: {t} slab tests, but the shard's rays make {want}"))?;
+            }
+            require(eh <= t && fm <= eh && fh <= t - eh && calls <= t, || {
+                format!("{name} {variant}: slab counts do not fit: tests {t}, exact hits {eh}, false misses {fm}, false hits {fh}, exact calls {calls}")
+            })?;
+        }
+        Ok(())
+    }
+
     /// The format's RTI report (when it ran the RTI unit) and one slab report per variant.
     pub fn finish(self) -> (Option<FormatReport>, Vec<SlabReport>) {
         let rep = self.rti.map(|acc| {

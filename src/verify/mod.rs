@@ -190,6 +190,19 @@ impl VerifyData {
     }
 }
 
+impl crate::partial::Consistent for VerifyData {
+    fn check(&self, share: &dyn Fn(u64, u64) -> u64) -> Result<(), String> {
+        self.check_formats(share(0, self.rays as u64).checked_mul(self.tests_per_ray as u64))
+    }
+}
+
+impl VerifyData {
+    /// Checks every format's accumulators; `tests`: each unit's test count, when known.
+    pub fn check_formats(&self, tests: Option<u64>) -> Result<(), String> {
+        self.formats.iter().try_for_each(|f| f.check(tests))
+    }
+}
+
 /// Runs every format over the engine's shard of the rays.
 pub fn accumulate(cfg: &VerifyConfig, scene: &Scene) -> VerifyData {
     VerifyData {
