@@ -944,7 +944,7 @@ fn run() -> Result<Outcome, String> {
                 return shard_done(json, path, p);
             }
             emit(json, &rep, raypipe::traverse::render)?;
-            Ok(Outcome::from(rep.passed))
+            Ok(rep.outcome())
         }
         Some(Cmd::Ops { format, op, exhaustive, count, seed, shard, partial, json, run }) => {
             let sh = shard_of(shard.as_deref(), partial.as_deref())?;
@@ -1003,7 +1003,7 @@ fn run() -> Result<Outcome, String> {
                 "traverse" => {
                     let rep = raypipe::partial::merge_data(&parts, raypipe::traverse::TraverseReport::merge)?;
                     emit(json, &rep, raypipe::traverse::render)?;
-                    Ok(Outcome::from(rep.passed))
+                    Ok(rep.outcome())
                 }
                 "ops" => {
                     let rep = raypipe::ops::finish(raypipe::partial::merge_data(&parts, raypipe::ops::OpsData::merge)?);
@@ -1050,7 +1050,7 @@ fn run() -> Result<Outcome, String> {
                     eprintln!("wrote {}", p.display());
                 }
             }
-            Ok(Outcome::Pass)
+            Ok(rep.outcome())
         }
         Some(Cmd::Render { scene, format, variant, width, height, leaf_size, eye, look_at, up, fov, out, json }) => {
             with_format!(format, |f| SlabConfig::named_for(&variant, &f).map(|_| ()))?;
@@ -1073,8 +1073,9 @@ fn run() -> Result<Outcome, String> {
                     scene.name, rep.format, rep.variant, rep.pixels, rep.golden_hits, rep.holes, rep.false_hits, rep.other_triangle, out.display(), out.display()
                 ) + &format!("\ncamera: --eye {} --look-at {} --up {} --fov {}", vec3(rep.camera.eye), vec3(rep.camera.look_at), vec3(rep.camera.up), rep.camera.fov) + &format!("\nboxes the slab unit culled on the way to the golden closest hit: {}{}\n", rep.culled,
                     if rep.conservative { if rep.culled > 0 { " (VIOLATION: the variant is conservative in this format)" } else { " (the variant is conservative in this format: must be 0)" } } else { "" })
+                    + &rep.vacuous().map(|why| format!("culling check: INCONCLUSIVE: {why}\n")).unwrap_or_default()
             })?;
-            Ok(Outcome::from(!(rep.conservative && rep.culled > 0)))
+            Ok(rep.outcome())
         }
         Some(Cmd::Vectors {
             unit,

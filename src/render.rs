@@ -40,6 +40,27 @@ pub struct RenderReport {
     pub camera: Camera,
 }
 
+impl RenderReport {
+    /// Why the culling check proved nothing: a conservative variant, but no pixel's ray hits
+    /// the scene, so no box lay on the way to a hit.
+    pub fn vacuous(&self) -> Option<String> {
+        (self.conservative && self.golden_hits == 0)
+            .then(|| "no pixel's ray hits the scene: no box lay on the way to a hit".to_string())
+    }
+
+    /// The exit outcome: a conservative variant that culled fails; one that saw no hit is
+    /// inconclusive.
+    pub fn outcome(&self) -> crate::Outcome {
+        if self.conservative && self.culled > 0 {
+            crate::Outcome::Fail
+        } else if self.vacuous().is_some() {
+            crate::Outcome::Inconclusive
+        } else {
+            crate::Outcome::Pass
+        }
+    }
+}
+
 /// The files [`render`] writes (checked before the work starts).
 pub const FILES: [&str; 2] = ["render.png", "diff.png"];
 

@@ -261,7 +261,8 @@ impl Scene {
         (lo, hi)
     }
 
-    /// `n` seeded rays: alternately aimed (from a random point in the bounds towards a random
+    /// `n` seeded rays: alternately aimed (from a random point in the origin box
+    /// ([`origin_bounds`]: the bounds, flat axes widened) towards a random
     /// barycentric point of a random triangle, barycentrics in [-0.1, 1.1] so edges and misses
     /// are exercised) and incoherent (random origin, uniformly random direction). Each ray
     /// carries the index of the triangle it was aimed at (or a random one).
@@ -272,8 +273,28 @@ impl Scene {
 
     /// The generator of [`Scene::rays`] for `seed`, to make any ray by its index.
     pub fn ray_gen(&self, seed: u64) -> RayGen {
-        RayGen { seed, bounds: self.bounds() }
+        RayGen { seed, bounds: origin_bounds(self.bounds()) }
     }
+}
+
+/// An axis of the scene's bounds thinner than the largest extent over this is degenerate.
+pub const FLAT_RATIO: f64 = 64.0;
+
+/// The box ray origins are drawn from: the scene's bounds, with every degenerate axis (extent
+/// below the largest extent / [`FLAT_RATIO`], a flat scene's normal axis) widened to half the
+/// largest extent around its centre (1 when every extent is 0), so that rays aimed at a flat
+/// scene do not lie in its plane. Other axes keep the bounds exactly.
+pub fn origin_bounds((lo, hi): ([f64; 3], [f64; 3])) -> ([f64; 3], [f64; 3]) {
+    let ext = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+    let pad = if ext > 0.0 { ext / 4.0 } else { 0.5 };
+    let (mut lo, mut hi) = (lo, hi);
+    for a in 0..3 {
+        if (hi[a] - lo[a]) * FLAT_RATIO < ext || ext == 0.0 {
+            let c = (lo[a] + hi[a]) / 2.0;
+            (lo[a], hi[a]) = (c - pad, c + pad);
+        }
+    }
+    (lo, hi)
 }
 
 /// Makes ray `i` of a scene's seeded ray set without the rays before it.

@@ -57,6 +57,23 @@ pub struct StatsReport {
     pub rows: Vec<LeafSizeStats>,
 }
 
+impl StatsReport {
+    /// Why the run measured no traversal: every leaf size's BVH is one leaf (0 inner levels).
+    pub fn vacuous(&self) -> Option<String> {
+        (!self.rows.is_empty() && self.rows.iter().all(|w| w.depth == 0)).then(|| {
+            format!("the BVH is one leaf at every leaf size ({} triangle(s)): no traversal to measure", self.triangles)
+        })
+    }
+
+    /// Pass, or inconclusive when the run measured no traversal.
+    pub fn outcome(&self) -> crate::Outcome {
+        match self.vacuous() {
+            Some(_) => crate::Outcome::Inconclusive,
+            None => crate::Outcome::Pass,
+        }
+    }
+}
+
 const BACK_BINS: usize = 11;
 
 /// One chunk's share of the figures: counts (rays hit, wasted RTI tests, history box tests,
@@ -187,6 +204,9 @@ pub fn render(r: &StatsReport) -> String {
             100.0 * w.within_8_levels,
             w.restart_overhead
         );
+    }
+    if let Some(why) = r.vacuous() {
+        s += &format!("\nINCONCLUSIVE: {why}\n");
     }
     s += "\nback traversals per ray (fig. 3-4), share of rays for 0, 1, .., 9, >=10:\n";
     for w in &r.rows {

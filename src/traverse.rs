@@ -92,6 +92,41 @@ pub struct TraverseReport {
     pub rows: Vec<TraverseRow>,
     /// No mismatch.
     pub passed: bool,
+    /// Why the run proved nothing ([`TraverseReport::vacuous`]), when it did not.
+    #[serde(default)]
+    pub inconclusive: Option<String>,
+}
+
+impl TraverseReport {
+    /// Why the run exercised nothing (the BVH has no inner level, or no ray reached a leaf):
+    /// then a pass proves nothing.
+    pub fn vacuous(&self) -> Option<String> {
+        if self.depth == 0 {
+            Some(format!(
+                "the BVH is one leaf ({} triangle(s), 0 inner levels): the ray history never held a bit",
+                self.triangles
+            ))
+        } else if self.rows.iter().all(|r| r.rays_with_leaves == 0) {
+            Some("no ray reached a leaf: no traversal was compared".into())
+        } else {
+            None
+        }
+    }
+
+    /// The report with `inconclusive` set from its rows.
+    pub fn with_verdict(mut self) -> Self {
+        self.inconclusive = self.vacuous();
+        self
+    }
+
+    /// The exit outcome: a mismatch fails; a run that exercised nothing is inconclusive.
+    pub fn outcome(&self) -> crate::Outcome {
+        match (self.passed, self.vacuous()) {
+            (false, _) => crate::Outcome::Fail,
+            (true, Some(_)) => crate::Outcome::Inconclusive,
+            (true, None) => crate::Outcome::Pass,
+        }
+    }
 }
 
 /// Primary rays on a pinhole camera in front of the scene (looking +z), then random ones.
@@ -173,7 +208,9 @@ pub fn traverse(cfg: &TraverseConfig, scene: &Scene) -> Result<TraverseReport, S
         n: cfg.n,
         passed: rows.iter().all(|r| r.history_mismatches == 0 && r.trail_mismatches == 0),
         rows,
-    })
+        inconclusive: None,
+    }
+    .with_verdict())
 }
 
 /// Counters of [`TraverseRow`] in field order from `rays` to `box_tests_skipped`.
@@ -230,6 +267,7 @@ impl TraverseReport {
             *a = TraverseRow::from_counters(a.format.clone(), std::array::from_fn(|k| x[k] + y[k]));
         }
         self.passed = self.rows.iter().all(|r| r.history_mismatches == 0 && r.trail_mismatches == 0);
+        self.inconclusive = self.vacuous();
         Ok(())
     }
 }
@@ -377,6 +415,10 @@ pub fn render(r: &TraverseReport) -> String {
         .collect::<Vec<_>>()
         .join(", ");
     s += "\n";
-    s += if r.passed { "equivalence: PASS\n" } else { "equivalence: FAIL\n" };
+    match (r.passed, r.vacuous()) {
+        (false, _) => s += "equivalence: FAIL\n",
+        (true, Some(why)) => s += &format!("equivalence: INCONCLUSIVE: {why}; the run proved nothing\n"),
+        (true, None) => s += "equivalence: PASS\n",
+    }
     s
 }
