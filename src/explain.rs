@@ -92,8 +92,11 @@ pub struct GoldenRti {
 pub struct BoundRti {
     /// Every compared quantity is farther from its threshold than its bound: the model must agree.
     pub decisive: bool,
-    /// The exact hit decision (f64-evaluated within the bound).
+    /// The reference hit decision `verify` judges by: the bound's when decisive, else the f64
+    /// filter's, else exact rational arithmetic's on the quantised inputs.
     pub exact_hit: bool,
+    /// What decided `exact_hit`: `bound`, `f64_filter`, `exact` or `golden_f64`.
+    pub decided_by: crate::judge::DecidedBy,
     /// Bounds on |error| of det, up, vp, tp and t.
     pub det_err: f64,
     /// up.
@@ -194,6 +197,7 @@ pub fn trace_rti_faulty<F: Format>(
     let g = golden::intersect(&rq, &tq, faces(rti));
     let b = RtiBound::new(f.error_model(), f.div_mode(), rq.o, rq.d, tq.v);
     let v = b.verdict(rti.cull, f.to_f64(rti.det_thr), rq.tmin, rq.tmax);
+    let (exact_hit, decided_by) = crate::judge::decide(rti, &rq, &tq, v, g.hit);
     RtiTrace {
         format: f.name(),
         width: f.width(),
@@ -218,7 +222,8 @@ pub fn trace_rti_faulty<F: Format>(
         },
         bound: BoundRti {
             decisive: v.decisive,
-            exact_hit: v.hit,
+            exact_hit,
+            decided_by,
             det_err: b.det.err(),
             up_err: b.up.err(),
             vp_err: b.vp.err(),
@@ -270,8 +275,8 @@ pub fn render_rti(t: &RtiTrace) -> String {
     let b = &t.bound;
     let _ = writeln!(
         s,
-        "bound : decisive {} (exact hit {}); |err| det <= {:.3e}, up <= {:.3e}, vp <= {:.3e}, tp <= {:.3e}, t <= {:.3e}",
-        b.decisive, b.exact_hit, b.det_err, b.up_err, b.vp_err, b.tp_err, b.t_err
+        "bound : decisive {} (exact hit {}, decided by {}); |err| det <= {:.3e}, up <= {:.3e}, vp <= {:.3e}, tp <= {:.3e}, t <= {:.3e}",
+        b.decisive, b.exact_hit, b.decided_by.words(), b.det_err, b.up_err, b.vp_err, b.tp_err, b.t_err
     );
     s
 }

@@ -80,16 +80,73 @@ pub fn quantise<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> (Ray64, Tr
 pub const EXACT_F64: datapath::format::ErrorModel =
     datapath::format::ErrorModel { u: 0.0, eta: 0.0, add_eta: 0.0, max: f64::MAX };
 
+/// What decided a test's reference hit/miss.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DecidedBy {
+    /// The format's error bound was decisive (its f64 evaluation's slack included).
+    Bound,
+    /// The f64 filter (the bound with zero format error) certified the signs.
+    F64Filter,
+    /// Exact rational arithmetic on the quantised inputs.
+    Exact,
+    /// No exact answer (a non-finite quantised input): the golden f64 test's.
+    GoldenF64,
+}
+
+impl DecidedBy {
+    /// The words `explain` prints.
+    pub fn words(self) -> &'static str {
+        match self {
+            DecidedBy::Bound => "the error bound",
+            DecidedBy::F64Filter => "the f64 filter",
+            DecidedBy::Exact => "exact rational arithmetic",
+            DecidedBy::GoldenF64 => "the golden f64 test (no exact answer for non-finite inputs)",
+        }
+    }
+
+    /// The f64 filter could not decide (verify counts these as `exact`).
+    pub fn fell_through(self) -> bool {
+        matches!(self, DecidedBy::Exact | DecidedBy::GoldenF64)
+    }
+}
+
 /// The reference decision of a quantised test and whether it fell through the f64 filter to
 /// exact rational arithmetic (see the module documentation); `golden_hit` stands in where the
 /// exact arithmetic has no answer (a non-finite input).
 pub fn reference<F: Format>(rti: &Rti<F>, rq: &Ray64, tq: &Tri64, golden_hit: bool) -> (bool, bool) {
+    let (hit, by) = reference_by(rti, rq, tq, golden_hit);
+    (hit, by.fell_through())
+}
+
+/// [`reference`], naming what decided: the f64 filter, exact rational arithmetic, or (no
+/// exact answer) the golden f64 test.
+pub fn reference_by<F: Format>(rti: &Rti<F>, rq: &Ray64, tq: &Tri64, golden_hit: bool) -> (bool, DecidedBy) {
     let b = RtiBound::new(EXACT_F64, datapath::format::DivMode::Divide, rq.o, rq.d, tq.v);
     let v = b.verdict(rti.cull, rti.fmt.to_f64(rti.det_thr), rq.tmin, rq.tmax);
     if v.decisive {
-        (v.hit, false)
+        (v.hit, DecidedBy::F64Filter)
     } else {
-        (golden::intersect_exact(rq, tq, faces(rti)).unwrap_or(golden_hit), true)
+        match golden::intersect_exact(rq, tq, faces(rti)) {
+            Some(h) => (h, DecidedBy::Exact),
+            None => (golden_hit, DecidedBy::GoldenF64),
+        }
+    }
+}
+
+/// The reference decision `verify` judges a test by: the format's error bound's when it is
+/// decisive (`verdict`, computed on the quantised inputs `rq`, `tq`), else [`reference_by`].
+pub fn decide<F: Format>(
+    rti: &Rti<F>,
+    rq: &Ray64,
+    tq: &Tri64,
+    verdict: datapath::bound::Verdict,
+    golden_hit: bool,
+) -> (bool, DecidedBy) {
+    if verdict.decisive {
+        (verdict.hit, DecidedBy::Bound)
+    } else {
+        reference_by(rti, rq, tq, golden_hit)
     }
 }
 
@@ -102,7 +159,8 @@ pub fn judge<F: Format>(rti: &Rti<F>, ray: &Ray64, tri: &Tri64) -> Judged {
     let b = RtiBound::new(f.error_model(), f.div_mode(), rq.o, rq.d, tq.v);
     let v = b.verdict(rti.cull, f.to_f64(rti.det_thr), rq.tmin, rq.tmax);
     // a decisive case is also decided by the f64 filter (the model's bounds include its slack)
-    let (reference_hit, fell_through) = if v.decisive { (v.hit, false) } else { reference(rti, &rq, &tq, golden.hit) };
+    let (reference_hit, by) = decide(rti, &rq, &tq, v, golden.hit);
+    let fell_through = by.fell_through();
     Judged {
         hit: out.hit,
         t: f.to_f64(out.t),

@@ -147,3 +147,49 @@ fn a_render_that_hits_nothing_is_inconclusive() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("culling check: INCONCLUSIVE"));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// `explain` reports the reference decision `verify` judges by and names what decided it. On
+/// these vertex- and edge-aimed threshold cases the f64 evaluation of the error bound says
+/// miss, exact rational arithmetic on the quantised inputs says hit: `explain` must say hit,
+/// decided by exact arithmetic (it used to print the f64 evaluation as the "exact hit").
+#[test]
+fn explain_reports_the_exact_decision_where_f64_is_wrong() {
+    use datapath::Format as _;
+    let cases = [
+        (
+            "f32",
+            "0.9618558883666992,0.1701918989419937,-0.7856403589248657,-0.39487239718437195,0.1563703864812851,0.924180805683136",
+            "0.5047459602355957,0.26268208026885986,0.9887862801551819,0.6292210221290588,0.39044249057769775,-0.7117053866386414,-0.6500075459480286,0.3023029565811157,-0.26717060804367065",
+        ),
+        (
+            "q8.24:divide",
+            "0.5783219337463379,0.17947542667388916,-0.5704593658447266,-0.11114555597305298,-0.16622716188430786,-0.049610137939453125",
+            "0.36472541093826294,0.501389741897583,-0.46935516595840454,0.5696273446083069,-0.4748932123184204,-0.7707838416099548,0.2916174530982971,0.9670970439910889,-0.5619288682937622",
+        ),
+    ];
+    for (fmt, ray, tri) in cases {
+        let nums = |s: &str| s.split(',').map(|x| x.parse::<f64>().unwrap()).collect::<Vec<_>>();
+        let (r, t) = (nums(ray), nums(tri));
+        let ray64 = golden::Ray64 { o: [r[0], r[1], r[2]], d: [r[3], r[4], r[5]], tmin: 0.0, tmax: f64::INFINITY };
+        let tri64 = golden::Tri64 { v: [[t[0], t[1], t[2]], [t[3], t[4], t[5]], [t[6], t[7], t[8]]] };
+        // the case is what it claims: exact rationals hit, the f64 evaluation of the bound misses
+        let any: datapath::AnyFormat = fmt.parse().unwrap();
+        let (exact, f64_hit) = datapath::with_format!(any, |f| {
+            let rti = datapath::rti::Rti::new(f, datapath::rti::RtiConfig::default());
+            let (rq, tq) = raypipe::judge::quantise(&rti, &ray64, &tri64);
+            let b = datapath::bound::RtiBound::new(f.error_model(), f.div_mode(), rq.o, rq.d, tq.v);
+            let v = b.verdict(rti.cull, f.to_f64(rti.det_thr), rq.tmin, rq.tmax);
+            assert!(!v.decisive);
+            (golden::intersect_exact(&rq, &tq, raypipe::judge::faces(&rti)), v.hit)
+        });
+        assert_eq!((exact, f64_hit), (Some(true), false), "{fmt}");
+        let o = raypipe(&["explain", "--format", fmt, "--ray", ray, "--tri", tri, "--json"]);
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(v["bound"]["exact_hit"], true, "{fmt}: {}", v["bound"]);
+        assert_eq!(v["bound"]["decided_by"], "exact", "{fmt}: {}", v["bound"]);
+        let o = raypipe(&["explain", "--format", fmt, "--ray", ray, "--tri", tri]);
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(text.contains("(exact hit true, decided by exact rational arithmetic)"), "{text}");
+    }
+}
