@@ -432,11 +432,12 @@ fn the_capture_unit_follows_its_tie_rule_on_a_hand_traced_leaf() {
     }
 }
 
-/// The slab unit's input conversion: a NaN ray input of any sign and payload gives the rows of
-/// the canonical NaN, and under FTZ a subnormal ray input the rows of zero of its sign (the
+/// The slab unit's input read: a NaN ray input of any sign and payload gives the rows of the
+/// canonical NaN, under `propagate` the rows of the same NaN quieted (payload kept, never the
+/// canonical NaN's), and under FTZ a subnormal ray input the rows of zero of its sign (the
 /// reference DUTs' `conv`); the stored box is not converted.
 #[test]
-fn the_slab_input_conversion_canonicalizes_nans_and_flushes_ftz_subnormals() {
+fn the_slab_input_read_canonicalizes_or_quiets_nans_and_flushes_ftz_subnormals() {
     use datapath::fault::NoFault;
     use datapath::slab::{Slab, SlabConfig};
     let rows = |fmt: &str, bits: &[u64]| {
@@ -463,14 +464,16 @@ fn the_slab_input_conversion_canonicalizes_nans_and_flushes_ftz_subnormals() {
         b(1.0),
         b(1.0),
     ];
-    for fmt in ["f32", "f32:propagate"] {
-        let mut canon = base;
-        canon[1] = 0x7fc0_0000;
-        for payload in [0xffc0_1234u64, 0x7f80_0001, 0xff80_0042] {
-            let mut p = base;
-            p[1] = payload;
-            assert_eq!(rows(fmt, &p), rows(fmt, &canon), "{fmt} {payload:#x}");
-        }
+    let mut canon = base;
+    canon[1] = 0x7fc0_0000;
+    for payload in [0xffc0_1234u64, 0x7f80_0001, 0xff80_0042] {
+        let mut p = base;
+        p[1] = payload;
+        assert_eq!(rows("f32", &p), rows("f32", &canon), "f32 {payload:#x}");
+        let mut quiet = base;
+        quiet[1] = payload | 0x0040_0000;
+        assert_eq!(rows("f32:propagate", &p), rows("f32:propagate", &quiet), "f32:propagate {payload:#x}");
+        assert_ne!(rows("f32:propagate", &p), rows("f32:propagate", &canon), "f32:propagate {payload:#x}");
     }
     let mut sub = base;
     sub[3] = 0x8000_0003; // -3 least steps

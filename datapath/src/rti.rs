@@ -304,6 +304,10 @@ impl<F: Format> Rti<F> {
         let [ox, oy, oz] = ray.o;
         let [dx, dy, dz] = ray.d;
         let [[v0x, v0y, v0z], [v1x, v1y, v1z], [v2x, v2y, v2z]] = tri.v;
+        // stage 0, the input read (Format::read_input, the slab unit's stage 0 too): every
+        // input below feeds an operation or a compare before anything else, and their NaN and
+        // FTZ rules give the same bits on a raw input as on the read one, so the read is
+        // implicit here (datapath/tests/nan_inputs.rs checks every signal both ways)
         // stage 1
         let e1x = sub("e1x", v1x, v0x);
         let e1y = sub("e1y", v1y, v0y);

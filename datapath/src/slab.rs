@@ -108,9 +108,9 @@ pub const MIN_MAN_BITS: u32 = 4;
 /// take-on-false, embree), in the order the probe reports the signals. Stage 0 runs once per
 /// ray; `sel*` rows are the compare unit's compare-selects; `step*` rows the widening.
 pub const SLAB_TABLE: [SigDef; 39] = [
-    l(0, "dx", "input conversion of d.x"),
-    l(0, "dy", "input conversion of d.y"),
-    l(0, "dz", "input conversion of d.z"),
+    l(0, "dx", "input read of d.x: a NaN reads as the canonical NaN (quieted, payload kept, under propagate); a subnormal as ±0 under FTZ; o, tmin, tmax are read the same way"),
+    l(0, "dy", "input read of d.y (as dx)"),
+    l(0, "dz", "input read of d.z (as dx)"),
     l(0, "pdx", "embree: |dx| < δ ? ±δ : dx; else dx"),
     l(0, "pdy", "likewise"),
     l(0, "pdz", "likewise"),
@@ -331,8 +331,8 @@ impl<F: Format> Slab<F> {
         self.prepare_faulty(o.map(q), d.map(q), q(tmin), q(tmax), p, &NoFault)
     }
 
-    /// Stage 0 on a ray of format encodings (converted first: NaN to the canonical NaN, FTZ
-    /// subnormals to zero), with every site computed by `x` (a hardware
+    /// Stage 0 on a ray of format encodings (read first by [`Format::read_input`]: a NaN as
+    /// the canonical NaN, or quieted under `propagate`; FTZ subnormals as zero), with every site computed by `x` (a hardware
     /// fault; [`NoFault`] is the datapath itself). Sites: the arithmetic sites `inv_dx`,
     /// `inv_dy`, `inv_dz`; the compare sites `pdx`, `pdy`, `pdz` (Embree: `|d| < δ`); the
     /// logic sites `pdx_sign`, `pdy_sign`, `pdz_sign` (Embree: the replacement's sign, d's sign
@@ -348,10 +348,10 @@ impl<F: Format> Slab<F> {
     ) -> SlabRay<F::V> {
         let f = &self.fmt;
         let one = f.one();
-        // the input conversion of every ray input (the stage table's dx, dy, dz): a NaN
-        // becomes the canonical NaN, under FTZ a subnormal becomes zero of its sign; numbers
-        // are unchanged (the format's own value through binary64 and back)
-        let conv = |v: F::V| f.from_f64(f.to_f64(v));
+        // the stage-0 input read of every ray input (the stage table's dx, dy, dz;
+        // Format::read_input): a NaN reads as the canonical NaN, quieted with its payload kept
+        // under :propagate; under FTZ a subnormal reads as zero of its sign; numbers unchanged
+        let conv = |v: F::V| f.read_input(v);
         let (o, d, tmin, tmax) = (o.map(conv), d.map(conv), conv(tmin), conv(tmax));
         let [dx, dy, dz] = d;
         let prep = |site, sign_site, v: F::V| match self.cfg.prep {

@@ -8,9 +8,10 @@ package raypipe_box;
   // the set's format, as an fmt_t
   localparam logic [$bits(fmt_t)-1:0] F = {EXP[7:0], MAN[7:0], FTZ[0], NAN_PROPAGATE[0]};
 
-  // The ray's input conversion: a NaN becomes the canonical NaN, under FTZ a subnormal zero.
+  // The ray's input read: a NaN reads as the canonical NaN (quieted, payload kept, under
+  // propagate), under FTZ a subnormal as zero of its sign.
   function automatic word_t conv(word_t a);
-    if (is_nan(F, a)) return canonical_nan(F);
+    if (is_nan(F, a)) return nan_result(F, a, a);
     return rd(F, a);
   endfunction
 

@@ -31,6 +31,7 @@ package raypipe_fp is
   function is_sub(f : fmt_t; a : word_t) return boolean;
   function sign_of(f : fmt_t; a : word_t) return boolean;
   function canonical_nan(f : fmt_t) return word_t;
+  function nan_result(f : fmt_t; a, b : word_t) return word_t;
   function zero_of(f : fmt_t; s : boolean) return word_t;
   function one_of(f : fmt_t) return word_t;
   function rd(f : fmt_t; a : word_t) return word_t;

@@ -48,11 +48,12 @@ architecture behavioural of raypipe_slab_ref is
     return "0";
   end function;
 
-  -- the ray's input conversion: NaN becomes the canonical NaN, under FTZ a subnormal zero
+  -- the ray's input read: a NaN reads as the canonical NaN (quieted, payload kept, under
+  -- propagate), under FTZ a subnormal as zero of its sign
   function conv(a : std_logic_vector) return std_logic_vector is
   begin
     if is_nan(F, w64(a)) then
-      return nw(canonical_nan(F));
+      return nw(nan_result(F, w64(a), w64(a)));
     end if;
     return nw(rd(F, w64(a)));
   end function;

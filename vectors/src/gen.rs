@@ -434,6 +434,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
         Unit::Rti => {
             let rti = Rti::new(f, req.rti);
             options.insert("cull".into(), format!("{:?}", req.rti.cull));
+            options.insert("input_read".into(), crate::rows::input_read(&f));
             options.insert(
                 "det_threshold".into(),
                 format!("{:?} (as the format rounds it: {})", req.rti.det_threshold, f.hex(rti.det_thr)),
@@ -618,6 +619,7 @@ fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
             let slab = Slab::new(f, sc);
             options.insert("variant".into(), req.slab_variant.clone());
             slab_options(&mut options, &sc);
+            options.insert("input_read".into(), crate::rows::input_read(&f));
             params.insert("slab_guard".into(), sc.guard as u64);
             params.insert("slab_take_on_false".into(), (sc.nan == datapath::slab::SlabNan::TakeOnFalse) as u64);
             params.insert("slab_embree".into(), (sc.prep == datapath::slab::DirPrep::Embree) as u64);

@@ -122,6 +122,23 @@ pub(crate) fn is_float<F: Format>(f: &F) -> bool {
     matches!(f.kind(), FormatKind::Float(_))
 }
 
+/// The stage-0 input read of a unit's input encodings in words (manifest `options.input_read`).
+pub(crate) fn input_read<F: Format>(f: &F) -> String {
+    let FormatKind::Float(l) = f.kind() else {
+        return "every input reads as itself (fixed point has no NaN and no subnormal)".into();
+    };
+    let nan = if f.nan_propagates() {
+        "a NaN input reads quieted: fraction MSB set, sign and the rest of the payload kept, and the payload propagates (through operations as their first NaN operand, unchanged through compare-selects)".to_string()
+    } else {
+        format!("a NaN input reads as the canonical NaN 0x{:x}: no input payload reaches any signal", l.canonical_nan())
+    };
+    let sub =
+        if f.flushes() { "a subnormal input reads as zero of its sign" } else { "a subnormal input reads as itself" };
+    format!(
+        "stage 0 reads every input encoding before any other use: {nan}; {sub}; every other encoding reads as itself"
+    )
+}
+
 /// The slab unit's configuration as manifest options, one key per rule, in words.
 pub(crate) fn slab_options(options: &mut BTreeMap<String, String>, sc: &SlabConfig) {
     use datapath::slab::{DirPrep, SlabNan, STEP_RULES};

@@ -356,6 +356,7 @@ pub(crate) fn generate<F: Format>(
     options.insert("scene".into(), tree.name.clone());
     options.insert("variant".into(), variant.to_string());
     crate::rows::slab_options(&mut options, &sc);
+    options.insert("input_read".into(), crate::rows::input_read(&f));
     options.insert(
         "traversal".into(),
         "2-bit ray history, restart from the root (raypipe README, section 'BVH traversal: the 2-bit ray history'); the right child is nearer only when its entry t_near is less than the left's (format compare), ties and NaN go left".into(),

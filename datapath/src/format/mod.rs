@@ -132,6 +132,13 @@ pub trait Format: Copy + Debug + Send + Sync + 'static {
     fn from_f64(&self, x: f64) -> Self::V;
     /// Value as f64 (exact for every float format and for fixed values below 2^53 steps).
     fn to_f64(&self, v: Self::V) -> f64;
+    /// The stage-0 input read of an encoding a unit receives (both units, every input): a NaN
+    /// reads as the canonical NaN under `canonical` and quieted (fraction MSB set, sign and
+    /// the rest of the payload kept) under `propagate`; under FTZ a subnormal reads as zero of
+    /// its sign; every other encoding reads as itself (fixed point: always itself).
+    fn read_input(&self, v: Self::V) -> Self::V {
+        v
+    }
     /// Encoding, right-aligned in a u64.
     fn to_bits(&self, v: Self::V) -> u64;
     /// Value from its encoding (low `width` bits).
@@ -326,11 +333,17 @@ impl<B: IeeeBackend> Format for Ieee<B> {
             rounding: "every + - x / and the f64 input conversion rounded once, to nearest, ties to even; no fused multiply-add".into(),
             subnormals: match self.opts.subnormals {
                 Subnormals::Ieee => "IEEE gradual underflow (subnormals kept)".into(),
-                Subnormals::Ftz => "flush to zero: subnormal operands read as zero of the same sign; a result that is subnormal after rounding becomes zero of the same sign; input conversion flushes the same way".into(),
+                Subnormals::Ftz => "flush to zero: subnormal operands read as zero of the same sign; a result that is subnormal after rounding becomes zero of the same sign; the f64 input conversion and the stage-0 read of every input encoding flush the same way".into(),
             },
             nan: match self.opts.nan {
-                NanMode::Canonical => format!("every NaN result is the canonical quiet NaN 0x{:x} (sign 0)", l.canonical_nan()),
-                NanMode::Propagate => format!("first NaN operand, quieted (x86 order); invalid operations give 0x{:x}", l.canonical_nan()),
+                NanMode::Canonical => format!(
+                    "every NaN result is the canonical quiet NaN 0x{c:x} (sign 0); a NaN input reads as 0x{c:x} at stage 0 (both units, every input), so no input payload reaches any signal",
+                    c = l.canonical_nan()
+                ),
+                NanMode::Propagate => format!(
+                    "a NaN result is the first NaN operand, quieted (x86 order); invalid operations give 0x{:x}; a NaN input reads quieted at stage 0 (fraction MSB set, sign and payload kept; both units, every input), so input payloads propagate: through operations, and unchanged through compare-selects",
+                    l.canonical_nan()
+                ),
             },
             overflow: "overflow rounds to ±infinity (nearest-even)".into(),
             division: match self.opts.div {
@@ -403,6 +416,18 @@ impl<B: IeeeBackend> Format for Ieee<B> {
     #[inline(always)]
     fn le(&self, a: B::V, b: B::V) -> bool {
         self.backend.le(self.read(a), self.read(b))
+    }
+    #[inline(always)]
+    fn read_input(&self, v: B::V) -> B::V {
+        let l = self.lay();
+        let b = B::bits(v);
+        if l.is_nan(b) {
+            return B::from_bits(match self.opts.nan {
+                NanMode::Canonical => l.canonical_nan(),
+                NanMode::Propagate => l.quiet(b),
+            });
+        }
+        self.read(v)
     }
     #[inline(always)]
     fn is_nan(&self, v: B::V) -> bool {
