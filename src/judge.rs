@@ -43,21 +43,41 @@ impl Judged {
     /// (which, in a decisive case, is the bound's exact decision), or a shared hit whose t
     /// error exceeds the bound.
     pub fn violation(&self) -> Option<String> {
-        if !self.decisive {
-            return None;
-        }
-        if self.hit != self.reference_hit || self.reference_hit != self.exact_hit {
-            return Some(format!("hit/miss: model {} exact {}", self.hit, self.reference_hit));
-        }
-        if self.hit && self.t_error() > self.t_err + self.golden.t.abs() * 1e-12 {
-            return Some(format!("t error {:e} exceeds bound {:e}", self.t_error(), self.t_err));
-        }
-        None
+        violation(self.decisive, self.hit, self.reference_hit, self.exact_hit, self.t, self.golden.t, self.t_err)
     }
     /// |t_model − t_golden|.
     pub fn t_error(&self) -> f64 {
         (self.t - self.golden.t).abs()
     }
+}
+
+/// Relative slack on the t bound: binary64's own rounding of the golden t.
+pub const T_SLACK: f64 = 1e-12;
+
+/// The property on one test, the one rule `verify` and `explain` judge by: nothing unless
+/// `decisive`; then a hit/miss that differs from the reference decision (or a reference that
+/// differs from the bound's `exact_hit`), else a model hit whose |t − t_golden| exceeds
+/// `t_err + |t_golden|·T_SLACK`. Returns the failure's message.
+pub fn violation(
+    decisive: bool,
+    hit: bool,
+    reference_hit: bool,
+    exact_hit: bool,
+    t: f64,
+    t_golden: f64,
+    t_err: f64,
+) -> Option<String> {
+    if !decisive {
+        return None;
+    }
+    if hit != reference_hit || reference_hit != exact_hit {
+        return Some(format!("hit/miss: model {hit} exact {reference_hit}"));
+    }
+    let e = (t - t_golden).abs();
+    if hit && e > t_err + t_golden.abs() * T_SLACK {
+        return Some(format!("t error {e:e} exceeds bound {t_err:e}"));
+    }
+    None
 }
 
 /// The golden's face options matching an RTI unit.

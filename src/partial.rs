@@ -24,8 +24,9 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
-/// The partial file format's version (2: the `digest` member and the consistency rules).
-pub const FORMAT: u32 = 2;
+/// The partial file format's version (2: the `digest` member and the consistency rules; 3:
+/// verify's counters by name).
+pub const FORMAT: u32 = 3;
 
 /// The member a partial file ends with: `,"digest":"` 64 lowercase hex digits `"}`.
 const DIGEST_KEY: &str = ",\"digest\":\"";

@@ -230,10 +230,12 @@ fn tampered_partials_are_refused() {
     let text = std::fs::read_to_string(&clean).unwrap();
     assert_eq!(reseal(&text), text);
     let rti = |v: &mut serde_json::Value| v["formats"][0]["rti"].clone();
-    assert!(rti(&mut serde_json::from_str::<serde_json::Value>(&text).unwrap()["data"])["c"].is_array());
+    assert!(
+        rti(&mut serde_json::from_str::<serde_json::Value>(&text).unwrap()["data"])["counts"]["violations"].is_u64()
+    );
     // five more violations, digest left as it was: the digest refuses it
     let add5 = |v: &mut serde_json::Value| {
-        let c = &mut v["formats"][0]["rti"]["c"][6];
+        let c = &mut v["formats"][0]["rti"]["counts"]["violations"];
         *c = (c.as_u64().unwrap() + 5).into();
     };
     let t = d.join("t1.json");
@@ -241,7 +243,7 @@ fn tampered_partials_are_refused() {
     // the same with the digest recomputed: no first-violation record
     refused(&merge(&[edit(&clean, &t, true, add5)]), "violations counted but the first-violation record is missing");
     // a failing shard edited to pass: the violations zeroed, the record left
-    let zero = |v: &mut serde_json::Value| v["formats"][0]["rti"]["c"][6] = 0.into();
+    let zero = |v: &mut serde_json::Value| v["formats"][0]["rti"]["counts"]["violations"] = 0.into();
     refused(
         &merge(&[edit(&failing, &t, true, zero)]),
         "0 violations counted but the first-violation record is present",
@@ -250,7 +252,7 @@ fn tampered_partials_are_refused() {
     // the digest and the rules do not stop someone who edits on purpose)
     // one test fewer than the shard's rays make
     let fewer = |v: &mut serde_json::Value| {
-        let c = &mut v["formats"][0]["rti"]["c"][0];
+        let c = &mut v["formats"][0]["rti"]["counts"]["tests"];
         *c = (c.as_u64().unwrap() - 1).into();
     };
     refused(&merge(&[edit(&clean, &t, true, fewer)]), "RTI tests, but the shard's rays make");
@@ -262,14 +264,21 @@ fn tampered_partials_are_refused() {
     refused(&merge(&[edit(&clean, &t, true, hist)]), "a histogram's buckets hold");
     // a slab count: more false misses than exact hits
     let slab = |v: &mut serde_json::Value| {
-        let c = &mut v["formats"][0]["slab"][0][2]["c"];
-        c[2] = (c[1].as_u64().unwrap() + 1).into();
+        let c = &mut v["formats"][0]["slab"][0][2]["counts"];
+        c["false_misses"] = (c["exact_hits"].as_u64().unwrap() + 1).into();
     };
     refused(&merge(&[edit(&clean, &t, true, slab)]), "slab counts do not fit");
-    // a partial of the previous format (no digest) is refused by its version
-    let v1 = d.join("v1.json");
-    std::fs::write(&v1, text.replacen("\"raypipe_partial\":2", "\"raypipe_partial\":1", 1)).unwrap();
-    refused(&merge(&[v1.display().to_string()]), "partial format 1; this raypipe reads format 2 only");
+    // partials of the previous formats (1: no digest; 2: positional counters) are refused by
+    // their version, whatever their digest
+    for old in [1, 2] {
+        let v = d.join(format!("v{old}.json"));
+        let t = text.replacen("\"raypipe_partial\":3", &format!("\"raypipe_partial\":{old}"), 1);
+        std::fs::write(&v, reseal(&t)).unwrap();
+        refused(&merge(&[v.display().to_string()]), &format!("partial format {old}; this raypipe reads format 3 only"));
+    }
+    // a counter the format does not name is refused
+    let extra = |v: &mut serde_json::Value| v["formats"][0]["rti"]["counts"]["bonus"] = 1.into();
+    refused(&merge(&[edit(&clean, &t, true, extra)]), "unknown field `bonus`");
     // an untouched partial re-serialised the same way (members in the same order) still merges
     let same = d.join("same.json");
     assert_eq!(merge(&[edit(&clean, &same, true, |_| ())]).status.code(), Some(0));

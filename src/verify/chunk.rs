@@ -9,8 +9,8 @@
 //! 2. model: the fastest bit-identical batch path ([`datapath::simd::rti_batch`]);
 //! 3. golden: Möller–Trumbore in f64 lanes ([`golden::block::intersect_block`]) and the error
 //!    bound in f64 lanes ([`datapath::bound::verdict_block`]), each equal to its scalar code;
-//! 4. judge: per lane the counts, the t-error histograms and the first violation, as
-//!    [`crate::judge::Judged::violation`] defines them; the min-capture unit and the golden
+//! 4. judge: per lane the counts, the t-error histograms and the first violation, by the one
+//!    rule [`crate::judge::violation`]; the min-capture unit and the golden
 //!    closest hit run along the ray's blocks;
 //! 5. slab: the boxes of the same triangles through every variant's batch path, against the
 //!    f64 slab test in lanes ([`golden::block::slab_block`], shared by the variants) and the
@@ -18,6 +18,7 @@
 //!
 //! The chunk's accumulators are merged by the engine; nothing else outlives the chunk.
 
+use super::counts::{RtiCounts, SlabCounts};
 use super::{FormatReport, SlabReport, VerifyConfig};
 use crate::scene::Scene;
 use datapath::bound::{verdict_block, BlockOpts, BlockRay};
@@ -26,7 +27,7 @@ use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
 use datapath::simd::{self, Kernel};
 use datapath::slab::{Aabb, BoxesSoa, Slab, SlabConfig, SlabOutSoa};
 use datapath::Format;
-use engine::{Counts, First, Hist, Merge, Progress};
+use engine::{First, Hist, Merge, Progress};
 use golden::block::{intersect_block, slab_block, Level};
 use golden::{Ray64, Tri64};
 use std::time::Instant;
@@ -71,14 +72,12 @@ pub fn explain_cmd(fmt: &str, ray: &Ray64, tri: &Tri64, scale: f64, inject: Opti
     )
 }
 
-/// One format's RTI results: counts (tests, decisive, reference hits, model hits, false misses,
-/// false hits, violations, shared hits, closest-hit disagreements, divides skipped, tests that
-/// fell through the f64 filter to exact arithmetic), the t
-/// errors of shared hits in ulps and relative, the first violation by (ray, test), and the
-/// nanoseconds spent in the model's batch calls.
+/// One format's RTI results: the counters, the t errors of shared hits in ulps and relative,
+/// the first violation and the first disagreement by (ray, test), and the nanoseconds spent in
+/// the model's batch calls.
 #[derive(Default, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct RtiAcc {
-    c: Counts<11>,
+    counts: RtiCounts,
     ulps: Hist,
     rels: Hist,
     first: First<(u64, u64), String>,
@@ -88,7 +87,7 @@ struct RtiAcc {
 
 impl Merge for RtiAcc {
     fn merge(&mut self, o: Self) {
-        self.c.merge(o.c);
+        self.counts.merge(o.counts);
         self.ulps.merge(o.ulps);
         self.rels.merge(o.rels);
         self.first.merge(o.first);
@@ -97,17 +96,16 @@ impl Merge for RtiAcc {
     }
 }
 
-/// One slab variant's results: counts (tests, exact hits, false misses, false hits, exact
-/// calls) and the nanoseconds in its batch calls.
+/// One slab variant's results: the counters and the nanoseconds in its batch calls.
 #[derive(Default, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct SlabAcc {
-    c: Counts<5>,
+    counts: SlabCounts,
     model_ns: u64,
 }
 
 impl Merge for SlabAcc {
     fn merge(&mut self, o: Self) {
-        self.c.merge(o.c);
+        self.counts.merge(o.counts);
         self.model_ns += o.model_ns;
     }
 }
@@ -230,7 +228,7 @@ where
                     (Some((gi, _)), true) => list[gi] == list[cap.id as usize],
                     _ => false,
                 };
-                acc.c.0[8] += !same as u64;
+                acc.counts.closest_disagreements += !same as u64;
             }
             s.list = list;
             s.prepared = prepared;
@@ -303,13 +301,13 @@ where
             &mut s.ehit[..n],
             &mut s.terr[..n],
         );
-        let c = &mut acc.c.0;
+        let c = &mut acc.counts;
         let mut c_exact = 0;
         for k in 0..n {
             let (mhit, dec) = (s.out.hit[k], s.dec[k]);
             let (gt, mt) = (s.gt[k], f.to_f64(s.out.t[k]));
-            // the reference decision (crate::judge::reference): a decisive case's is the
-            // bound's; the rest go through the f64 filter, then exact arithmetic
+            // the reference decision (crate::judge::decide): a decisive case's is the bound's;
+            // the rest go through the f64 filter, then exact arithmetic
             let gh = if dec {
                 s.ehit[k]
             } else {
@@ -318,12 +316,12 @@ where
                 c_exact += fell as u64;
                 h
             };
-            c[0] += 1;
-            c[1] += dec as u64;
-            c[2] += gh as u64;
-            c[3] += mhit as u64;
-            c[4] += (gh && !mhit) as u64;
-            c[5] += (!gh && mhit) as u64;
+            c.tests += 1;
+            c.decisive += dec as u64;
+            c.reference_hits += gh as u64;
+            c.model_hits += mhit as u64;
+            c.false_misses += (gh && !mhit) as u64;
+            c.false_hits += (!gh && mhit) as u64;
             if mhit != gh {
                 let tri = &self.scene.tris[blk[k] as usize];
                 acc.disagree.offer((ray_index, (base + k) as u64), || {
@@ -332,35 +330,27 @@ where
                     format!("{what} ({how}): {}", self.explain(ray, tri))
                 });
             }
-            if dec {
-                // the property of crate::judge::Judged::violation
-                let why = if mhit != gh {
-                    Some(format!("hit/miss: model {mhit} exact {gh}"))
-                } else if mhit && (mt - gt).abs() > s.terr[k] + gt.abs() * 1e-12 {
-                    Some(format!("t error {:e} exceeds bound {:e}", (mt - gt).abs(), s.terr[k]))
-                } else {
-                    None
-                };
-                if let Some(why) = why {
-                    c[6] += 1;
-                    let tri = &self.scene.tris[blk[k] as usize];
-                    acc.first.offer((ray_index, (base + k) as u64), || format!("{why}: {}", self.explain(ray, tri)));
-                }
+            // the property, the one rule of crate::judge (a decisive case's reference is the
+            // bound's exact decision)
+            if let Some(why) = crate::judge::violation(dec, mhit, gh, gh, mt, gt, s.terr[k]) {
+                c.violations += 1;
+                let tri = &self.scene.tris[blk[k] as usize];
+                acc.first.offer((ray_index, (base + k) as u64), || format!("{why}: {}", self.explain(ray, tri)));
             }
             if mhit && gh {
-                c[7] += 1;
+                c.shared_hits += 1;
                 let e = (mt - gt).abs();
                 acc.ulps.add(e / f.ulp(gt));
                 acc.rels.add(e / gt.abs().max(f64::MIN_POSITIVE));
             }
-            c[9] += !s.out.valid[k] as u64;
+            c.divide_skipped += !s.out.valid[k] as u64;
             let out = RtiOut { valid: s.out.valid[k], hit: mhit, t: s.out.t[k], u: s.out.u[k], v: s.out.v[k] };
             self.rti.capture(cap, &out, (base + k) as u32);
             if gh && gbest.is_none_or(|(_, bt)| gt < bt) {
                 *gbest = Some((base + k, gt));
             }
         }
-        c[10] += c_exact;
+        c.exact += c_exact;
     }
 
     #[allow(clippy::needless_range_loop)]
@@ -416,11 +406,11 @@ where
             let t0 = Instant::now();
             simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
             acc.model_ns += t0.elapsed().as_nanos() as u64;
-            let c = &mut acc.c.0;
+            let c = &mut acc.counts;
             for k in 0..n {
                 let (hit, g) = (s.sout.hit[k], s.shit[k]);
                 let exact = if s.sclose[k] || g != hit {
-                    c[4] += 1;
+                    c.exact_calls += 1;
                     if s.exact[k] == 0 {
                         let b = &self.boxes[blk[k] as usize];
                         // verify's rays and boxes are finite; a ray that overflowed the format
@@ -434,10 +424,10 @@ where
                 } else {
                     g
                 };
-                c[0] += 1;
-                c[1] += exact as u64;
-                c[2] += (exact && !hit) as u64;
-                c[3] += (!exact && hit) as u64;
+                c.tests += 1;
+                c.exact_hits += exact as u64;
+                c.false_misses += (exact && !hit) as u64;
+                c.false_hits += (!exact && hit) as u64;
             }
         }
     }
@@ -497,7 +487,19 @@ impl FormatAcc {
         use crate::partial::require;
         let name = &self.name;
         if let Some(a) = &self.rti {
-            let [t, dec, gh, mh, fm, fh, viol, shared, closest, skipped, exact] = a.c.0;
+            let RtiCounts {
+                tests: t,
+                decisive: dec,
+                reference_hits: gh,
+                model_hits: mh,
+                false_misses: fm,
+                false_hits: fh,
+                violations: viol,
+                shared_hits: shared,
+                closest_disagreements: closest,
+                divide_skipped: skipped,
+                exact,
+            } = a.counts;
             let le = |x: u64, y: u64, what: &str, of: &str| {
                 require(x <= y, || format!("{name}: {what} ({x}) exceed {of} ({y})"))
             };
@@ -538,7 +540,8 @@ impl FormatAcc {
             }
         }
         for (variant, _, a) in &self.slab {
-            let [t, eh, fm, fh, calls] = a.c.0;
+            let SlabCounts { tests: t, exact_hits: eh, false_misses: fm, false_hits: fh, exact_calls: calls } =
+                a.counts;
             if let Some(want) = tests {
                 require(t == want, || format!("{name} {variant}: {t} slab tests, but the shard's rays make {want}"))?;
             }
@@ -552,27 +555,27 @@ impl FormatAcc {
     /// The format's RTI report (when it ran the RTI unit) and one slab report per variant.
     pub fn finish(self) -> (Option<FormatReport>, Vec<SlabReport>) {
         let rep = self.rti.map(|acc| {
-            let c = acc.c.0;
+            let c = acc.counts;
             FormatReport {
                 format: self.name.clone(),
                 width: self.width,
-                tests: c[0],
-                decisive: c[1],
-                golden_hits: c[2],
-                model_hits: c[3],
-                false_misses: c[4],
-                false_hits: c[5],
-                violations: c[6],
-                shared_hits: c[7],
+                tests: c.tests,
+                decisive: c.decisive,
+                golden_hits: c.reference_hits,
+                model_hits: c.model_hits,
+                false_misses: c.false_misses,
+                false_hits: c.false_hits,
+                violations: c.violations,
+                shared_hits: c.shared_hits,
                 t_err_ulps_median: acc.ulps.median(),
                 t_err_ulps_max: acc.ulps.max(),
                 t_err_rel_median: acc.rels.median(),
                 t_err_rel_max: acc.rels.max(),
-                closest_disagreements: c[8],
-                divide_skipped: c[9],
-                exact: c[10],
-                mtests_per_s: rate(c[0], acc.model_ns),
-                judged_mtests_per_s: rate(c[0], self.wall_ns),
+                closest_disagreements: c.closest_disagreements,
+                divide_skipped: c.divide_skipped,
+                exact: c.exact,
+                mtests_per_s: rate(c.tests, acc.model_ns),
+                judged_mtests_per_s: rate(c.tests, self.wall_ns),
                 first_violation: acc.first.into_inner(),
                 first_disagreement: acc.disagree.into_inner(),
             }
@@ -584,12 +587,12 @@ impl FormatAcc {
                 format: self.name.clone(),
                 variant,
                 conservative,
-                tests: a.c.0[0],
-                exact_hits: a.c.0[1],
-                false_misses: a.c.0[2],
-                false_hits: a.c.0[3],
-                exact_calls: a.c.0[4],
-                mtests_per_s: rate(a.c.0[0], a.model_ns),
+                tests: a.counts.tests,
+                exact_hits: a.counts.exact_hits,
+                false_misses: a.counts.false_misses,
+                false_hits: a.counts.false_hits,
+                exact_calls: a.counts.exact_calls,
+                mtests_per_s: rate(a.counts.tests, a.model_ns),
             })
             .collect();
         (rep, slab)
