@@ -77,6 +77,23 @@ impl OpsData {
     }
 }
 
+impl crate::partial::Sharded for OpsData {
+    const COMMAND: &'static str = "ops";
+    type Report = OpsReport;
+    fn add(&mut self, other: Self) -> Result<(), String> {
+        self.merge(other)
+    }
+    fn finish(self) -> Result<OpsReport, String> {
+        Ok(finish(self))
+    }
+    fn render(r: &OpsReport) -> String {
+        render(r)
+    }
+    fn outcome(r: &OpsReport) -> crate::Outcome {
+        crate::Outcome::from(r.passed)
+    }
+}
+
 impl crate::partial::Consistent for OpsData {
     /// One test per item of the shard, mismatches within the tests, a first mismatch record
     /// exactly when mismatches are counted.

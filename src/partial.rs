@@ -38,6 +38,24 @@ pub trait Consistent {
     fn check(&self, share: &dyn Fn(u64, u64) -> u64) -> Result<(), String>;
 }
 
+/// A command whose runs shard (`--shard K/N --partial FILE`, then `raypipe merge`): what a
+/// shard accumulates (this type, a partial's `data`), how shards add up, and the report. A new
+/// sharded command is one impl of this trait and of [`Consistent`].
+pub trait Sharded: Serialize + DeserializeOwned + Consistent {
+    /// The command (a partial's `command`).
+    const COMMAND: &'static str;
+    /// The report of the whole run.
+    type Report: Serialize;
+    /// Adds another shard's data of the same run (refused when it is not).
+    fn add(&mut self, other: Self) -> Result<(), String>;
+    /// The report of (merged) data.
+    fn finish(self) -> Result<Self::Report, String>;
+    /// The report as text.
+    fn render(report: &Self::Report) -> String;
+    /// The report's exit outcome.
+    fn outcome(report: &Self::Report) -> crate::Outcome;
+}
+
 /// An error unless `ok`: the inconsistency `what`.
 pub fn require(ok: bool, what: impl FnOnce() -> String) -> Result<(), String> {
     if ok {

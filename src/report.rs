@@ -212,6 +212,23 @@ impl ReportData {
     }
 }
 
+impl crate::partial::Sharded for ReportData {
+    const COMMAND: &'static str = "report";
+    type Report = Report;
+    fn add(&mut self, other: Self) -> Result<(), String> {
+        self.merge(other)
+    }
+    fn finish(self) -> Result<Report, String> {
+        finish(self)
+    }
+    fn render(r: &Report) -> String {
+        markdown(r)
+    }
+    fn outcome(_: &Report) -> crate::Outcome {
+        crate::Outcome::Pass
+    }
+}
+
 impl crate::partial::Consistent for ReportData {
     /// The stress rows and every scene's verify data consistent in themselves (their shares
     /// of the run use their own chunk sizes, so totals are not checked here), one entry per

@@ -646,6 +646,23 @@ impl crate::partial::Consistent for StressReport {
     }
 }
 
+impl crate::partial::Sharded for StressReport {
+    const COMMAND: &'static str = "stress";
+    type Report = StressReport;
+    fn add(&mut self, other: Self) -> Result<(), String> {
+        self.merge(other)
+    }
+    fn finish(self) -> Result<StressReport, String> {
+        Ok(self)
+    }
+    fn render(r: &StressReport) -> String {
+        render(r)
+    }
+    fn outcome(r: &StressReport) -> crate::Outcome {
+        crate::Outcome::from(r.passed)
+    }
+}
+
 impl StressReport {
     /// Checks the rows ([`crate::partial::Consistent`]); the slab class totals only with `share`.
     pub fn check_rows(&self, share: Option<&dyn Fn(u64, u64) -> u64>) -> Result<(), String> {

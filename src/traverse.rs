@@ -272,6 +272,23 @@ impl TraverseReport {
     }
 }
 
+impl crate::partial::Sharded for TraverseReport {
+    const COMMAND: &'static str = "traverse";
+    type Report = TraverseReport;
+    fn add(&mut self, other: Self) -> Result<(), String> {
+        self.merge(other)
+    }
+    fn finish(self) -> Result<TraverseReport, String> {
+        Ok(self)
+    }
+    fn render(r: &TraverseReport) -> String {
+        render(r)
+    }
+    fn outcome(r: &TraverseReport) -> crate::Outcome {
+        r.outcome()
+    }
+}
+
 impl crate::partial::Consistent for TraverseReport {
     /// Every row over the same rays, its per-ray counts within them, and `passed` what the
     /// rows say.

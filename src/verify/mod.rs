@@ -197,6 +197,23 @@ impl crate::partial::Consistent for VerifyData {
     }
 }
 
+impl crate::partial::Sharded for VerifyData {
+    const COMMAND: &'static str = "verify";
+    type Report = VerifyReport;
+    fn add(&mut self, other: Self) -> Result<(), String> {
+        self.merge(other)
+    }
+    fn finish(self) -> Result<VerifyReport, String> {
+        Ok(finish(self))
+    }
+    fn render(r: &VerifyReport) -> String {
+        render(r)
+    }
+    fn outcome(r: &VerifyReport) -> crate::Outcome {
+        r.outcome()
+    }
+}
+
 impl VerifyData {
     /// Checks every format's accumulators; `tests`: each unit's test count, when known.
     pub fn check_formats(&self, tests: Option<u64>) -> Result<(), String> {

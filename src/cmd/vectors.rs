@@ -1,0 +1,161 @@
+//! `raypipe vectors`: write a self-describing vector set for RTL testbenches (or check one with --check).
+
+use super::prelude::*;
+
+/// The options of `raypipe vectors`.
+#[derive(clap::Args, Clone)]
+pub struct Args {
+    /// Unit: rti, slab, op, traverse or capture (the min-capture unit).
+    #[arg(long, default_value = "rti")]
+    pub unit: String,
+    /// Number format (default f32, or the plan's narrowest format within its budget).
+    #[arg(long, value_parser = parse_format)]
+    pub format: Option<AnyFormat>,
+    /// A plan (`raypipe plan --json`): its format, leaf size and level pipelines.
+    #[arg(long)]
+    pub plan: Option<PathBuf>,
+    /// Output directory (replaced atomically).
+    #[arg(long, required_unless_present = "check")]
+    pub out: Option<PathBuf>,
+    /// Vectors per coverage class.
+    #[arg(long, default_value_t = 64)]
+    pub count: u64,
+    /// Seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Coverage level: 1 (every class on its own) or 2 (level 1 plus crossed classes).
+    #[arg(long, default_value_t = 1)]
+    pub level: u32,
+    /// Worker threads (default: every core); the files do not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Slab variant (units slab and traverse): plain, conservative, take-on-false, embree.
+    #[arg(long, default_value = "plain")]
+    pub variant: String,
+    /// Re-check an existing set against the models instead of writing one (a minimal set:
+    /// also that it still detects every fault its manifest names).
+    #[arg(long)]
+    pub check: Option<PathBuf>,
+    /// Write the minimal set: the fewest vectors of the default set (greedy set cover over
+    /// the fault bank) that still detect every fault it detects from the outputs.
+    #[arg(long, conflicts_with = "check")]
+    pub minimal: bool,
+    /// OBJ scene whose BVH the traverse unit uses (default: the built-in scene).
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// First N leaves per ray (unit traverse, 1..=255).
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u64).range(1..=255))]
+    pub leaves: u64,
+    /// Triangles per leaf at most (unit traverse, 1..=255; default 4, or the plan's).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=255))]
+    pub leaf_size: Option<u32>,
+    /// Level pipelines the hardware has (unit traverse; the history holds 2 bits per level;
+    /// default 64, or the plan's).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub levels: Option<u64>,
+    #[command(flatten)]
+    pub rti: RtiArgs,
+}
+
+/// Runs `raypipe vectors`.
+pub fn run(a: Args) -> Result<Outcome, String> {
+    let Args {
+        unit,
+        format,
+        plan,
+        out,
+        count,
+        seed,
+        level,
+        threads,
+        variant,
+        check,
+        minimal,
+        scene,
+        leaves,
+        leaf_size,
+        levels,
+        rti,
+    } = a;
+    if let Some(dir) = check {
+        let n = vectors::gen::check_set(&dir)?;
+        println!(
+            "{}: {n} vectors; the manifest, the HDL packages and every input, expected and stage row are what this raypipe writes",
+            dir.display()
+        );
+        if let Some(detects) = raypipe::faults::check_minimal(&dir)? {
+            println!("{}: a minimal set; it still detects all {detects} faults its manifest names", dir.display());
+        }
+        return Ok(Outcome::Pass);
+    }
+    let out = out.ok_or("--out is required")?;
+    limit("--count", count, MAX_VECTOR_COUNT, "a set is built in memory before it is written")?;
+    vectors::gen::check_out(&out)?;
+    let unit: vectors::gen::Unit = unit.parse()?;
+    // a plan fixes what the scene does not need: the format, the leaf size, the levels
+    let plan = plan.as_deref().map(raypipe::plan::load).transpose()?;
+    let format = match (format, &plan) {
+        (Some(f), _) => f,
+        (None, Some(p)) => p.narrowest()?,
+        (None, None) => "f32".parse().expect("built-in format name"),
+    };
+    // the plan's leaf size and level pipelines, unless given (a conflict is refused)
+    let (leaf_size, levels) = match &plan {
+        Some(p) => {
+            for (flag, given, planned) in [
+                ("--leaf-size", leaf_size.map(u64::from), p.leaf_size as u64),
+                ("--levels", levels, p.level_pipelines as u64),
+            ] {
+                if let Some(g) = given.filter(|&g| g != planned) {
+                    return Err(format!("{flag} {g} conflicts with the plan's {planned}; drop one of them"));
+                }
+            }
+            (p.leaf_size, p.level_pipelines as u64)
+        }
+        None => (leaf_size.unwrap_or(4), levels.unwrap_or(64)),
+    };
+    let tree = traverse_tree(unit, scene.as_deref(), leaf_size, plan.as_ref())?;
+    let req = vectors::gen::Request {
+        unit,
+        tree,
+        leaves: leaves as usize,
+        max_levels: levels as usize,
+        threads: threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+        format,
+        count: count as usize,
+        seed,
+        level,
+        command: command_without_threads(),
+        rti: rti.config()?,
+        slab_variant: variant,
+    };
+    let set = vectors::gen::generate(&req)?;
+    let set = if minimal {
+        let (cut, c) = faults::minimal::minimal(&set, &command_without_threads())?;
+        let m = cut.manifest.minimal.as_ref().expect("a minimal set says so");
+        println!(
+            "minimal set: {} of {} vectors ({:.1} %) detect the {} faults of the {} bank the default set detects from the outputs ({} escape both; see raypipe faults)",
+            cut.manifest.files[0].rows,
+            m.from_vectors,
+            100.0 * cut.manifest.files[0].rows as f64 / m.from_vectors.max(1) as f64,
+            m.detects.len(),
+            cut.manifest.unit,
+            c.escaped
+        );
+        cut
+    } else {
+        set
+    };
+    vectors::gen::write_set(&set, &out)?;
+    let m = &set.manifest;
+    println!(
+        "wrote {}: unit {}, format {}, {} vectors ({}), seed {}",
+        out.display(),
+        m.unit,
+        m.format,
+        m.files[0].rows,
+        m.classes.iter().map(|c| format!("{} {}", c.name, c.count)).collect::<Vec<_>>().join(", "),
+        m.seed
+    );
+    Ok(Outcome::Pass)
+}
