@@ -16,11 +16,11 @@ pub mod ops;
 pub mod partial;
 pub mod plan;
 pub mod render;
-pub mod report;
 pub mod scene;
 pub mod speed;
 pub mod stats;
 pub mod stress;
+pub mod time_vs_error;
 pub mod traverse;
 pub mod verify;
 

@@ -1,7 +1,7 @@
 //! `raypipe report`: every variant gets a point, the Pareto front is exactly the undominated
 //! points per unit, and the files are written.
 
-use raypipe::report::{report, write, ReportConfig};
+use raypipe::time_vs_error::{report, write, ReportConfig};
 use raypipe::scene::Scene;
 
 #[test]
@@ -35,7 +35,7 @@ fn points_pareto_front_and_files() {
     assert!(r.points.iter().filter(|p| p.variant.ends_with("directed")).all(|p| p.false_misses == 0));
     let dir = std::env::temp_dir().join(format!("raypipe-report-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let files = write(&r, &vectors::outdir::OutDir::check(&dir, &raypipe::report::FILES).unwrap()).unwrap();
+    let files = write(&r, &vectors::outdir::OutDir::check(&dir, &raypipe::time_vs_error::FILES).unwrap()).unwrap();
     assert_eq!(files.len(), 4);
     assert!(std::fs::read_to_string(dir.join("report.md")).unwrap().contains("| rti | f32 | 32 |"));
     // every point drawn, and named: beside its dot, or in the line under the plot

@@ -19,7 +19,7 @@ pub struct Args {
 /// Runs `raypipe merge`.
 pub fn run(a: Args) -> Result<Outcome, String> {
     let Args { partials, out, json } = a;
-    let dir = out.as_deref().map(|d| OutDir::check(d, &raypipe::report::FILES)).transpose()?;
+    let dir = out.as_deref().map(|d| OutDir::check(d, &raypipe::time_vs_error::FILES)).transpose()?;
     let parts = raypipe::partial::read_all(&partials)?;
     if dir.is_some() && parts[0].command != "report" {
         return Err(format!("--out writes a report's files; these are {} partials", parts[0].command));
@@ -30,15 +30,15 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     }
     match parts[0].command.as_str() {
         "report" => {
-            let mut rep = merged::<raypipe::report::ReportData>(&parts)?.finish()?;
+            let mut rep = merged::<raypipe::time_vs_error::ReportData>(&parts)?.finish()?;
             // the timings come from the shards' machines; the merge names its own
             rep.command = command_as_typed();
             if let Some(dir) = &dir {
-                for f in raypipe::report::write(&rep, dir)? {
+                for f in raypipe::time_vs_error::write(&rep, dir)? {
                     eprintln!("wrote {}", f.display());
                 }
             }
-            emit(json, &rep, raypipe::report::markdown)?;
+            emit(json, &rep, raypipe::time_vs_error::markdown)?;
             Ok(Outcome::Pass)
         }
         "stress" => finish_and_print(json, merged::<raypipe::stress::StressReport>(&parts)?),

@@ -39,7 +39,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     let sh = shard_of(sharding.shard.as_deref(), sharding.partial.as_deref())?;
     // a shard writes its partial, not the report's files
     let dir = match sharding.partial {
-        None => Some(OutDir::check(&out, &raypipe::report::FILES)?),
+        None => Some(OutDir::check(&out, &raypipe::time_vs_error::FILES)?),
         Some(_) => None,
     };
     let mut scenes = vec![Scene::builtin()];
@@ -49,7 +49,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     for s in &scenes {
         check_tests(rays, s, 512)?;
     }
-    let cfg = raypipe::report::ReportConfig {
+    let cfg = raypipe::time_vs_error::ReportConfig {
         formats: format,
         variants: variant,
         rays: rays as usize,
@@ -58,19 +58,19 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         engine: engine::Engine::new(raypipe::verify::CHUNK_RAYS).with_shard(sh),
     };
     if let Some(path) = &sharding.partial {
-        let data = raypipe::report::accumulate(&cfg, &scenes)?;
+        let data = raypipe::time_vs_error::accumulate(&cfg, &scenes)?;
         let id = Run {
-            args: raypipe::report::args(&cfg, &scenes),
+            args: raypipe::time_vs_error::args(&cfg, &scenes),
             scene_hash: String::new(),
             chunk: raypipe::verify::CHUNK_RAYS,
             shard: sh,
         };
         return conclude(json, Some(path), id, data);
     }
-    let mut rep = raypipe::report::report(&cfg, &scenes)?;
+    let mut rep = raypipe::time_vs_error::report(&cfg, &scenes)?;
     rep.command = command_as_typed();
-    let files = raypipe::report::write(&rep, dir.as_ref().expect("checked when there is no partial"))?;
-    emit(json, &rep, raypipe::report::markdown)?;
+    let files = raypipe::time_vs_error::write(&rep, dir.as_ref().expect("checked when there is no partial"))?;
+    emit(json, &rep, raypipe::time_vs_error::markdown)?;
     for f in files {
         eprintln!("wrote {}", f.display());
     }
