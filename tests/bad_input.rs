@@ -3,16 +3,11 @@
 //! and every bad input is a clear error (exit 2), never a panic, an abort or a vacuous pass
 //! (a run that proved nothing exits 3).
 
+mod common;
+use common::raypipe;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn raypipe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe"))
-        .current_dir(std::env::temp_dir())
-        .args(args)
-        .output()
-        .expect("run raypipe")
-}
 
 /// A fresh, empty temporary directory for one test.
 fn scratch(name: &str) -> PathBuf {

@@ -1,16 +1,11 @@
 //! The command line: the main job passes, JSON is well formed, and every bad input gives a
 //! clear error and exit code 2 (never a panic).
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
+use common::raypipe;
 
-fn raypipe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe"))
-        .current_dir(std::env::temp_dir())
-        .args(args)
-        .output()
-        .expect("run raypipe")
-}
+use std::path::PathBuf;
+use std::process::Output;
 
 fn text(o: &Output) -> (String, String) {
     (String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())

@@ -1,16 +1,11 @@
 //! `raypipe faults`: the bank against generated and written vector sets, its JSON, exit codes
 //! and refusals.
 
+mod common;
+use common::raypipe;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
-
-fn raypipe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe"))
-        .current_dir(std::env::temp_dir())
-        .args(args)
-        .output()
-        .expect("run raypipe")
-}
 
 fn json(o: &Output) -> serde_json::Value {
     serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&o.stdout)))

@@ -3,11 +3,11 @@
 //! command that reproduces it; the reference side of the run does not change.
 
 mod common;
+use common::raypipe;
 
 use common::{untimed, untimed_value};
 use raypipe::scene::Scene;
 use raypipe::verify::{verify, VerifyConfig};
-use std::process::Command;
 
 fn cfg(inject: Option<&str>) -> VerifyConfig {
     let mut c =
@@ -47,10 +47,6 @@ fn an_injected_fault_fails_verify_and_names_itself() {
         assert_eq!(untimed(&verify(&one, &scene)), untimed(&r), "{name}");
     }
     assert_eq!(kinds, [true, true]);
-}
-
-fn raypipe(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe")).current_dir(std::env::temp_dir()).args(args).output().unwrap()
 }
 
 #[test]

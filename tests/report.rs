@@ -1,8 +1,8 @@
 //! `raypipe report`: every variant gets a point, the Pareto front is exactly the undominated
 //! points per unit, and the files are written.
 
-use raypipe::time_vs_error::{report, write, ReportConfig};
 use raypipe::scene::Scene;
+use raypipe::time_vs_error::{report, write, ReportConfig};
 
 #[test]
 fn points_pareto_front_and_files() {

@@ -3,16 +3,11 @@
 //! stats run whose BVHs are all one leaf and a conservative render that hits nothing say so
 //! and exit 3.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
+use common::raypipe;
 
-fn raypipe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe"))
-        .current_dir(std::env::temp_dir())
-        .args(args)
-        .output()
-        .expect("run raypipe")
-}
+use std::path::PathBuf;
+use std::process::Command;
 
 /// A file in a fresh temporary directory.
 fn scene(name: &str, obj: &str) -> PathBuf {

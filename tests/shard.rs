@@ -2,16 +2,11 @@
 //! unsharded run (timings aside) for several N and any merge order; every bad partial set is
 //! refused with exit 2 and nothing merged.
 
+mod common;
+use common::raypipe;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn raypipe(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypipe"))
-        .current_dir(std::env::temp_dir())
-        .args(args)
-        .output()
-        .expect("run raypipe")
-}
 
 fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("raypipe-shard-{}-{name}", std::process::id()));

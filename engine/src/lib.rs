@@ -20,7 +20,7 @@
 //!                                   ▼
 //!                                report
 //! ```
-
+#![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod acc;

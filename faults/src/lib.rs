@@ -5,6 +5,7 @@
 //! vector set and says which faults the set detects, by which vectors and classes;
 //! [`minimal`] cuts a set to the fewest vectors that still detect what it detects.
 #![warn(missing_docs)]
+#![forbid(unsafe_code)]
 
 pub mod bank;
 pub mod campaign;

@@ -2,6 +2,7 @@
 //! rows, one vector per line, plus a `manifest.json` that says what every bit means), written
 //! atomically and deterministically, and read back to re-check every bit.
 #![warn(missing_docs)]
+#![forbid(unsafe_code)]
 
 pub mod capture;
 pub mod check;

@@ -24,11 +24,43 @@ fn req(unit: Unit, format: &str, count: usize) -> Request {
     }
 }
 
-/// The built-in scene's BVH (leaf size 4).
+/// A BVH over 64 overlapping boxes on a jittered 4 x 4 x 4 grid in [-1, 1]³ (median splits on the
+/// longest axis of the centres; leaf ids in box order): the shape of a scene's tree, built here
+/// so that the vectors crate tests without the CLI's scene code.
 fn builtin_tree() -> TreeInput {
-    let scene = raypipe::scene::Scene::builtin();
-    let b = raypipe::bvh::build(&scene, 4);
-    TreeInput { name: scene.name.clone(), nodes: b.nodes, root: 0 }
+    use datapath::bvh::NodeDesc;
+    let mut r = datapath::rng::SplitMix64::new(0x7472_6565);
+    let boxes: Vec<([f64; 3], [f64; 3])> = (0..64)
+        .map(|i| {
+            let c: [f64; 3] = std::array::from_fn(|a| {
+                let k = [i % 4, i / 4 % 4, i / 16][a] as f64;
+                (k - 1.5) * 0.5 + r.range(-0.05, 0.05)
+            });
+            let h = r.range(0.2, 0.3);
+            (c.map(|x| x - h), c.map(|x| x + h))
+        })
+        .collect();
+    fn build(boxes: &[([f64; 3], [f64; 3])], ids: &mut [usize], nodes: &mut Vec<NodeDesc>) -> u32 {
+        let lo: [f64; 3] = std::array::from_fn(|a| ids.iter().map(|&i| boxes[i].0[a]).fold(f64::INFINITY, f64::min));
+        let hi: [f64; 3] =
+            std::array::from_fn(|a| ids.iter().map(|&i| boxes[i].1[a]).fold(f64::NEG_INFINITY, f64::max));
+        let at = nodes.len() as u32;
+        nodes.push(NodeDesc { children: None, leaf: ids[0] as u32, min: lo, max: hi });
+        if ids.len() > 1 {
+            let axis = (0..3).max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b]))).unwrap();
+            let centre = |i: usize| boxes[i].0[axis] + boxes[i].1[axis];
+            ids.sort_by(|&x, &y| centre(x).total_cmp(&centre(y)).then(x.cmp(&y)));
+            let (l, r) = ids.split_at_mut(ids.len() / 2);
+            let left = build(boxes, l, nodes);
+            let right = build(boxes, r, nodes);
+            nodes[at as usize].children = Some([left, right]);
+        }
+        at
+    }
+    let mut ids: Vec<usize> = (0..boxes.len()).collect();
+    let mut nodes = Vec::new();
+    build(&boxes, &mut ids, &mut nodes);
+    TreeInput { name: "grid64".into(), nodes, root: 0 }
 }
 
 fn tmp(name: &str) -> PathBuf {
