@@ -67,7 +67,7 @@ pub const BATCH_PATHS: [&str; 5] = [
     "bf16: binary32 lanes, each op rounded to bf16 in integer lanes (IEEE or FTZ, canonical NaN)",
     "eEmM with M <= 24, E <= 10: binary64 lanes, each op rounded to the format in the lanes (subnormals, FTZ, overflow), a range filter skipping that work where the stage-1 values prove it unneeded (IEEE or FTZ, canonical NaN); the slab kernels: every variant, IEEE or FTZ, grid steps in the lanes (a raw subnormal t limit under FTZ: that lane on the scalar model)",
     "scalar model only: the propagate NaN rule, eEmM with E = 11 or M > 24, any :propagate float; every format's directed slab variant on ray-box pairs (one ray x many boxes has kernels)",
-    "fixed point qI.F with I + F <= 32: i64 lanes for RTI and slab (every variant), every rounding, overflow and division mode (datapath::fixed_lanes); wider fixed point: scalar model only",
+    "fixed point qI.F with I + F <= 32: i64 lanes for RTI and slab (every variant), every rounding, overflow and division mode (datapath::simd::fixed); wider fixed point: scalar model only",
 ];
 
 /// Adds and multiplies on independent accumulators for about `secs`, on the widest vector
@@ -282,7 +282,7 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     }));
     push(row("rti fp16 scalar model", pairs, RTI_OPS, 3, || r16.batch(&rays16, &tris16, &mut o16)));
     // the batch paths of bf16 (binary32 lanes), e8m16 (binary64 lanes, see
-    // datapath::format::narrow) and q16.16 (i64 lanes, datapath::fixed_lanes) beside their
+    // datapath::format::narrow) and q16.16 (i64 lanes, datapath::simd::fixed) beside their
     // scalar models (BATCH_PATHS says what runs where)
     for name in ["bf16", "e8m16", "q16.16"] {
         let any: datapath::AnyFormat = name.parse().expect("a built-in format name");

@@ -9,7 +9,7 @@
 //! was without the hook. The fault models themselves (which site, which bug) live
 //! in the `faults` crate.
 
-use crate::rti::Op;
+use crate::stage::Op;
 use crate::Format;
 
 /// The comparison a compare site makes.

@@ -7,7 +7,6 @@ pub mod alloc;
 pub mod bound;
 pub mod bvh;
 pub mod fault;
-pub mod fixed_lanes;
 pub mod format;
 pub mod lanes;
 pub mod probe;
@@ -15,6 +14,7 @@ pub mod rng;
 pub mod rti;
 pub mod simd;
 pub mod slab;
+pub mod stage;
 
 pub use format::{AnyFormat, Format};
 

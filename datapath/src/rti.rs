@@ -14,6 +14,7 @@
 use crate::fault::{Cmp, Fault, NoFault};
 use crate::format::{DivMode, Format};
 use crate::probe::{NoProbe, Probe};
+pub use crate::stage::{Op, SigDef};
 use crate::{record, record_flags};
 
 /// A ray in the datapath's format: origin, direction and the accepted t interval.
@@ -84,38 +85,6 @@ impl Default for RtiConfig {
     fn default() -> Self {
         Self { cull: Cull::TwoSided, det_threshold: 0.0, tie: TieRule::First }
     }
-}
-
-/// Operation of one signal in the stage table.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Op {
-    /// a - b.
-    Sub,
-    /// a + b.
-    Add,
-    /// a × b.
-    Mul,
-    /// a ÷ b (per the format's division mode).
-    Div,
-    /// A comparison or logic bit; the formula is in the note.
-    Logic,
-}
-
-/// One row of the stage table: `name = a op b` at `stage`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SigDef {
-    /// Pipeline stage (1-based).
-    pub stage: u8,
-    /// Signal name (as recorded by the probe).
-    pub name: &'static str,
-    /// Operation.
-    pub op: Op,
-    /// First operand (input or earlier signal).
-    pub a: &'static str,
-    /// Second operand.
-    pub b: &'static str,
-    /// Formula for logic bits.
-    pub note: &'static str,
 }
 
 const fn s(stage: u8, name: &'static str, op: Op, a: &'static str, b: &'static str) -> SigDef {

@@ -47,7 +47,7 @@
 use crate::fault::{Cmp, Fault, NoFault};
 use crate::format::Format;
 use crate::probe::{NoProbe, Probe};
-use crate::rti::{Op, SigDef};
+use crate::stage::{Op, SigDef};
 use crate::{record, record_flags};
 
 /// What the compare unit does with a NaN slab distance.

@@ -1054,7 +1054,7 @@ fn widest_fixed() -> Kernel {
     if !std::arch::is_x86_feature_detected!("avx512dq") {
         return Kernel::Avx2;
     }
-    datapath::fixed_lanes::WIDEST_FIXED
+    datapath::simd::fixed::WIDEST_FIXED
 }
 
 fn fixed(name: &str) -> datapath::format::Fixed {
@@ -1081,7 +1081,7 @@ proptest! {
     /// every rounding, overflow and division mode, both cullings.
     #[test]
     fn fixed_point_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, name in 0usize..8, mode in 0usize..16, cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-3), Just(0.5)]) {
-        use datapath::fixed_lanes::{kernel_fixed, rti_batch_fixed};
+        use datapath::simd::fixed::{kernel_fixed, rti_batch_fixed};
         let f = fixed(&format!("{}{}", FIXED_NAMES[name], FIXED_MODES[mode]));
         let rti = Rti::new(f, config(cull, thr));
         let (rays, tris) = columns(&f, n, seed, &fixed_specials(&f));
@@ -1102,7 +1102,7 @@ proptest! {
 /// of each under emu/avx512), in every rounding, overflow and division mode, on every kernel.
 #[test]
 fn fixed_point_ops_in_i64_lanes_equal_the_i128_model() {
-    use datapath::fixed_lanes::op_batch_fixed;
+    use datapath::simd::fixed::op_batch_fixed;
     for name in FIXED_NAMES {
         for mode in FIXED_MODES {
             let full = format!("{name}{mode}");
@@ -1135,6 +1135,6 @@ fn fixed_point_ops_in_i64_lanes_equal_the_i128_model() {
 #[test]
 fn fixed_point_formats_wider_than_32_bits_run_the_scalar_model() {
     for name in ["q16.17", "q32.32", "q8.56", "q33.0"] {
-        assert_eq!(datapath::fixed_lanes::kernel_fixed(&fixed(name)), Kernel::Scalar, "{name}");
+        assert_eq!(datapath::simd::fixed::kernel_fixed(&fixed(name)), Kernel::Scalar, "{name}");
     }
 }

@@ -37,10 +37,11 @@
 //! parameter, so no lane decides a mode; the slots after the last full vector run the scalar
 //! model.
 
+use super::select::{Kernel, SlabRays};
 use crate::format::{DivMode, Fixed, FxOverflow, FxRound};
-use crate::rti::{Cull, HitsSoa, Op, RaysSoa, Rti, TrisSoa};
-use crate::simd::{Kernel, SlabRays};
+use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
 use crate::slab::{BoxesSoa, Slab, SlabOutSoa, SlabRay, SlabRaysSoa};
+use crate::stage::Op;
 use crate::Format as _;
 
 /// The widest kernel of the fixed-point batch path (AVX-512F with AVX-512DQ: 8 i64 lanes).
@@ -1238,7 +1239,7 @@ mod isa {
 /// The kernel `rti_batch_fixed` / `op_batch_fixed` use for this format on this machine:
 /// formats of at most 32 bits on i64 lanes, the scalar model otherwise.
 pub fn kernel_fixed(f: &Fixed) -> Kernel {
-    let k = crate::simd::best_kernel(Lanes::of(f).is_some(), WIDEST_FIXED);
+    let k = super::select::best_kernel(Lanes::of(f).is_some(), WIDEST_FIXED);
     // the 8-lane kernel also needs AVX-512DQ (64-bit multiplies and conversions)
     #[cfg(target_arch = "x86_64")]
     if k == Kernel::Avx512 && !std::arch::is_x86_feature_detected!("avx512dq") {
@@ -1252,7 +1253,7 @@ pub fn kernel_fixed(f: &Fixed) -> Kernel {
 /// # Panics
 /// If the column lengths differ.
 pub fn rti_batch_fixed(rti: &Rti<Fixed>, rays: &RaysSoa<i64>, tris: &TrisSoa<i64>, out: &mut HitsSoa<i64>) -> Kernel {
-    crate::simd::rti_dispatch(
+    super::select::rti_dispatch(
         rti,
         rays,
         tris,
@@ -1306,7 +1307,7 @@ pub fn slab_kernel_fixed(s: &Slab<Fixed>) -> Kernel {
 
 /// The slab unit on the kernel `slab_kernel_fixed` names, through `datapath::simd`'s dispatch.
 fn slab_fixed(s: &Slab<Fixed>, rays: SlabRays<'_, i64>, boxes: &BoxesSoa<i64>, out: &mut SlabOutSoa<i64>) -> Kernel {
-    crate::simd::slab_dispatch(
+    super::select::slab_dispatch(
         s,
         rays,
         boxes,

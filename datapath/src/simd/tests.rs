@@ -1,0 +1,105 @@
+use super::isa::{v4d, v8d};
+use crate::format::{Ieee, Soft};
+use crate::Format;
+
+/// The range filter of both binary64-lane ISAs passes a vector exactly when, on every lane,
+/// every one of the twelve values is ±0 or a magnitude in [`fast_lo`, `fast_hi`] (the
+/// predicate of `datapath::format::narrow`, written here per value): NaNs, infinities,
+/// zeros, the limits and their neighbours, one odd value in one lane among ordinary ones.
+#[test]
+fn the_range_filter_is_the_documented_predicate() {
+    use crate::rng::SplitMix64;
+    use std::arch::is_x86_feature_detected as has;
+    for name in ["e8m16", "e10m24", "e8m7", "e6m9"] {
+        let crate::AnyFormat::Soft(f) = name.parse::<crate::AnyFormat>().unwrap() else { unreachable!() };
+        let n = super::select::narrow_of(&f).unwrap();
+        let (lo, hi) = (n.fast_lo, n.fast_hi);
+        let odd = [
+            f64::NAN,
+            -f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            0.0,
+            -0.0,
+            lo,
+            -lo,
+            hi,
+            -hi,
+            lo * (1.0 - f64::EPSILON / 2.0),
+            -lo * (1.0 - f64::EPSILON / 2.0),
+            hi * (1.0 + f64::EPSILON),
+            -hi * (1.0 + f64::EPSILON),
+            lo / 2.0,
+            hi * 2.0,
+            f64::MIN_POSITIVE,
+            f64::MAX,
+        ];
+        let ordinary = (lo * hi).sqrt();
+        let pass = |x: f64| !x.is_nan() && x.abs() <= hi && (x == 0.0 || x.abs() >= lo);
+        let mut r = SplitMix64::new(0xf11);
+        for round in 0..4000 {
+            // every value ordinary, then one to three odd values at random places
+            let mut v = [[ordinary; 8]; 12];
+            for _ in 0..round % 4 {
+                v[r.below(12) as usize][r.below(8) as usize] = odd[r.below(odd.len() as u64) as usize];
+            }
+            let want = v.iter().flatten().all(|&x| pass(x));
+            if has!("avx2") && has!("fma") {
+                for half in 0..2 {
+                    let w: [std::arch::x86_64::__m256d; 12] = std::array::from_fn(|k| {
+                        let l = &v[k][4 * half..4 * half + 4];
+                        // SAFETY: the features were detected.
+                        unsafe { std::mem::transmute::<[f64; 4], _>([l[0], l[1], l[2], l[3]]) }
+                    });
+                    let want = v.iter().all(|l| l[4 * half..4 * half + 4].iter().all(|&x| pass(x)));
+                    // SAFETY: the features were detected.
+                    assert_eq!(unsafe { v4d::fast_ok(&w, &n) }, want, "{name} v4d {v:?}");
+                }
+            }
+            if has!("avx512f") && has!("avx512dq") {
+                // SAFETY: the features were detected.
+                let w: [std::arch::x86_64::__m512d; 12] =
+                    std::array::from_fn(|k| unsafe { std::mem::transmute::<[f64; 8], _>(v[k]) });
+                // SAFETY: the features were detected.
+                assert_eq!(unsafe { v8d::fast_ok(&w, &n) }, want, "{name} v8d {v:?}");
+            }
+        }
+    }
+}
+
+/// The lanes' grid step equals the model's `next_up` on every encoding of small formats
+/// (subnormals, ±0, ±max, ±∞ dense), on every binary64-lane ISA here. (Under FTZ the step
+/// goes through `slab_ftz!`, held to the model by the slab proptests in `:ftz`.)
+#[test]
+fn next_up_in_binary64_lanes_equals_the_model_on_every_encoding() {
+    use std::arch::is_x86_feature_detected as has;
+    for name in ["e5m4", "e4m3", "e3m2", "e2m1", "e8m7", "e5m10", "e6m9"] {
+        let crate::AnyFormat::Soft(f) = name.parse::<crate::AnyFormat>().unwrap() else { unreachable!() };
+        let f: Ieee<Soft> = f;
+        let n = super::select::narrow_of(&f).unwrap();
+        let lay = n.lay;
+        let vals: Vec<u64> = (0..1u64 << lay.width()).filter(|&b| !lay.is_nan(b)).collect();
+        for &b in &vals {
+            let want = f.to_f64(f.next_up(f.from_bits(b)));
+            let x = f.to_f64(f.from_bits(b));
+            let mut got = Vec::new();
+            if has!("avx2") && has!("fma") {
+                // SAFETY: the features were detected.
+                let v = unsafe {
+                    std::mem::transmute::<std::arch::x86_64::__m256d, [f64; 4]>(v4d::next_up_soft(v4d::splat(x), &n))
+                };
+                got.push(v[0]);
+            }
+            if has!("avx512f") {
+                // SAFETY: the feature was detected.
+                let v = unsafe {
+                    std::mem::transmute::<std::arch::x86_64::__m512d, [f64; 8]>(v8d::next_up_soft(v8d::splat(x), &n))
+                };
+                got.push(v[0]);
+            }
+            for g in got {
+                assert_eq!(g.to_bits(), want.to_bits(), "{name}: next_up({x:e}) = {g:e}, the model {want:e}");
+            }
+        }
+    }
+}
