@@ -100,7 +100,7 @@ fn bench_export(c: &mut Criterion) {
     g.bench_function("rti_f32_generate_and_write", |bch| {
         bch.iter(|| {
             let set = vectors::gen::generate(black_box(&req)).expect("set");
-            vectors::gen::write_set(&set, &dir).expect("written");
+            vectors::write::write_set(&set, &dir).expect("written");
         })
     });
     g.finish();

@@ -13,7 +13,7 @@ fn manifest_of(dir: &Path) -> Result<vectors::manifest::Manifest, String> {
 
 /// The campaign over the set in `dir` with manifest `m` (rows checked against their hashes).
 fn on_set(dir: &Path, m: &vectors::manifest::Manifest, outputs_only: bool) -> Result<Campaign, String> {
-    let rows = vectors::gen::read_files(dir, m)?;
+    let rows = vectors::read::read_files(dir, m)?;
     faults::run(m, &rows, outputs_only)
 }
 
@@ -47,7 +47,7 @@ pub fn check_minimal(dir: &Path) -> Result<Option<usize>, String> {
 /// The campaign over the set `req` generates (in memory).
 pub fn on_request(req: &vectors::gen::Request, outputs_only: bool) -> Result<Campaign, String> {
     let set = vectors::gen::generate(req)?;
-    let rows = vectors::gen::set_rows(&set)?;
+    let rows = vectors::read::set_rows(&set)?;
     faults::run(&set.manifest, &rows, outputs_only)
 }
 

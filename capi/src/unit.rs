@@ -476,8 +476,8 @@ impl Unit {
         if m.unit != "traverse" {
             return Err(format!("{} is a set of unit {}, not traverse", dir.display(), m.unit));
         }
-        let contents = vectors::gen::read_files(dir, &m)?;
-        let (root, images) = vectors::gen::tree_images(&m, &contents)?;
+        let contents = vectors::read::read_files(dir, &m)?;
+        let (root, images) = vectors::read::tree_images(&m, &contents)?;
         let banks: Vec<_> = images.into_iter().map(|(a, b)| (a.clone(), b.clone())).collect();
         let leaves = m.params.get("leaves").copied().ok_or("manifest.json: params has no leaves")? as usize;
         let variant = m.options.get("variant").map_or("plain", |s| s.as_str()).to_string();

@@ -5,7 +5,8 @@
 use datapath::rti::{Cull, RtiConfig, TieRule};
 use raypipe_capi::*;
 use std::ffi::{CStr, CString};
-use vectors::gen::{generate, set_rows, Request, Unit};
+use vectors::gen::{generate, Request, Unit};
+use vectors::read::set_rows;
 
 fn request(unit: Unit, format: &str, rti: RtiConfig, variant: &str) -> Request {
     Request {

@@ -6,8 +6,10 @@ use datapath::bvh::NodeDesc;
 use datapath::rti::RtiConfig;
 use raypipe_capi::*;
 use std::ffi::{CStr, CString};
-use vectors::gen::{generate, set_rows, write_set, Request, Unit};
+use vectors::gen::{generate, Request, Unit};
+use vectors::read::set_rows;
 use vectors::traverse::TreeInput;
+use vectors::write::write_set;
 
 /// A balanced tree of 16 leaves: unit cubes spaced along x and y, inner boxes their unions.
 fn tree() -> TreeInput {

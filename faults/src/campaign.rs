@@ -185,18 +185,18 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
         .collect();
     with_format!(any, |f| {
         let model = match m.unit.as_str() {
-            "rti" => Model::Rti(Rti::new(f, vectors::gen::rti_config_from(m)?)),
-            "capture" => Model::Capture(vectors::gen::capture_rti_from(f, m)),
+            "rti" => Model::Rti(Rti::new(f, vectors::read::rti_config_from(m)?)),
+            "capture" => Model::Capture(vectors::read::capture_rti_from(f, m)),
             "op" => Model::Op(f),
             "traverse" => {
-                let slab = Slab::new(f, vectors::gen::slab_config_from(m)?);
-                let (root, images) = vectors::gen::tree_images(m, rows)?;
+                let slab = Slab::new(f, vectors::read::slab_config_from(m)?);
+                let (root, images) = vectors::read::tree_images(m, rows)?;
                 let banks: Vec<_> = images.into_iter().map(|(a, b)| (a.clone(), b.clone())).collect();
                 let tree = vectors::traverse::tree_from_images(&slab, root, &banks)?;
                 let leaves = m.params.get("leaves").copied().ok_or("manifest has no leaves parameter")? as usize;
                 Model::Traverse { slab, tree, leaves }
             }
-            _ => Model::Slab(Slab::new(f, vectors::gen::slab_config_from(m)?)),
+            _ => Model::Slab(Slab::new(f, vectors::read::slab_config_from(m)?)),
         };
         let injected: Vec<Injected> = bank.iter().map(|s| Injected::new(s)).collect();
         for (i, input) in inputs.iter().enumerate() {

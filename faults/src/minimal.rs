@@ -7,8 +7,9 @@
 //! ln(faults) + 1 of the smallest cover; the set is "the smallest found", not proven smallest.
 
 use crate::campaign::{run, Campaign};
-use vectors::gen::{set_rows, VectorSet};
+use vectors::gen::VectorSet;
 use vectors::manifest::Minimal;
+use vectors::read::set_rows;
 
 /// A minimal set cut from `set`, and the campaign over it (every fault the whole set detects
 /// from the outputs is detected by it). `command` is recorded in its manifest.

@@ -270,7 +270,7 @@ fn read_set<'py>(py: Python<'py>, dir: std::path::PathBuf) -> PyResult<Bound<'py
         .map_err(|e| PyIOError::new_err(format!("{}: {e}", dir.join("manifest.json").display())))?;
     let m: vectors::manifest::Manifest =
         serde_json::from_str(&text).map_err(|e| PyValueError::new_err(format!("manifest.json: {e}")))?;
-    let files = vectors::gen::read_files(&dir, &m).map_err(PyValueError::new_err)?;
+    let files = vectors::read::read_files(&dir, &m).map_err(PyValueError::new_err)?;
     let json = py.import("json")?;
     let d = PyDict::new(py);
     d.set_item("manifest", json.call_method1("loads", (text,))?)?;

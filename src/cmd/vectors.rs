@@ -78,7 +78,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         rti,
     } = a;
     if let Some(dir) = check {
-        let n = vectors::gen::check_set(&dir)?;
+        let n = vectors::check::check_set(&dir)?;
         println!(
             "{}: {n} vectors; the manifest, the HDL packages and every input, expected and stage row are what this raypipe writes",
             dir.display()
@@ -90,7 +90,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     }
     let out = out.ok_or("--out is required")?;
     limit("--count", count, MAX_VECTOR_COUNT, "a set is built in memory before it is written")?;
-    vectors::gen::check_out(&out)?;
+    vectors::write::check_out(&out)?;
     let unit: vectors::gen::Unit = unit.parse()?;
     // a plan fixes what the scene does not need: the format, the leaf size, the levels
     let plan = plan.as_deref().map(raypipe::plan::load).transpose()?;
@@ -146,7 +146,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     } else {
         set
     };
-    vectors::gen::write_set(&set, &out)?;
+    vectors::write::write_set(&set, &out)?;
     let m = &set.manifest;
     println!(
         "wrote {}: unit {}, format {}, {} vectors ({}), seed {}",

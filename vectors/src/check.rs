@@ -1,5 +1,5 @@
 //! `vectors --check`: a whole set against what this raypipe writes. The model is re-run on
-//! every input row ([`crate::gen::check_rows`]); the manifest is regenerated from the set's own
+//! every input row ([`crate::read::check_rows`]); the manifest is regenerated from the set's own
 //! unit, format, level, seed, options and (traverse) tree and compared field by field; the
 //! generated HDL packages are regenerated from the manifest and compared byte for byte; and, for
 //! a set written by this raypipe version, the input rows too (a minimal set's rows must be rows
@@ -23,11 +23,11 @@ pub fn check_set(dir: &Path) -> Result<usize, String> {
     }
     let unit: Unit = m.unit.parse().map_err(|e| format!("manifest.json: field unit: {e}"))?;
     let any: AnyFormat = m.format.parse().map_err(|e| format!("manifest.json: field format: {e}"))?;
-    let contents = crate::gen::read_files(dir, &m)?;
+    let contents = crate::read::read_files(dir, &m)?;
     // the manifest this raypipe writes for the same unit, format, level, seed and options
     let regen = generate(&request_from(&m, unit, any, &contents)?)?;
     compare_manifests(&m, &regen.manifest)?;
-    let n = crate::gen::check_rows(&m, unit, any, &contents)?;
+    let n = crate::read::check_rows(&m, unit, any, &contents)?;
     // the HDL packages are a function of the manifest
     for (name, want) in
         [("raypipe_pkg.sv", crate::hdl::sv_package(&m)), ("raypipe_pkg.vhd", crate::hdl::vhdl_package(&m))]
@@ -119,7 +119,7 @@ fn request_from(m: &Manifest, unit: Unit, format: AnyFormat, contents: &[Vec<Vec
 /// The traverse set's tree from its root row and level banks, in the breadth-first order the
 /// layout assigns pair indices in (so laying it out again gives the same banks).
 fn tree_from_banks<F: Format>(f: &F, m: &Manifest, contents: &[Vec<Vec<u64>>]) -> Result<TreeInput, String> {
-    let (root, banks) = crate::gen::tree_images(m, contents)?;
+    let (root, banks) = crate::read::tree_images(m, contents)?;
     let levels = banks.len();
     let node = |row: &[u64]| -> Result<(NodeDesc, u32), String> {
         if row.len() < 7 {

@@ -11,6 +11,7 @@ pub mod hdl;
 pub mod manifest;
 pub mod outdir;
 pub mod pack;
+pub mod read;
 mod rows;
 pub mod traverse;
 
@@ -35,3 +36,4 @@ mod tests {
         assert_eq!(hex_field(u64::MAX, 64), "ffffffffffffffff");
     }
 }
+pub mod write;

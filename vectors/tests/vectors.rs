@@ -3,8 +3,10 @@
 
 use datapath::rti::RtiConfig;
 use std::path::PathBuf;
-use vectors::gen::{check_set, generate, write_set, Request, Unit};
+use vectors::check::check_set;
+use vectors::gen::{generate, Request, Unit};
 use vectors::traverse::TreeInput;
+use vectors::write::write_set;
 
 fn req(unit: Unit, format: &str, count: usize) -> Request {
     Request {
