@@ -279,7 +279,7 @@ impl crate::partial::Sharded for TraverseReport {
         self.merge(other)
     }
     fn finish(self) -> Result<TraverseReport, String> {
-        Ok(self)
+        Ok(self.with_verdict())
     }
     fn render(r: &TraverseReport) -> String {
         render(r)
@@ -290,8 +290,8 @@ impl crate::partial::Sharded for TraverseReport {
 }
 
 impl crate::partial::Consistent for TraverseReport {
-    /// Every row over the same rays, its per-ray counts within them, and `passed` what the
-    /// rows say.
+    /// Every row over the same rays, its per-ray counts within them, and `passed` and
+    /// `inconclusive` what the rows and the tree say.
     fn check(&self, _share: &dyn Fn(u64, u64) -> u64) -> Result<(), String> {
         use crate::partial::require;
         let rays = self.rows.first().map_or(0, |r| r.rays);
@@ -307,7 +307,10 @@ impl crate::partial::Consistent for TraverseReport {
             )?;
         }
         let passed = self.rows.iter().all(|r| r.history_mismatches == 0 && r.trail_mismatches == 0);
-        require(self.passed == passed, || format!("passed is {} but the rows say {passed}", self.passed))
+        require(self.passed == passed, || format!("passed is {} but the rows say {passed}", self.passed))?;
+        require(self.inconclusive == self.vacuous(), || {
+            format!("inconclusive is {:?} but the tree and rows say {:?}", self.inconclusive, self.vacuous())
+        })
     }
 }
 

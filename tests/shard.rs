@@ -404,3 +404,42 @@ fn report_shards_and_merges() {
     refused(&raypipe(&["merge", "--out", merged_dir.to_str().unwrap(), &v[0]]), "report");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// A traverse shard over a BVH of one leaf merges as inconclusive (exit 3), and the same
+/// partial with `inconclusive` edited away (digest recomputed) is refused.
+#[test]
+fn a_vacuous_traverse_shard_stays_inconclusive() {
+    let d = dir("vacuous");
+    let obj = d.join("one.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let p = d.join("t.json").display().to_string();
+    let o = raypipe(&[
+        "traverse",
+        "--scene",
+        obj.to_str().unwrap(),
+        "--rays",
+        "64",
+        "--quiet",
+        "--shard",
+        "0/1",
+        "--partial",
+        &p,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m = merge(std::slice::from_ref(&p));
+    assert_eq!(m.status.code(), Some(3), "{}", String::from_utf8_lossy(&m.stdout));
+    let j = raypipe(&["merge", "--json", &p]);
+    assert_eq!(j.status.code(), Some(3));
+    let jv: serde_json::Value = serde_json::from_slice(&j.stdout).unwrap();
+    assert!(jv["inconclusive"].is_string(), "{jv}");
+    let t = d.join("t2.json");
+    let text = std::fs::read_to_string(&p).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["data"]["inconclusive"] = serde_json::Value::Null;
+    let digest = v.as_object_mut().unwrap().remove("digest").unwrap();
+    let body = serde_json::to_string(&v).unwrap();
+    let edited = format!("{},\"digest\":{digest}}}\n", body.strip_suffix('}').unwrap());
+    std::fs::write(&t, reseal(&edited)).unwrap();
+    refused(&merge(&[t.display().to_string()]), "inconclusive is None but the tree and rows say");
+    std::fs::remove_dir_all(&d).unwrap();
+}
