@@ -23,7 +23,7 @@ pub struct PlanConfig {
     /// Largest acceptable rate of hit/miss disagreements with the golden, per test.
     pub budget: f64,
     /// Rays of the measurement.
-    pub rays: usize,
+    pub rays: u64,
     /// Seed of the measurement.
     pub seed: u64,
     /// Level pipelines the hardware has.
@@ -127,7 +127,7 @@ pub struct Plan {
     /// The narrowest format meeting the budget.
     pub smallest_within_budget: Option<String>,
     /// Rays and seed of the measurement.
-    pub rays: usize,
+    pub rays: u64,
     /// Seed.
     pub seed: u64,
 }

@@ -27,7 +27,7 @@ pub struct ReportConfig {
     /// Slab variants.
     pub variants: Vec<String>,
     /// Rays per scene.
-    pub rays: usize,
+    pub rays: u64,
     /// Stress cases per class.
     pub stress_count: usize,
     /// Seed.
@@ -91,7 +91,7 @@ pub struct Report {
     /// Scenes.
     pub scenes: Vec<String>,
     /// Rays per scene.
-    pub rays: usize,
+    pub rays: u64,
     /// Stress cases per class.
     pub stress_count: usize,
     /// Seed.
@@ -111,14 +111,14 @@ pub struct Report {
 /// Scene rays against their target and 31 sampled triangles: (tests, false misses, false hits)
 /// against the exact decision on the quantised inputs, over the engine's shard of the rays
 /// (ray i samples its triangles from `SplitMix64::new(seed ^ i · 0x9e3779b97f4a7c15)`).
-fn exact_rti<F: Format>(f: F, scene: &Scene, rays: usize, seed: u64, eng: &engine::Engine) -> [u64; 3] {
+fn exact_rti<F: Format>(f: F, scene: &Scene, rays: u64, seed: u64, eng: &engine::Engine) -> [u64; 3] {
     let rti = Rti::new(f, RtiConfig::default());
     let q = |x: f64| f.to_f64(f.from_f64(x));
     let gen = scene.ray_gen(seed);
     let n = scene.tris.len() as u64;
     let acc = engine::run(
         eng,
-        rays as u64,
+        rays,
         &engine::Progress::off(),
         || (),
         |_, range| {
@@ -171,7 +171,7 @@ pub struct ReportData {
     /// Slab variants.
     pub variants: Vec<String>,
     /// Rays per scene.
-    pub rays: usize,
+    pub rays: u64,
     /// Stress cases per class.
     pub stress_count: usize,
     /// Seed.

@@ -30,14 +30,14 @@ unsafe impl GlobalAlloc for Counting {
 static A: Counting = Counting;
 
 /// Heap bytes above the level before the run, at the run's peak.
-fn peak_of(rays: usize) -> usize {
+fn peak_of(rays: u64) -> usize {
     let scene = Scene::builtin();
     let cfg =
         VerifyConfig::new(vec!["f32".parse().unwrap(), "bf16".parse().unwrap()], rays, 3, Default::default(), 512);
     let before = NOW.load(Relaxed);
     PEAK.store(before, Relaxed);
     let rep = verify(&cfg, &scene);
-    assert!(rep.formats.iter().all(|f| f.tests == rays as u64 * 368));
+    assert!(rep.formats.iter().all(|f| f.tests == rays * 368));
     PEAK.load(Relaxed) - before
 }
 

@@ -11,7 +11,7 @@ fn pool(n: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap()
 }
 
-fn cfg(formats: &[&str], rays: usize, seed: u64) -> VerifyConfig {
+fn cfg(formats: &[&str], rays: u64, seed: u64) -> VerifyConfig {
     VerifyConfig::new(formats.iter().map(|f| f.parse().unwrap()).collect(), rays, seed, Default::default(), 512)
 }
 
@@ -54,7 +54,7 @@ fn the_streaming_engine_equals_the_scalar_judge() {
             let mut slab = vec![[0u64; 5]; 0];
             let variants = SlabConfig::variants_for(&rti.fmt);
             slab.resize(variants.len(), [0; 5]);
-            for (i, (ray, _)) in scene.rays(c.rays, c.seed).iter().enumerate() {
+            for (i, (ray, _)) in scene.rays(c.rays as usize, c.seed).iter().enumerate() {
                 let _ = i;
                 let mut cap = Capture::default();
                 // the closest hit among the reference decisions (nearest golden t)

@@ -52,7 +52,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         formats: format,
         pipelines,
         budget,
-        rays: rays as usize,
+        rays,
         seed,
         max_levels: levels as usize,
         arch: hw.params(pipelines.max(1), levels as u32),

@@ -52,7 +52,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     let cfg = raypipe::time_vs_error::ReportConfig {
         formats: format,
         variants: variant,
-        rays: rays as usize,
+        rays,
         stress_count: stress_count as usize,
         seed,
         engine: engine::Engine::new(raypipe::verify::CHUNK_RAYS).with_shard(sh),

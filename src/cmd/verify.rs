@@ -83,7 +83,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     };
     check_tests(a.rays, &scene, a.sample)?;
     let shard = shard_of(a.sharding.shard.as_deref(), a.sharding.partial.as_deref())?;
-    let mut cfg = VerifyConfig::new(formats, a.rays as usize, a.seed, rti, a.sample as usize);
+    let mut cfg = VerifyConfig::new(formats, a.rays, a.seed, rti, a.sample as usize);
     cfg.engine = a.run.engine(a.chunk).with_shard(shard);
     cfg.progress = !a.run.quiet;
     cfg.inject = inject;

@@ -671,10 +671,10 @@ where
         name: f.name(),
         rti: rti.clone(),
     };
-    let progress = Progress::new(cfg.engine.shard_items(cfg.rays as u64), "rays", !cfg.progress);
+    let progress = Progress::new(cfg.engine.shard_items(cfg.rays), "rays", !cfg.progress);
     progress.message(format!("{} ({} tests per ray)", setup.name, tests_per_ray(scene, cfg.sample)));
     let wall = Instant::now();
-    let (acc, sacc) = engine::run(&cfg.engine, cfg.rays as u64, &progress, Scratch::new, |s, r| setup.chunk(s, r));
+    let (acc, sacc) = engine::run(&cfg.engine, cfg.rays, &progress, Scratch::new, |s, r| setup.chunk(s, r));
     let wall_ns = wall.elapsed().as_nanos() as u64;
     progress.finish();
     // an empty run merges nothing: one empty accumulator per variant

@@ -18,7 +18,7 @@ pub struct VerifyConfig {
     /// Formats to verify.
     pub formats: Vec<AnyFormat>,
     /// Number of rays.
-    pub rays: usize,
+    pub rays: u64,
     /// Seed of the ray generator.
     pub seed: u64,
     /// RTI options.
@@ -40,7 +40,7 @@ pub const CHUNK_RAYS: u64 = 16;
 
 impl VerifyConfig {
     /// A configuration with every core, the default chunk and no progress output.
-    pub fn new(formats: Vec<AnyFormat>, rays: usize, seed: u64, rti: RtiConfig, sample: usize) -> Self {
+    pub fn new(formats: Vec<AnyFormat>, rays: u64, seed: u64, rti: RtiConfig, sample: usize) -> Self {
         VerifyConfig {
             formats,
             rays,
@@ -117,7 +117,7 @@ pub struct VerifyReport {
     /// The power of two applied to the scene's coordinates.
     pub scale: f64,
     /// Rays cast.
-    pub rays: usize,
+    pub rays: u64,
     /// Ray seed.
     pub seed: u64,
     /// Triangles tested per ray.
@@ -163,7 +163,7 @@ pub struct VerifyData {
     /// Coordinate scale.
     pub scale: f64,
     /// Rays of the whole run.
-    pub rays: usize,
+    pub rays: u64,
     /// Seed.
     pub seed: u64,
     /// Tests per ray.
@@ -193,7 +193,7 @@ impl VerifyData {
 
 impl crate::partial::Consistent for VerifyData {
     fn check(&self, share: &dyn Fn(u64, u64) -> u64) -> Result<(), String> {
-        self.check_formats(share(0, self.rays as u64).checked_mul(self.tests_per_ray as u64))
+        self.check_formats(share(0, self.rays).checked_mul(self.tests_per_ray as u64))
     }
 }
 
