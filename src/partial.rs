@@ -4,7 +4,7 @@
 //! shard is there exactly once, then adds the accumulators up and reports as the unsharded run
 //! would.
 //!
-//! A partial file is JSON: `raypipe_partial` (format version 1), `version` (raypipe's),
+//! A partial file is JSON: `raypipe_partial` (format version, [`FORMAT`]), `version` (raypipe's),
 //! `command` (e.g. `verify`), `args` (every option that changes the results, canonical),
 //! `scene_hash` (FNV-1a 64 over the scene's triangle coordinates' binary64 encodings, hex),
 //! `chunk` (items per chunk: the shard split depends on it), `shard` (`k`, `n`), `data`
@@ -21,8 +21,8 @@
 use engine::Shard;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
+use vectors::write::sha256_hex;
 
 /// The partial file format's version (2: the `digest` member and the consistency rules; 3:
 /// verify's counters by name).
@@ -104,11 +104,6 @@ impl<T> Partial<T> {
             file: PathBuf::new(),
         }
     }
-}
-
-/// SHA-256 of `bytes` as 64 lowercase hex digits.
-fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// The file text of a partial whose JSON (one object, no trailing newline) is `body`: the
@@ -214,8 +209,9 @@ pub fn read_all(paths: &[PathBuf]) -> Result<Vec<Partial<serde_json::Value>>, St
                 p.display()
             ));
         }
-        let body = unseal(&text).map_err(|e| format!("{}: refused: {e}", p.display()))?;
-        let mut part: Partial<serde_json::Value> = serde_json::from_str(&body)
+        unseal(&text).map_err(|e| format!("{}: refused: {e}", p.display()))?;
+        // the digest member is not a field of Partial: the parsed file is its content
+        let mut part: Partial<serde_json::Value> = serde_json::from_value(value)
             .map_err(|e| format!("{}: not a raypipe partial (corrupt or truncated?): {e}", p.display()))?;
         part.file = p.clone();
         parts.push((p.clone(), part));
@@ -281,16 +277,13 @@ pub fn data<T: DeserializeOwned + Consistent>(p: &Partial<serde_json::Value>) ->
 }
 
 /// The checked partials' data, typed, each checked for consistency, and added up in shard
-/// order by `add`.
-pub fn merge_data<T: DeserializeOwned + Consistent>(
-    parts: &[Partial<serde_json::Value>],
-    add: impl Fn(&mut T, T) -> Result<(), String>,
-) -> Result<T, String> {
+/// order by [`Sharded::add`].
+pub fn merge_data<T: Sharded>(parts: &[Partial<serde_json::Value>]) -> Result<T, String> {
     let mut total: Option<T> = None;
     for p in parts {
         let d: T = data(p)?;
         match total.as_mut() {
-            Some(t) => add(t, d)?,
+            Some(t) => t.add(d)?,
             None => total = Some(d),
         }
     }

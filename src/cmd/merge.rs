@@ -24,13 +24,11 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     if dir.is_some() && parts[0].command != "report" {
         return Err(format!("--out writes a report's files; these are {} partials", parts[0].command));
     }
-    // one function per command: merge_data checks each shard's consistency and adds them up
-    fn merged<T: Sharded>(parts: &[raypipe::partial::Partial<serde_json::Value>]) -> Result<T, String> {
-        raypipe::partial::merge_data(parts, T::add)
-    }
+    // merge_data checks each shard's consistency and adds them up
+    use raypipe::partial::merge_data;
     match parts[0].command.as_str() {
         "report" => {
-            let mut rep = merged::<raypipe::time_vs_error::ReportData>(&parts)?.finish()?;
+            let mut rep = merge_data::<raypipe::time_vs_error::ReportData>(&parts)?.finish()?;
             // the timings come from the shards' machines; the merge names its own
             rep.command = command_as_typed();
             if let Some(dir) = &dir {
@@ -41,10 +39,10 @@ pub fn run(a: Args) -> Result<Outcome, String> {
             emit(json, &rep, raypipe::time_vs_error::markdown)?;
             Ok(Outcome::Pass)
         }
-        "stress" => finish_and_print(json, merged::<raypipe::stress::StressReport>(&parts)?),
-        "traverse" => finish_and_print(json, merged::<raypipe::traverse::TraverseReport>(&parts)?),
-        "ops" => finish_and_print(json, merged::<raypipe::ops::OpsData>(&parts)?),
-        "verify" => finish_and_print(json, merged::<raypipe::verify::VerifyData>(&parts)?),
+        "stress" => finish_and_print(json, merge_data::<raypipe::stress::StressReport>(&parts)?),
+        "traverse" => finish_and_print(json, merge_data::<raypipe::traverse::TraverseReport>(&parts)?),
+        "ops" => finish_and_print(json, merge_data::<raypipe::ops::OpsData>(&parts)?),
+        "verify" => finish_and_print(json, merge_data::<raypipe::verify::VerifyData>(&parts)?),
         other => Err(format!("raypipe merge: partials of '{other}' cannot be merged by this raypipe")),
     }
 }

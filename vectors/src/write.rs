@@ -6,7 +6,8 @@ use crate::manifest::Manifest;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
-pub(crate) fn sha256_hex(data: &[u8]) -> String {
+/// SHA-256 of `data` as 64 lowercase hex digits (a manifest's file digests, a partial's digest).
+pub fn sha256_hex(data: &[u8]) -> String {
     Sha256::digest(data).iter().map(|b| format!("{b:02x}")).collect()
 }
 
