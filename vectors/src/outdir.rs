@@ -21,11 +21,14 @@ pub fn partial_of(path: &Path) -> Result<PathBuf, String> {
     Ok(parent.join(format!(".{}.raypipe-partial", name.to_string_lossy())))
 }
 
-/// Records a temporary path that [`remove_partials`] deletes if the run is interrupted.
-pub fn register_partial(p: &Path) {
-    if let Ok(mut v) = PARTIALS.lock() {
-        v.push(p.to_path_buf());
-    }
+/// Records the temporary path `p` for [`remove_partials`] and creates it with `create`, both
+/// under the registry's lock, so that an interrupt finds `p` either recorded or not yet created
+/// (never created after the handler looked). On an error `p` stays recorded: the caller
+/// removes what was made and calls [`unregister_partial`].
+pub fn create_partial(p: &Path, create: impl FnOnce(&Path) -> std::io::Result<()>) -> std::io::Result<()> {
+    let mut v = PARTIALS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    v.push(p.to_path_buf());
+    create(p)
 }
 
 /// Forgets a temporary path (it was renamed into place).
@@ -35,16 +38,25 @@ pub fn unregister_partial(p: &Path) {
     }
 }
 
-/// Deletes every registered temporary path (the SIGINT handler calls it).
+/// Deletes every registered temporary path; for the SIGINT handler, which exits right after:
+/// the registry stays locked, so no run creates a temporary path afterwards.
 pub fn remove_partials() {
-    let paths = PARTIALS.lock().map(|v| v.clone()).unwrap_or_default();
-    for p in paths {
+    let paths = PARTIALS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    for p in paths.iter() {
         if p.is_dir() {
-            let _ = std::fs::remove_dir_all(&p);
+            // A run's thread may still be writing into the directory: a file it creates
+            // between the listing and the final `rmdir` makes that fail, so try again (a run
+            // writes a handful of files; once the directory is gone its writes fail).
+            for _ in 0..64 {
+                if std::fs::remove_dir_all(p).is_ok() || !p.exists() {
+                    break;
+                }
+            }
         } else {
-            let _ = std::fs::remove_file(&p);
+            let _ = std::fs::remove_file(p);
         }
     }
+    std::mem::forget(paths);
 }
 
 /// The nearest existing ancestor of `path` must be a directory (so that it can be created).
@@ -133,8 +145,7 @@ fn written_by_raypipe(dir: &Path) -> Vec<String> {
 /// Writes `path` through its temporary sibling and a rename.
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), String> {
     let tmp = partial_of(path)?;
-    register_partial(&tmp);
-    let r = std::fs::write(&tmp, bytes)
+    let r = create_partial(&tmp, |t| std::fs::write(t, bytes))
         .and_then(|_| std::fs::rename(&tmp, path))
         .map_err(|e| format!("{}: {e}", path.display()));
     if r.is_err() {

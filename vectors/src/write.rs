@@ -58,7 +58,7 @@ pub fn check_out(dir: &Path) -> Result<(), String> {
 /// temporary sibling `.<dir>.raypipe-partial` (removed on SIGINT, and by the next run if left),
 /// then renamed into place, so that an interrupted run never leaves a half set that looks whole.
 pub fn write_set(set: &VectorSet, dir: &Path) -> Result<PathBuf, String> {
-    use crate::outdir::{partial_of, register_partial, unregister_partial};
+    use crate::outdir::{create_partial, partial_of, unregister_partial};
     check_out(dir)?;
     let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
@@ -74,8 +74,10 @@ pub fn write_set(set: &VectorSet, dir: &Path) -> Result<PathBuf, String> {
         }
         std::fs::remove_dir_all(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
     }
-    std::fs::create_dir(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
-    register_partial(&tmp);
+    if let Err(e) = create_partial(&tmp, |t| std::fs::create_dir(t)) {
+        unregister_partial(&tmp);
+        return Err(format!("{}: {e}", tmp.display()));
+    }
     let result = (|| {
         std::fs::write(tmp.join(OWN), "").map_err(|e| format!("{}: {e}", tmp.display()))?;
         let mut manifest = set.manifest.clone();
