@@ -14,6 +14,7 @@ use datapath::slab::{Slab, SlabConfig};
 use datapath::{with_format, AnyFormat, Format};
 use golden::{Faces, Ray64, Tri64};
 use serde::Serialize;
+use vectors::gen::slab_rays;
 
 /// What to run.
 #[derive(Clone, Debug)]
@@ -380,33 +381,13 @@ fn slab_case(class: usize, r: &mut SplitMix64, e: Edges) -> ([f64; 8], [f64; 3],
         5 => ((-20f64).exp2(), [0.0; 3]),
         _ => (1.0, [0.0; 3]),
     };
-    let mut lo = [0.0; 3];
-    let mut hi = [0.0; 3];
-    for a in 0..3 {
-        let c = center[a] + scale * r.range(-1.0, 1.0);
-        let e = if class == 3 && r.below(2) == 0 { 0.0 } else { scale * r.range(0.01, 0.5) };
-        lo[a] = c - e;
-        hi[a] = c + e;
-    }
+    let (lo, hi) = slab_rays::random_box(r, scale, center, class == 3);
     let mut o: [f64; 3] = std::array::from_fn(|a| center[a] + scale * r.range(-2.0, 2.0));
     let mut d = unit(r);
     match class {
-        0 => {
-            let a = r.below(3) as usize;
-            o[a] = if r.below(2) == 0 { lo[a] } else { hi[a] };
-            for b in (0..3).filter(|&b| b != a) {
-                o[b] = r.range(lo[b], hi[b]);
-            }
-            d[r.below(3) as usize] = if r.below(2) == 0 { 0.0 } else { -0.0 };
-        }
-        1 => {
-            let mut p: [f64; 3] = std::array::from_fn(|a| r.range(lo[a], hi[a]));
-            for a in 0..1 + r.below(3) as usize {
-                p[a] = if r.below(2) == 0 { lo[a] } else { hi[a] };
-            }
-            d = std::array::from_fn(|a| p[a] - o[a]);
-        }
-        2 => o = std::array::from_fn(|a| r.range(lo[a], hi[a])),
+        0 => slab_rays::origin_on_face(r, &lo, &hi, &mut o, &mut d),
+        1 => d = slab_rays::toward_surface(r, &lo, &hi, &o),
+        2 => o = slab_rays::inside(r, &lo, &hi),
         6 => {
             d = [0.0; 3];
             let a = r.below(3) as usize;

@@ -10,6 +10,7 @@
 pub mod op;
 pub mod rti;
 pub mod slab;
+pub mod slab_rays;
 
 pub use op::*;
 pub use rti::*;

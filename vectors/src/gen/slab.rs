@@ -1,6 +1,7 @@
 //! The slab unit's vectors: its coverage classes (ray placements × box shapes), the case of a
 //! class and its edge refinements (limits, ties, subnormal gaps), and the expected rows.
 
+use super::slab_rays;
 use super::*;
 use datapath::fault::{Fault, NoFault};
 use datapath::format::FormatKind;
@@ -77,36 +78,13 @@ pub(crate) fn slab_crosses(level: u32) -> Vec<SlabCross> {
 }
 
 pub(crate) fn slab_case(cross: SlabCross, r: &mut SplitMix64, e: datapath::format::Edges) -> [f64; 14] {
-    let mut lo = [0.0; 3];
-    let mut hi = [0.0; 3];
-    for a in 0..3 {
-        let c = r.range(-1.0, 1.0);
-        let e = if cross.zero_box && r.below(2) == 0 { 0.0 } else { r.range(0.01, 0.5) };
-        lo[a] = c - e;
-        hi[a] = c + e;
-    }
+    let (mut lo, mut hi) = slab_rays::random_box(r, 1.0, [0.0; 3], cross.zero_box);
     let mut o: [f64; 3] = std::array::from_fn(|_| r.range(-2.0, 2.0));
     let mut d: [f64; 3] = std::array::from_fn(|_| r.range(-1.0, 1.0));
     match cross.ray {
-        1 => {
-            let a = r.below(3) as usize;
-            o[a] = if r.below(2) == 0 { lo[a] } else { hi[a] };
-            for b in 0..3 {
-                if b != a {
-                    o[b] = r.range(lo[b], hi[b]);
-                }
-            }
-            let z = r.below(3) as usize;
-            d[z] = if r.below(2) == 0 { 0.0 } else { -0.0 };
-        }
-        2 => {
-            let mut p: [f64; 3] = std::array::from_fn(|a| r.range(lo[a], hi[a]));
-            for a in 0..1 + r.below(3) as usize {
-                p[a] = if r.below(2) == 0 { lo[a] } else { hi[a] };
-            }
-            d = std::array::from_fn(|a| p[a] - o[a]);
-        }
-        3 => o = std::array::from_fn(|a| r.range(lo[a], hi[a])),
+        1 => slab_rays::origin_on_face(r, &lo, &hi, &mut o, &mut d),
+        2 => d = slab_rays::toward_surface(r, &lo, &hi, &o),
+        3 => o = slab_rays::inside(r, &lo, &hi),
         4 => {
             // the ray crosses the other axes' slabs around t = tm; axis a's slab where the ray
             // meets it at t in [t1, t2] (q1.F holds t < 1)
