@@ -97,9 +97,14 @@ module raypipe_hf_divbank #(parameter int E = 8, parameter int S = 24) (
     if (!rst_n) turn <= '0;
     else turn <= (turn == N - 1) ? '0 : turn + 1'b1;
   end
+  // divSqrtRecFN_small's data registers (exponent, quotient bits) have no reset and are loaded
+  // only by a finite nonzero operation; a unit whose first operation has a NaN, infinite or zero
+  // operand rounds them (its flags then select the result) and gives X in simulation. So while
+  // rst_n is low every unit takes 1 / 1 (entering needs no reset), which defines them.
+  localparam logic [E+S-1:0] ONE = (E + S)'(((1 << (E - 1)) - 1)) << (S - 1);
   wire [R-1:0] ra, rb;
-  fNToRecFN #(E, S) in_a (.in(a), .out(ra));
-  fNToRecFN #(E, S) in_b (.in(b), .out(rb));
+  fNToRecFN #(E, S) in_a (.in(rst_n ? a : ONE), .out(ra));
+  fNToRecFN #(E, S) in_b (.in(rst_n ? b : ONE), .out(rb));
   wire [N*R-1:0] outs;
   wire [N-1:0] ready;
   genvar i;
@@ -108,7 +113,7 @@ module raypipe_hf_divbank #(parameter int E = 8, parameter int S = 24) (
     wire [4:0] flags;
     divSqrtRecFN_small #(E, S) unit (
       .nReset(rst_n), .clock(clk), .control(`flControl_tininessAfterRounding),
-      .inReady(ready[i]), .inValid(in_valid && turn == i), .sqrtOp(1'b0), .a(ra), .b(rb), .roundingMode(rm),
+      .inReady(ready[i]), .inValid(!rst_n || (in_valid && turn == i)), .sqrtOp(1'b0), .a(ra), .b(rb), .roundingMode(rm),
       .outValid(out_valid), .sqrtOpOut(sqrt_out), .out(outs[i*R +: R]),
       .exceptionFlags(flags));
   end
