@@ -123,3 +123,34 @@ module raypipe_hf_divbank #(parameter int E = 8, parameter int S = 24) (
       $fatal(1, "raypipe_hf_divbank: unit %0d not ready when its turn came", turn);
   end
 endmodule
+
+// A row and its valid bit delayed by N >= 2 clock edges (the state of a datapath waiting beside
+// raypipe_hf_divbank): d is x as registered N edges ago; v is rst_n & x_valid likewise.
+module raypipe_hf_delay #(parameter int W = 1, parameter int N = 2) (
+  input  logic         clk,
+  input  logic         rst_n,
+  input  logic         x_valid,
+  input  logic [W-1:0] x,
+  output logic         v,
+  output logic [W-1:0] d
+);
+  // dl[1..N-1] an array, the last word a plain variable (Icarus 11 misses updates of
+  // generate-written array words); one always_ff per register (Verilator 5.006 has no delayed
+  // assignment to arrays in loops)
+  logic [W-1:0] dl [1:N-1];
+  logic dv [1:N-1];
+  always_ff @(posedge clk) begin
+    dl[1] <= x;
+    dv[1] <= rst_n & x_valid;
+  end
+  for (genvar k = 2; k < N; k++) begin : g_wait
+    always_ff @(posedge clk) begin
+      dl[k] <= dl[k-1];
+      dv[k] <= rst_n & dv[k-1];
+    end
+  end
+  always_ff @(posedge clk) begin
+    d <= dl[N-1];
+    v <= rst_n & dv[N-1];
+  end
+endmodule

@@ -211,25 +211,11 @@ module raypipe_rti_hf
     assign q1 = '0;
     assign q2 = '0;
   end
-  // the state of stage 7 waits N edges beside the dividers (they take the operands at the edge that fills dl[1] and their results are registered N edges later)
-  state_t dl [1:ND-1];
-  logic dv [1:ND-1];
-  state_t dlast;  // dl[ND], a plain variable (Icarus 11 misses updates of generate-written array words)
+  // the state of stage 7 waits N edges beside the dividers (they take the operands at the edge
+  // that registers its first copy, and their results are registered N edges later)
+  state_t dlast;
   logic dvlast;
-  always_ff @(posedge clk) begin
-    dl[1] <= r7;
-    dv[1] <= rst_n & v7;
-  end
-  for (genvar k = 2; k < ND; k++) begin : g_wait
-    always_ff @(posedge clk) begin
-      dl[k] <= dl[k-1];
-      dv[k] <= rst_n & dv[k-1];
-    end
-  end
-  always_ff @(posedge clk) begin
-    dlast <= dl[ND-1];
-    dvlast <= rst_n & dv[ND-1];
-  end
+  raypipe_hf_delay #($bits(state_t), ND) wait_div (.clk(clk), .rst_n(rst_n), .x_valid(v7), .x(r7), .v(dvlast), .d(dlast));
   always @* begin
     n8 = dlast;
 `ifdef RAYPIPE_RECIP_MUL

@@ -125,25 +125,11 @@ module raypipe_slab_hf
   raypipe_hf_divbank #(E, S) d_x (.clk(clk), .rst_n(rst_n), .in_valid(v0), .a(ONE), .b(n0.s.pdx), .rm(RNE), .y(rx));
   raypipe_hf_divbank #(E, S) d_y (.clk(clk), .rst_n(rst_n), .in_valid(v0), .a(ONE), .b(n0.s.pdy), .rm(RNE), .y(ry));
   raypipe_hf_divbank #(E, S) d_z (.clk(clk), .rst_n(rst_n), .in_valid(v0), .a(ONE), .b(n0.s.pdz), .rm(RNE), .y(rz));
-  // the state waits N edges beside the dividers (they take the operands at the edge that fills dl[1] and their results are registered N edges later)
-  state_t dl [1:ND-1];
-  logic dv [1:ND-1];
-  state_t dlast;  // dl[ND], a plain variable (Icarus 11 misses updates of generate-written array words)
+  // the state waits N edges beside the dividers (they take the operands at the edge
+  // that registers its first copy, and their results are registered N edges later)
+  state_t dlast;
   logic dvlast;
-  always_ff @(posedge clk) begin
-    dl[1] <= n0;
-    dv[1] <= rst_n & v0;
-  end
-  for (genvar k = 2; k < ND; k++) begin : g_wait
-    always_ff @(posedge clk) begin
-      dl[k] <= dl[k-1];
-      dv[k] <= rst_n & dv[k-1];
-    end
-  end
-  always_ff @(posedge clk) begin
-    dlast <= dl[ND-1];
-    dvlast <= rst_n & dv[ND-1];
-  end
+  raypipe_hf_delay #($bits(state_t), ND) wait_div (.clk(clk), .rst_n(rst_n), .x_valid(v0), .x(n0), .v(dvlast), .d(dlast));
   // the guard: a finite nonzero d whose reciprocal is not a normal number
   function automatic logic [W-1:0] guard_recip(logic [W-1:0] d, logic [W-1:0] r);
     if (GUARD && finite(d) && !is_zero(d) && (is_inf(r) || is_zero(r) || is_sub(r))) return QNAN;
