@@ -374,6 +374,91 @@ fn vectors_traverse_takes_a_scene_and_refuses_what_it_cannot_use() {
 }
 
 #[test]
+fn vectors_wrapper_axis_writes_the_map_and_wrapper_and_refuses_bad_maps() {
+    let dir = std::env::temp_dir().join(format!("raypipe-cli-{}-axis", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let set = dir.join("set");
+    let s = set.to_str().unwrap();
+    let o = raypipe(&["vectors", "--unit", "op", "--format", "fp16", "--count", "2", "--wrapper", "axis", "--out", s]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let map: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(set.join("axis_map.json")).unwrap()).unwrap();
+    // op inputs: class (not on tdata), opcode 4, a 16, b 16: packed from bit 0 in file order
+    let lsbs: Vec<(String, u64)> = map["s_axis_tdata"]["fields"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| (f["name"].as_str().unwrap().to_string(), f["lsb"].as_u64().unwrap()))
+        .collect();
+    assert_eq!(lsbs, [("opcode".to_string(), 0), ("a".to_string(), 4), ("b".to_string(), 20)]);
+    assert_eq!(map["s_axis_tdata"]["width"], 40);
+    let wrap = std::fs::read_to_string(set.join("raypipe_axis_wrap.sv")).unwrap();
+    assert!(wrap.contains("module raypipe_axis_wrap") && wrap.contains("s_axis_tdata[4 +: 16]"), "{wrap}");
+    // the set with its wrapper re-checks, and may be written again in place
+    let o = raypipe(&["vectors", "--check", s]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    let o = raypipe(&["vectors", "--unit", "op", "--format", "fp16", "--count", "2", "--wrapper", "axis", "--out", s]);
+    assert!(o.status.success(), "{:?}", text(&o));
+    // a hand-edited wrapper is not its map's
+    std::fs::write(set.join("raypipe_axis_wrap.sv"), wrap.replace("s_axis_tdata[4 +: 16]", "s_axis_tdata[5 +: 16]"))
+        .unwrap();
+    assert_clear_error(&raypipe(&["vectors", "--check", s]), "raypipe_axis_wrap.sv line");
+    // a user map: overlapping fields, and a map that does not parse, are refused before writing
+    let mut bad = map.clone();
+    bad["s_axis_tdata"]["fields"][1]["lsb"] = serde_json::json!(0);
+    let bad_path = dir.join("bad.json");
+    std::fs::write(&bad_path, bad.to_string()).unwrap();
+    let other = dir.join("other");
+    let o = raypipe(&[
+        "vectors",
+        "--unit",
+        "op",
+        "--format",
+        "fp16",
+        "--count",
+        "2",
+        "--wrapper",
+        "axis",
+        "--axis-map",
+        bad_path.to_str().unwrap(),
+        "--out",
+        other.to_str().unwrap(),
+    ]);
+    assert_clear_error(&o, "fields opcode and a share bit 0");
+    assert!(!other.exists(), "nothing is written for a refused map");
+    std::fs::write(&bad_path, "{").unwrap();
+    let o = raypipe(&[
+        "vectors",
+        "--unit",
+        "op",
+        "--wrapper",
+        "axis",
+        "--axis-map",
+        bad_path.to_str().unwrap(),
+        "--out",
+        other.to_str().unwrap(),
+    ]);
+    assert_clear_error(&o, "--axis-map");
+    // traverse has no stream wrapper; --axis-map needs --wrapper
+    assert_clear_error(
+        &raypipe(&["vectors", "--unit", "traverse", "--wrapper", "axis", "--out", other.to_str().unwrap()]),
+        "streaming units",
+    );
+    let o = raypipe(&[
+        "vectors",
+        "--unit",
+        "op",
+        "--axis-map",
+        bad_path.to_str().unwrap(),
+        "--out",
+        other.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{:?}", text(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn vectors_do_not_depend_on_the_thread_count() {
     let out = std::env::temp_dir().join(format!("raypipe-cli-{}-threads", std::process::id()));
     let mut sets = Vec::new();

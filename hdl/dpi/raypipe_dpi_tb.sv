@@ -16,8 +16,16 @@
 // Each result must come LATENCY edges after the edge that captured its vector. The care rules
 // of the set package (diff_out, diff_stg) apply. It prints `N passed, M failed`, and ends with
 // $fatal when a vector failed.
+// Valid/ready (compiled with RAYPIPE_DPI_HANDSHAKE; hdl/dpi/run --handshake or --hardfloat): the
+// DUT has the ports of hdl/sv/raypipe_stream_tb.sv (in_ready, out_ready besides); each vector is
+// held on in_row with in_valid until in_ready takes it, out_ready is low in a seeded +stall=P
+// percent of the cycles, results are expected in input order at any latency, a result offered
+// without out_ready must stay unchanged until its transfer (else a protocol failure), and the
+// oldest vector without a result for 4 x +latency=L (default LATENCY) + 64 ready cycles fails the
+// run, named. Latency min / max and the throughput are printed.
 // Plusargs: +format=F (must be the package's format), +options=O (the unit's CLI options, ','
-// for ' '), +n=N (default 2000), +seed=S (default 1), +maxerrors=K (default 10).
+// for ' '), +n=N (default 2000), +seed=S (default 1), +maxerrors=K (default 10); with the
+// handshake +stall=P (default 0), +latency=L.
 `ifndef DUT
 `define DUT raypipe_ref
 `endif
@@ -38,8 +46,15 @@ module raypipe_dpi_tb;
   logic [OUT_W-1:0] out_row;
   logic [STG_W-1:0] stg_row;
 
+`ifdef RAYPIPE_DPI_HANDSHAKE
+  logic in_ready;
+  logic out_ready = 1'b0;
+  `DUT dut (.clk(clk), .rst_n(rst_n), .in_valid(in_valid), .in_ready(in_ready), .in_row(in_row), .out_valid(out_valid),
+            .out_ready(out_ready), .out_row(out_row), .stg_row(stg_row));
+`else
   `DUT dut (.clk(clk), .rst_n(rst_n), .in_valid(in_valid), .in_row(in_row), .out_valid(out_valid),
             .out_row(out_row), .stg_row(stg_row));
+`endif
 
   always #5 clk = ~clk;
 
@@ -217,6 +232,37 @@ module raypipe_dpi_tb;
              rp_version(), UNIT, fmt, opts, n, seed, LATENCY);
     repeat (2) @(negedge clk);
     rst_n = 1'b1;
+`ifdef RAYPIPE_DPI_HANDSHAKE
+    if ($value$plusargs("stall=%d", stall)) ;
+    if ($value$plusargs("latency=%d", lat)) ;
+    if (stall < 0 || stall > 99) $fatal(1, "raypipe_dpi_tb: +stall=%0d: give a percentage from 0 to 99", stall);
+    timeout = 4 * lat + 64;
+    $display("raypipe_dpi_tb: valid/ready, stall %0d%%, timeout %0d ready cycles", stall, timeout);
+    @(negedge clk);
+    for (int k = 0; k < n && !hung; k++) begin
+      stimulus(v, kind);
+      in_row = '0;
+      for (int i = 0; i < NI; i++)
+        for (int b = 0; b < W; b++) in_row[IN_W - 9 - i * W - (W - 1 - b)] = v[i][b];
+      in_valid = 1'b1;
+      expect_rows(v, kind);
+      // held until a rising edge with in_ready takes it
+      do @(negedge clk); while (!took_in && !hung);
+      in_at.push_back(took_at);
+      sent++;
+    end
+    in_valid = 1'b0;
+    wait (hung || got == sent);
+    repeat (8) @(negedge clk);
+    if (got < n) begin
+      $display("FAIL: %0d vectors never came out", n - got);
+      failed += n - got;
+    end
+    if (got > 0)
+      $display("latency (edges from input to output transfer): min %0d, max %0d over %0d results; throughput %0d results in %0d edges (%0.3f per clock)",
+               lat_min, lat_max, got, got, last_out - first_in + 1, real'(got) / real'(last_out - first_in + 1));
+    if (proto > 0) $display("%0d protocol violations", proto);
+`else
     for (int k = 0; k < n; k++) begin
       @(negedge clk);
       stimulus(v, kind);
@@ -234,12 +280,83 @@ module raypipe_dpi_tb;
       $display("FAIL: %0d vectors never came out", due_at.size());
       failed += due_at.size();
     end
+`endif
     $display("%0d passed, %0d failed", passed, failed);
     rp_unit_free(u);
     if (failed > 0) $fatal(1, "raypipe_dpi_tb: %0d of %0d vectors failed", failed, n);
     $finish;
   end
 
+`ifdef RAYPIPE_DPI_HANDSHAKE
+  // ---- valid/ready: output stalls, in-order scoring, the protocol rule, the timeout ----
+  int stall = 0;
+  int lat = LATENCY;
+  int timeout;
+  int sent = 0;
+  int got = 0;
+  int proto = 0;
+  int waited = 0;
+  bit hung = 0;
+  int in_at [$];
+  int lat_min = 1 << 30;
+  int lat_max = 0;
+  int first_in = -1;
+  int last_out = 0;
+  bit held = 0;
+  logic [OUT_W-1:0] held_out;
+  logic [STG_W-1:0] held_stg;
+  always @(negedge clk) if (rst_n) out_ready <= (stall == 0) || ($urandom_range(0, 99) >= stall);
+  logic took_in = 1'b0;
+  int took_at;
+  always @(posedge clk) begin
+    took_in <= rst_n && in_valid && in_ready;
+    took_at <= cycle;
+  end
+  always @(posedge clk) begin
+    if (rst_n && !hung) begin
+      if (held && (!out_valid || out_row !== held_out || stg_row !== held_stg)) begin
+        proto++;
+        failed++;
+        if (failed <= max_errors)
+          $display("FAIL: protocol at edge %0d: the result offered at the edge before (out_valid without out_ready) %0s before its transfer",
+                   cycle, !out_valid ? "was withdrawn" : "changed");
+      end
+      held <= out_valid && !out_ready;
+      held_out <= out_row;
+      held_stg <= stg_row;
+      if (out_valid && out_ready) begin
+        waited = 0;
+        if (want_out.size() == 0 || in_at.size() == 0) begin
+          failed++;
+          if (failed <= max_errors) $display("FAIL: a result at edge %0d with no vector outstanding", cycle);
+        end else begin
+          if (first_in < 0) first_in = in_at[0];
+          if (cycle - in_at[0] < lat_min) lat_min = cycle - in_at[0];
+          if (cycle - in_at[0] > lat_max) lat_max = cycle - in_at[0];
+          last_out = cycle;
+          if (diff_out(out_row, want_out[0], 0) != "none" || diff_stg(stg_row, want_stg[0], want_out[0], 0) != "none") begin
+            failed++;
+            if (failed <= max_errors)
+              $display("FAIL (vector %0d, %0s vector, edge %0d): first output to differ: %0s; first stage signal to differ: %0s", got,
+                       kind_of[0], cycle, diff_out(out_row, want_out[0], 0), diff_stg(stg_row, want_stg[0], want_out[0], 0));
+          end else passed++;
+          got++;
+          void'(in_at.pop_front());
+          void'(want_out.pop_front());
+          void'(want_stg.pop_front());
+          void'(kind_of.pop_front());
+        end
+      end else if (in_at.size() > 0 && out_ready) begin
+        waited++;
+        if (waited > timeout) begin
+          failed++;
+          $display("FAIL (vector %0d, %0s vector): never came out: no result for %0d ready cycles", got, kind_of[0], timeout);
+          hung = 1;
+        end
+      end
+    end
+  end
+`else
   // compare at the negative edge what the last positive edge produced
   always @(negedge clk) begin
     if (rst_n) begin
@@ -263,4 +380,5 @@ module raypipe_dpi_tb;
       end
     end
   end
+`endif
 endmodule

@@ -13,8 +13,12 @@
 // Faults (one define each; hdl/hardfloat/README.md):
 //   RAYPIPE_HF_FAULT_E1X_SWAP    e1.x = v0.x - v1.x (operand swap)
 //   RAYPIPE_HF_FAULT_UV_STRICT   u' + v' <= det tested as < (strict compare)
-//   RAYPIPE_HF_FAULT_DETX_RTZ    the det.x multiplier's roundingMode port tied to 001 (toward 0)
-//   RAYPIPE_HF_FAULT_DET_FTZ     a flush-to-zero wrapper on stage 6's det (subnormal -> 0)
+//   RAYPIPE_HF_FAULT_DETX_RNA    the det.x multiplier's roundingMode port tied to 100 (nearest, ties
+//                                away from zero: round_near_maxMag)
+//   RAYPIPE_HF_FAULT_QX_FTZ      a flush-to-zero wrapper on stage 3's q.x (subnormal -> 0 of its sign)
+// Each is the bank fault of the same name in raypipe's fault model (rti.e1x.swap,
+// rti.uv_ok.strict, rti.detx.rna, rti.qx.ftz): hdl/hardfloat/selftest checks that the RTL fails
+// first at the vector where `raypipe faults` first detects the modelled fault.
 module raypipe_rti_hf
   import raypipe_set_pkg::*;
   import raypipe_rti_pkg::*;
@@ -113,12 +117,16 @@ module raypipe_rti_hf
   always @* begin
     n3 = r2;
     {n3.s.px, n3.s.py, n3.s.pz, n3.s.qx, n3.s.qy, n3.s.qz} = {px, py, pz, qx, qy, qz};
+`ifdef RAYPIPE_HF_FAULT_QX_FTZ
+    // a flush-to-zero wrapper on q.x: a subnormal becomes zero of its sign
+    if (qx[W-2:S-1] == 0) n3.s.qx = {qx[W-1], {(W - 1) {1'b0}}};
+`endif
   end
 
   // ---- stage 4: the dot products' multiplies (det = e1.p, u' = s.p, v' = d.q, t' = e2.q)
   wire [W-1:0] detx, dety, detz, upx, upy, upz, vpx, vpy, vpz, tpx, tpy, tpz;
-`ifdef RAYPIPE_HF_FAULT_DETX_RTZ
-  raypipe_hf_mul #(E, S) u_detx (.a(r3.s.e1x), .b(r3.s.px), .rm(3'b001), .y(detx));
+`ifdef RAYPIPE_HF_FAULT_DETX_RNA
+  raypipe_hf_mul #(E, S) u_detx (.a(r3.s.e1x), .b(r3.s.px), .rm(3'b100), .y(detx));
 `else
   raypipe_hf_mul #(E, S) u_detx (.a(r3.s.e1x), .b(r3.s.px), .rm(RNE), .y(detx));
 `endif
@@ -158,12 +166,7 @@ module raypipe_rti_hf
   raypipe_hf_add #(E, S) u_tp (.a(r5.s.tp_xy), .b(r5.s.tpz), .sub(1'b0), .rm(RNE), .y(tp));
   always @* begin
     n6 = r5;
-`ifdef RAYPIPE_HF_FAULT_DET_FTZ
-    // a flush-to-zero wrapper on det: a subnormal becomes zero of its sign
-    n6.s.det = (det[W-2:S-1] == 0) ? {det[W-1], {(W - 1) {1'b0}}} : det;
-`else
     n6.s.det = det;
-`endif
     {n6.s.up, n6.s.vp, n6.s.tp} = {up, vp, tp};
   end
 

@@ -22,8 +22,11 @@
 // Faults (one define each; hdl/hardfloat/README.md):
 //   RAYPIPE_HF_FAULT_LOX_SWAP     lo.x = o.x - min.x (operand swap)
 //   RAYPIPE_HF_FAULT_HIT_STRICT   t_near <= t_far tested as < (strict compare)
-//   RAYPIPE_HF_FAULT_NO_GUARD     the conservative guard left out
-//   RAYPIPE_HF_FAULT_TLOX_RUP     the tlo.x multiplier's roundingMode port tied to 011 (toward +inf)
+//   RAYPIPE_HF_FAULT_NO_GUARD_SUB the conservative guard's overflowed-subtract check left out
+//   RAYPIPE_HF_FAULT_THIZ_RUP     the thi.z multiplier's roundingMode port tied to 011 (toward +inf)
+// Each is the bank fault of the same name in raypipe's fault model (slab.lox.swap,
+// slab.hit.strict, slab.guard_sub.stuck0, slab.thiz.rup): hdl/hardfloat/selftest checks that the
+// RTL fails first at the vector where `raypipe faults` first detects the modelled fault.
 module raypipe_slab_hf
   import raypipe_set_pkg::*;
   import raypipe_slab_pkg::*;
@@ -46,10 +49,11 @@ module raypipe_slab_hf
   localparam logic [W-1:0] ONE = W'(((1 << (E - 1)) - 1)) << (S - 1);
   localparam logic [W-1:0] QNAN = ({W{1'b1}} >> 1) & ~(({W{1'b1}} >> (E + 2)));  // exp all ones, top fraction bit
   localparam logic [W-1:0] DELTA = SLAB_DELTA[W-1:0];
-`ifdef RAYPIPE_HF_FAULT_NO_GUARD
-  localparam logic GUARD = 1'b0;
-`else
   localparam logic GUARD = SLAB_GUARD[0];
+`ifdef RAYPIPE_HF_FAULT_NO_GUARD_SUB
+  localparam logic GUARD_SUB = 1'b0;
+`else
+  localparam logic GUARD_SUB = GUARD;
 `endif
 
   initial begin
@@ -155,7 +159,7 @@ module raypipe_slab_hf
   raypipe_hf_add #(E, S) u_loz (.a(r1.i.minz), .b(r1.i.oz), .sub(1'b1), .rm(RNE), .y(loz));
   raypipe_hf_add #(E, S) u_hiz (.a(r1.i.maxz), .b(r1.i.oz), .sub(1'b1), .rm(RNE), .y(hiz));
   function automatic logic [W-1:0] guard_sub(logic [W-1:0] a, logic [W-1:0] b, logic [W-1:0] r);
-    if (GUARD && finite(a) && finite(b) && is_inf(r)) return QNAN;
+    if (GUARD_SUB && finite(a) && finite(b) && is_inf(r)) return QNAN;
     return r;
   endfunction
   always @* begin
@@ -170,16 +174,16 @@ module raypipe_slab_hf
 
   // ---- stage 2: (b - o) x (1 / d)
   wire [W-1:0] tlox, thix, tloy, thiy, tloz, thiz;
-`ifdef RAYPIPE_HF_FAULT_TLOX_RUP
-  raypipe_hf_mul #(E, S) u_tlox (.a(r2.s.lox), .b(r2.s.inv_dx), .rm(3'b011), .y(tlox));
-`else
   raypipe_hf_mul #(E, S) u_tlox (.a(r2.s.lox), .b(r2.s.inv_dx), .rm(RNE), .y(tlox));
-`endif
   raypipe_hf_mul #(E, S) u_thix (.a(r2.s.hix), .b(r2.s.inv_dx), .rm(RNE), .y(thix));
   raypipe_hf_mul #(E, S) u_tloy (.a(r2.s.loy), .b(r2.s.inv_dy), .rm(RNE), .y(tloy));
   raypipe_hf_mul #(E, S) u_thiy (.a(r2.s.hiy), .b(r2.s.inv_dy), .rm(RNE), .y(thiy));
   raypipe_hf_mul #(E, S) u_tloz (.a(r2.s.loz), .b(r2.s.inv_dz), .rm(RNE), .y(tloz));
+`ifdef RAYPIPE_HF_FAULT_THIZ_RUP
+  raypipe_hf_mul #(E, S) u_thiz (.a(r2.s.hiz), .b(r2.s.inv_dz), .rm(3'b011), .y(thiz));
+`else
   raypipe_hf_mul #(E, S) u_thiz (.a(r2.s.hiz), .b(r2.s.inv_dz), .rm(RNE), .y(thiz));
+`endif
   always @* begin
     n3 = r2;
     {n3.s.tlox, n3.s.thix, n3.s.tloy, n3.s.thiy, n3.s.tloz, n3.s.thiz} = {tlox, thix, tloy, thiy, tloz, thiz};

@@ -14,8 +14,17 @@
 // Timeout: a vector that has been in the DUT for more than +timeout=K output-ready cycles
 // (cycles with out_ready = 1; stalls do not count) fails the run, naming it. Default K =
 // 4 x the latency (+latency=L, default the set's LATENCY) + 64.
-// An out_valid while no vector is outstanding is an extra result. Any failure ends the run with
-// $fatal. Plusargs: +set=DIR, +gap=K, +stall=P, +seed=S (default 1), +latency=L, +timeout=K,
+// An out_valid while no vector is outstanding is an extra result. Protocol: once out_valid is 1
+// at an edge without out_ready, it must stay 1 and out_row (stg_row when stages are checked,
+// out_id) must stay the same until the transfer (AXI4-Stream's rule for a source); a change
+// fails the run, naming the edge. Any failure ends the run with $fatal.
+// Out of order: with the macro RAYPIPE_ID_W defined (hdl/run --ids W), the DUT has the ports
+//   input logic [RAYPIPE_ID_W-1:0] in_id, output logic [RAYPIPE_ID_W-1:0] out_id
+// the testbench gives vector k the id k mod 2^W with its input transfer and matches each
+// result to the outstanding vector with that id, in any order; it keeps at most 2^W vectors
+// outstanding (in_valid stays low while 2^W are), so an id names one vector. The timeout then
+// applies to the oldest vector still outstanding, and the largest reordering (how many later
+// vectors came out before one) is reported. Plusargs: +set=DIR, +gap=K, +stall=P, +seed=S (default 1), +latency=L, +timeout=K,
 // +nostages, +maxerrors=K (default 10), +strict.
 //
 // The DUT is the module named by the DUT macro, with the ports of raypipe_tb.sv plus the two
@@ -39,15 +48,29 @@ module raypipe_stream_tb;
   logic out_ready = 1'b0;
   logic [OUT_W-1:0] out_row;
   logic [STG_W-1:0] stg_row;
+`ifdef RAYPIPE_ID_W
+  localparam int IDN = 1 << `RAYPIPE_ID_W;
+  logic [`RAYPIPE_ID_W-1:0] in_id = '0;
+  logic [`RAYPIPE_ID_W-1:0] out_id;
+`else
+  localparam int IDN = 0;
+`endif
 
   logic [IN_W-1:0] ins [0:N-1];
   logic [OUT_W-1:0] outs [0:N-1];
   logic [STG_W-1:0] stgs [0:N-1];
   int sent_at [0:N-1];
   int lats [0:N-1];
+  bit rcvd [0:N-1];
+  int low = 0;  // the oldest vector not yet out
+  int reorder = 0;  // the largest number of later vectors out before one
 
   `DUT dut (.clk(clk), .rst_n(rst_n), .in_valid(in_valid), .in_ready(in_ready), .in_row(in_row),
-            .out_valid(out_valid), .out_ready(out_ready), .out_row(out_row), .stg_row(stg_row));
+            .out_valid(out_valid), .out_ready(out_ready), .out_row(out_row), .stg_row(stg_row)
+`ifdef RAYPIPE_ID_W
+            , .in_id(in_id), .out_id(out_id)
+`endif
+           );
 
   always #5 clk = ~clk;
 
@@ -66,6 +89,7 @@ module raypipe_stream_tb;
   int passed = 0;
   int failed = 0;
   int extra = 0;
+  int proto = 0;  // protocol violations
   int waited = 0;  // out_ready cycles the oldest outstanding vector has waited
   bit done = 0;
 
@@ -104,22 +128,26 @@ module raypipe_stream_tb;
         in_valid = 1'b0;
       end
       if (!in_valid && sent < N) begin
-        if (gap > 0 && (cycle % gap) == gap - 1) begin
+        if ((gap > 0 && (cycle % gap) == gap - 1) || (IDN > 0 && sent - low >= IDN)) begin
           in_row = '0;
         end else begin
           in_valid = 1'b1;
           in_row = ins[sent];
+`ifdef RAYPIPE_ID_W
+          in_id = sent[`RAYPIPE_ID_W-1:0];
+`endif
         end
       end
     end
     wait (done);
     if (got < N) begin
-      $display("FAIL: %0d vectors never came out (the first: vector %0d, line %0d)", N - got, got, got + 1);
+      $display("FAIL: %0d vectors never came out (the first: vector %0d, line %0d)", N - got, low, low + 1);
       failed += N - got;
     end
     if (extra > 0) $display("%0d extra results", extra);
     if (got > 0) report_latency();
     $display("%0d passed, %0d failed", passed, failed);
+    if (proto > 0) $fatal(1, "raypipe_stream_tb: %0d protocol violations (out_valid withdrawn or data changed before the transfer)", proto);
     if (failed > 0) $fatal(1, "raypipe_stream_tb: %0d of %0d vectors failed", failed, N);
     $finish;
   end
@@ -144,44 +172,89 @@ module raypipe_stream_tb;
   logic took = 1'b0;
   logic [OUT_W-1:0] took_out;
   logic [STG_W-1:0] took_stg;
+  int took_id = 0;
   int took_at;
   always @(posedge clk) begin
     took <= rst_n && out_valid && out_ready;
     took_out <= out_row;
     took_stg <= stg_row;
+`ifdef RAYPIPE_ID_W
+    took_id <= int'(out_id);
+`endif
     took_at <= cycle;
   end
+
+  // the protocol: a result offered without ready is held, unchanged, until it is taken
+  logic held = 1'b0;
+  logic [OUT_W-1:0] held_out;
+  logic [STG_W-1:0] held_stg;
+  int held_id = 0;
+`ifdef RAYPIPE_ID_W
+  int cur_id;
+  always @* cur_id = int'(out_id);
+`else
+  localparam int cur_id = 0;
+`endif
+  always @(posedge clk) begin
+    if (rst_n && held && !done && (!out_valid || out_row !== held_out || cur_id != held_id
+                                   || (check_stages && stg_row !== held_stg))) begin
+      proto++;
+      if (proto <= max_errors)
+        $display("FAIL: protocol at edge %0d: the result offered at the edge before (out_valid without out_ready) %0s before its transfer (AXI4-Stream: a source holds valid and its data until the transfer)",
+                 cycle, !out_valid ? "was withdrawn" : "changed");
+    end
+    held <= rst_n && out_valid && !out_ready;
+    held_out <= out_row;
+    held_stg <= stg_row;
+    held_id <= cur_id;
+  end
+
+  // the vector a result belongs to: the oldest outstanding one, or (ids) the outstanding one
+  // with its id; -1 when there is none
+  function automatic int owner(int id);
+    if (IDN == 0) return got < sent ? low : -1;
+    for (int j = low; j < sent; j++)
+      if (!rcvd[j] && (j % IDN) == id) return j;
+    return -1;
+  endfunction
 
   always @(negedge clk) begin
     if (rst_n && !done) begin
       if (took) begin
-        if (got >= sent) begin
+        k = owner(took_id);
+        if (k < 0) begin
           failed++;
           extra++;
-          if (failed <= max_errors) $display("FAIL: extra result at edge %0d: no vector is outstanding", took_at);
+          if (failed <= max_errors && IDN > 0)
+            $display("FAIL: extra result at edge %0d: no outstanding vector has id %0d", took_at, took_id);
+          else if (failed <= max_errors)
+            $display("FAIL: extra result at edge %0d: no vector is outstanding", took_at);
         end else begin
-          lats[got] = took_at - sent_at[got];
+          lats[got] = took_at - sent_at[k];
           last_at = took_at;
-          if (diff_out(took_out, outs[got], strict) != "none"
-              || (check_stages && diff_stg(took_stg, stgs[got], outs[got], strict) != "none")) begin
+          if (got - k > reorder) reorder = got - k;
+          if (diff_out(took_out, outs[k], strict) != "none"
+              || (check_stages && diff_stg(took_stg, stgs[k], outs[k], strict) != "none")) begin
             failed++;
             if (failed <= max_errors && check_stages)
               $display("FAIL vector %0d (line %0d, class %0d %0s): first output to differ: %0s; first stage signal to differ: %0s (result at edge %0d)",
-                       got, got + 1, ins[got][IN_W-1 -: 8], class_name(ins[got][IN_W-1 -: 8]), diff_out(took_out, outs[got], strict),
-                       diff_stg(took_stg, stgs[got], outs[got], strict), took_at);
+                       k, k + 1, ins[k][IN_W-1 -: 8], class_name(ins[k][IN_W-1 -: 8]), diff_out(took_out, outs[k], strict),
+                       diff_stg(took_stg, stgs[k], outs[k], strict), took_at);
             else if (failed <= max_errors)
               $display("FAIL vector %0d (line %0d, class %0d %0s): first output to differ: %0s (stages not checked; result at edge %0d)",
-                       got, got + 1, ins[got][IN_W-1 -: 8], class_name(ins[got][IN_W-1 -: 8]), diff_out(took_out, outs[got], strict),
+                       k, k + 1, ins[k][IN_W-1 -: 8], class_name(ins[k][IN_W-1 -: 8]), diff_out(took_out, outs[k], strict),
                        took_at);
           end else passed++;
+          rcvd[k] = 1'b1;
           got++;
+          if (k == low) waited = 0;
+          while (low < sent && rcvd[low]) low++;
         end
-        waited = 0;
-      end else if (got < sent && out_ready) begin
+      end else if (low < sent && out_ready) begin
         waited++;
         if (waited > timeout) begin
           $display("FAIL vector %0d (line %0d, class %0d %0s): never came out: no result for %0d ready cycles (it went in at edge %0d; +timeout=%0d)",
-                   got, got + 1, ins[got][IN_W-1 -: 8], class_name(ins[got][IN_W-1 -: 8]), waited, sent_at[got], timeout);
+                   low, low + 1, ins[low][IN_W-1 -: 8], class_name(ins[low][IN_W-1 -: 8]), waited, sent_at[low], timeout);
           done = 1;
         end
       end
@@ -192,6 +265,7 @@ module raypipe_stream_tb;
       end
     end
   end
+  int k;
   int tail = 8;
   int last_at = 0;
 
@@ -215,32 +289,15 @@ module raypipe_stream_tb;
       k++;
     end
     $display("latency (edges from input to output transfer): min %0d, median %0d, max %0d over %0d results", lo, lo + k, hi, got);
+    if (IDN > 0) $display("out of order: ids of %0d bits; at most %0d later vector(s) came out before an earlier one", $clog2(IDN), reorder);
     $display("throughput: %0d results in %0d edges from the first input to the last output transfer (%0.3f per clock)", got,
              last_at - sent_at[0] + 1, real'(got) / real'(last_at - sent_at[0] + 1));
   endtask
-  // Waveforms: +wavefile=F dumps to F (FST with Icarus' -fst and Verilator's --trace-fst, as
-  // hdl/run builds them); with +waves_from=T0 [+waves_to=T1] only that window of simulation
-  // time. hdl/run passes them (+waves: the whole run; after a failure, a re-run dumps the window
-  // around the first failure, whose time this testbench prints).
-  string wavefile;
-  int waves_from = -1;
-  int waves_to = -1;
-  initial begin
-    if ($value$plusargs("wavefile=%s", wavefile)) begin
-      $dumpfile(wavefile);
-      $dumpvars(0, raypipe_stream_tb);
-      if ($value$plusargs("waves_from=%d", waves_from)) begin
-        $dumpoff;
-        #(waves_from) $dumpon;
-        if ($value$plusargs("waves_to=%d", waves_to)) begin
-          #(waves_to - waves_from) $dumpoff;
-        end
-      end
-    end
-  end
+`define RAYPIPE_WAVES_TOP raypipe_stream_tb
+`include "raypipe_waves.svh"
   bit first_failure_shown = 0;
-  always @(failed) begin
-    if (failed > 0 && !first_failure_shown) begin
+  always @(failed or proto) begin
+    if ((failed > 0 || proto > 0) && !first_failure_shown) begin
       first_failure_shown = 1;
       $display("first failure at simulation time %0t", $time);
     end

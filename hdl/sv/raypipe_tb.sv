@@ -138,26 +138,8 @@ module raypipe_tb;
       end
     end
   end
-  // Waveforms: +wavefile=F dumps to F (FST with Icarus' -fst and Verilator's --trace-fst, as
-  // hdl/run builds them); with +waves_from=T0 [+waves_to=T1] only that window of simulation
-  // time. hdl/run passes them (+waves: the whole run; after a failure, a re-run dumps the window
-  // around the first failure, whose time this testbench prints).
-  string wavefile;
-  int waves_from = -1;
-  int waves_to = -1;
-  initial begin
-    if ($value$plusargs("wavefile=%s", wavefile)) begin
-      $dumpfile(wavefile);
-      $dumpvars(0, raypipe_tb);
-      if ($value$plusargs("waves_from=%d", waves_from)) begin
-        $dumpoff;
-        #(waves_from) $dumpon;
-        if ($value$plusargs("waves_to=%d", waves_to)) begin
-          #(waves_to - waves_from) $dumpoff;
-        end
-      end
-    end
-  end
+`define RAYPIPE_WAVES_TOP raypipe_tb
+`include "raypipe_waves.svh"
   bit first_failure_shown = 0;
   always @(failed) begin
     if (failed > 0 && !first_failure_shown) begin

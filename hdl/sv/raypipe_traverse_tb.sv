@@ -5,10 +5,15 @@
 // compares each result (in ray order) with traverse_expected.hex: the first-N leaf ids, their
 // count, the passes, the box tests and each level's final history state. Prints
 // `N passed, M failed`; any failure ends the run with $fatal. A ray with no result within
-// +timeout cycles is reported as a hang (ray, class and cycle), counted failed, and the DUT is
-// reset and given its tree again; the rays after it are still driven and checked.
+// its timeout is reported as a hang (ray, class and cycle), counted failed, and the DUT is
+// reset and given its tree again; the rays after it are still driven and checked. The timeout
+// of a ray (cycles since the previous result) is derived from the set: 16 x (the ray's expected
+// box tests + 2 x the tree's levels) + 256 cycles — room for a DUT that spends 8 cycles per box
+// test and tests twice as many boxes as the model counts, plus a pass down the tree and back —
+// so a DUT that hangs costs little per ray; +timeout=CYCLES fixes it for every ray instead.
 // The DUT is the module named by the DUT macro (default raypipe_traverse_ref), with the ports
-// of hdl/sv/ref/traverse_ref.sv. Plusargs: +set=DIR, +maxerrors=K, +timeout=CYCLES (per ray).
+// of hdl/sv/ref/traverse_ref.sv. Plusargs: +set=DIR, +maxerrors=K, +timeout=CYCLES (per ray),
+// +strict.
 `ifndef DUT
 `define DUT raypipe_traverse_ref
 `endif
@@ -41,7 +46,7 @@ module raypipe_traverse_tb;
   string dir;
   int max_errors = 10;
   bit strict = 0;
-  int timeout = 100000;
+  int timeout = -1;  // +timeout: fixed per ray; -1: derived per ray (budget)
   int sent = 0;
   int got = 0;
   int passed = 0;
@@ -52,6 +57,13 @@ module raypipe_traverse_tb;
   logic took = 1'b0;
 
   always @(posedge clk) cycle <= cycle + 1;
+
+  // the cycles ray k may take after the previous result (see the header)
+  int longest;
+  function automatic int budget(int k);
+    if (timeout >= 0) return timeout;
+    return 16 * (int'(outs[k][BOX_TESTS_LSB +: BOX_TESTS_W]) + 2 * int'(LEVELS)) + 256;
+  endfunction
 
   task automatic write_entry(input logic [7:0] level, input logic right, input int row, input logic [ENTRY_W-1:0] e);
     @(negedge clk);
@@ -84,7 +96,13 @@ module raypipe_traverse_tb;
     if ($test$plusargs("strict")) strict = 1;
     $readmemh($sformatf("%0s/%0s", dir, IN_FILE), ins);
     $readmemh($sformatf("%0s/%0s", dir, OUT_FILE), outs);
-    $display("raypipe_traverse_tb: %0d rays from %0s, %0d levels, first %0d leaves", N, dir, LEVELS, LEAVES);
+    longest = 0;
+    for (int k = 0; k < N; k++) if (budget(k) > longest) longest = budget(k);
+    if (timeout >= 0)
+      $display("raypipe_traverse_tb: %0d rays from %0s, %0d levels, first %0d leaves, timeout %0d cycles per ray", N, dir, LEVELS, LEAVES, timeout);
+    else
+      $display("raypipe_traverse_tb: %0d rays from %0s, %0d levels, first %0d leaves, timeout 16 x (expected box tests + %0d) + 256 cycles per ray (longest %0d)",
+               N, dir, LEVELS, LEAVES, 2 * LEVELS, longest);
     repeat (2) @(negedge clk);
     rst_n = 1'b1;
     load_tree();
@@ -96,7 +114,7 @@ module raypipe_traverse_tb;
       took = 1'b0;
       ray_valid = 1'b0;
       idle = 0;
-      while (got < N && idle < timeout) begin
+      while (got < N && idle < budget(got)) begin
         if (ray_valid && took) sent = sent + 1;
         if (sent < N) begin
           ray_valid = 1'b1;
@@ -110,7 +128,7 @@ module raypipe_traverse_tb;
         hangs++;
         if (failed <= max_errors)
           $display("FAIL ray %0d (line %0d, class %0d %0s): no result within %0d cycles, a hang (at edge %0d); the DUT is reset and the next rays are checked",
-                   got, got + 1, ins[got][IN_W-1 -: 8], class_name(ins[got][IN_W-1 -: 8]), timeout, cycle);
+                   got, got + 1, ins[got][IN_W-1 -: 8], class_name(ins[got][IN_W-1 -: 8]), budget(got), cycle);
         got++;
         ray_valid = 1'b0;
         rst_n = 1'b0;
@@ -141,6 +159,15 @@ module raypipe_traverse_tb;
         end else passed++;
         got++;
       end
+    end
+  end
+`define RAYPIPE_WAVES_TOP raypipe_traverse_tb
+`include "raypipe_waves.svh"
+  bit first_failure_shown = 0;
+  always @(failed) begin
+    if (failed > 0 && !first_failure_shown) begin
+      first_failure_shown = 1;
+      $display("first failure at simulation time %0t", $time);
     end
   end
 endmodule

@@ -79,6 +79,10 @@ begin
       variable cls : natural;
     begin
       failed := failed + 1;
+      if failed = 1 then
+        -- hdl/run reads this line to write the failing run's waveform
+        report "first failure at simulation time " & integer'image(now / 1 ns) & " ns" severity note;
+      end if;
       cls := to_integer(unsigned(ins(i)(SLAB_INPUTS_W - 1 downto SLAB_INPUTS_W - 8)));
       if failed <= 10 then
         report "FAIL vector " & integer'image(i) & " (line " & integer'image(i + 1) & ", class " &

@@ -53,6 +53,15 @@ pub struct Args {
     /// default 64, or the plan's).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub levels: Option<u64>,
+    /// Also write a wrapper for a DUT with your own ports: `axis` writes `axis_map.json` (where
+    /// each field sits on s_axis_tdata / m_axis_tdata) and `raypipe_axis_wrap.sv` into the set
+    /// (streaming units: rti, slab, op, capture; see docs/your-dut.md).
+    #[arg(long, value_parser = ["axis"])]
+    pub wrapper: Option<String>,
+    /// Your field map (an edited `axis_map.json`) for `--wrapper axis`, instead of the default
+    /// packing (fields from bit 0 in file order).
+    #[arg(long, requires = "wrapper")]
+    pub axis_map: Option<PathBuf>,
     #[command(flatten)]
     pub rti: RtiArgs,
 }
@@ -75,6 +84,8 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         leaves,
         leaf_size,
         levels,
+        wrapper,
+        axis_map,
         rti,
     } = a;
     if let Some(dir) = check {
@@ -92,6 +103,15 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     limit("--count", count, MAX_VECTOR_COUNT, "a set is built in memory before it is written")?;
     vectors::write::check_out(&out)?;
     let unit: vectors::gen::Unit = unit.parse()?;
+    if wrapper.is_some() && unit == vectors::gen::Unit::Traverse {
+        return Err("--wrapper axis covers the streaming units (rti, slab, op, capture)".into());
+    }
+    if let Some(p) = &axis_map {
+        // a map that does not read is refused before any work; its fields are checked below
+        let text = std::fs::read_to_string(p).map_err(|e| format!("--axis-map {}: {e}", p.display()))?;
+        serde_json::from_str::<vectors::axis::AxisMap>(&text)
+            .map_err(|e| format!("--axis-map {}: {e}", p.display()))?;
+    }
     // a plan fixes what the scene does not need: the format, the leaf size, the levels
     let plan = plan.as_deref().map(raypipe::plan::load).transpose()?;
     let format = match (format, &plan) {
@@ -146,7 +166,11 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     } else {
         set
     };
-    vectors::write::write_set(&set, &out)?;
+    let extra = match wrapper {
+        Some(_) => vectors::axis::files_for(&set.manifest, axis_map.as_deref())?,
+        None => Vec::new(),
+    };
+    vectors::write::write_set_with(&set, &out, &extra)?;
     let m = &set.manifest;
     println!(
         "wrote {}: unit {}, format {}, {} vectors ({}), seed {}",

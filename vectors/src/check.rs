@@ -45,6 +45,8 @@ pub fn check_set(dir: &Path) -> Result<usize, String> {
             ));
         }
     }
+    // the AXI4-Stream wrapper, when the set has one, is a function of its map and the manifest
+    crate::axis::check_files(dir, &m)?;
     // inputs: what this raypipe draws from the seed (the same version only; traverse rays are
     // drawn from the original scene, which the set does not hold)
     if unit != Unit::Traverse && m.raypipe_version == env!("CARGO_PKG_VERSION") {

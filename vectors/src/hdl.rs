@@ -97,6 +97,10 @@ fn sv_set_package(m: &crate::manifest::Manifest) -> String {
             root.width,
             rows.iter().sum::<usize>().max(1)
         );
+        // the expected box tests of a ray (the testbench's per-ray timeout is derived from them)
+        if let Some(b) = m.files.get(1).and_then(|f| f.fields.iter().find(|x| x.name == "box_tests")) {
+            s += &format!("  localparam int BOX_TESTS_LSB = {};\n  localparam int BOX_TESTS_W = {};\n", b.lsb, b.width);
+        }
         s += "  // rows of level l's banks, and their first row in a memory holding every level in order\n";
         s += "  function automatic int level_rows(int l);\n    case (l)\n";
         for (l, r) in rows.iter().enumerate() {

@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
+pub mod axis;
 pub mod capture;
 pub mod check;
 pub mod gen;

@@ -14,7 +14,8 @@ pub fn sha256_hex(data: &[u8]) -> String {
 /// Checks, before any work, that `dir` can take a vector set: it does not exist (nothing is
 /// created yet), is empty, or is a set raypipe wrote — its `manifest.json` reads as a raypipe
 /// manifest and every entry is a regular file that manifest names (its data files, the
-/// manifest, `raypipe_pkg.sv`, `raypipe_pkg.vhd`). Anything else is refused and left untouched.
+/// manifest, `raypipe_pkg.sv`, `raypipe_pkg.vhd`, and the AXI4-Stream wrapper's `axis_map.json` and
+/// `raypipe_axis_wrap.sv`). Anything else is refused and left untouched.
 pub fn check_out(dir: &Path) -> Result<(), String> {
     if !dir.exists() {
         return crate::outdir::OutDir::check(dir, &[]).map(|_| ());
@@ -42,7 +43,13 @@ pub fn check_out(dir: &Path) -> Result<(), String> {
         return refuse("its manifest.json is not a raypipe manifest".into());
     };
     let mut allowed: Vec<&str> = m.files.iter().map(|f| f.name.as_str()).collect();
-    allowed.extend(["manifest.json", "raypipe_pkg.sv", "raypipe_pkg.vhd"]);
+    allowed.extend([
+        "manifest.json",
+        "raypipe_pkg.sv",
+        "raypipe_pkg.vhd",
+        crate::axis::MAP_FILE,
+        crate::axis::WRAP_FILE,
+    ]);
     for e in &entries {
         let name = e.file_name();
         let name = name.to_string_lossy();
@@ -58,6 +65,12 @@ pub fn check_out(dir: &Path) -> Result<(), String> {
 /// temporary sibling `.<dir>.raypipe-partial` (removed on SIGINT, and by the next run if left),
 /// then renamed into place, so that an interrupted run never leaves a half set that looks whole.
 pub fn write_set(set: &VectorSet, dir: &Path) -> Result<PathBuf, String> {
+    write_set_with(set, dir, &[])
+}
+
+/// [`write_set`] plus `extra` (name, contents) files the manifest does not list (the
+/// AXI4-Stream wrapper's map and module), written into the set before it is renamed into place.
+pub fn write_set_with(set: &VectorSet, dir: &Path, extra: &[(String, String)]) -> Result<PathBuf, String> {
     use crate::outdir::{create_partial, partial_of, unregister_partial};
     check_out(dir)?;
     let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
@@ -91,6 +104,9 @@ pub fn write_set(set: &VectorSet, dir: &Path) -> Result<PathBuf, String> {
             .map_err(|e| format!("raypipe_pkg.sv: {e}"))?;
         std::fs::write(tmp.join("raypipe_pkg.vhd"), crate::hdl::vhdl_package(&manifest))
             .map_err(|e| format!("raypipe_pkg.vhd: {e}"))?;
+        for (fname, content) in extra {
+            std::fs::write(tmp.join(fname), content).map_err(|e| format!("{fname}: {e}"))?;
+        }
         let json = serde_json::to_string_pretty(&manifest).map_err(|e| e.to_string())? + "\n";
         std::fs::write(tmp.join("manifest.json"), json).map_err(|e| format!("manifest.json: {e}"))?;
         std::fs::remove_file(tmp.join(OWN)).map_err(|e| format!("{}: {e}", tmp.display()))?;
