@@ -22,7 +22,7 @@
 // percent of the cycles, results are expected in input order at any latency, a result offered
 // without out_ready must stay unchanged until its transfer (else a protocol failure), and the
 // oldest vector without a result for 4 x +latency=L (default LATENCY) + 64 ready cycles fails the
-// run, named. Latency min / max and the throughput are printed.
+// run, named. Latency min / median / max and the throughput are printed.
 // Plusargs: +format=F (must be the package's format), +options=O (the unit's CLI options, ','
 // for ' '), +n=N (default 2000), +seed=S (default 1), +maxerrors=K (default 10); with the
 // handshake +stall=P (default 0), +latency=L.
@@ -258,9 +258,11 @@ module raypipe_dpi_tb;
       $display("FAIL: %0d vectors never came out", n - got);
       failed += n - got;
     end
-    if (got > 0)
-      $display("latency (edges from input to output transfer): min %0d, max %0d over %0d results; throughput %0d results in %0d edges (%0.3f per clock)",
-               lat_min, lat_max, got, got, last_out - first_in + 1, real'(got) / real'(last_out - first_in + 1));
+    if (got > 0) begin
+      lats.sort();
+      $display("latency (edges from input to output transfer): min %0d, median %0d, max %0d over %0d results; throughput %0d results in %0d edges (%0.3f per clock)",
+               lat_min, lats[lats.size() / 2], lat_max, got, got, last_out - first_in + 1, real'(got) / real'(last_out - first_in + 1));
+    end
     if (proto > 0) $display("%0d protocol violations", proto);
 `else
     for (int k = 0; k < n; k++) begin
@@ -298,6 +300,7 @@ module raypipe_dpi_tb;
   int waited = 0;
   bit hung = 0;
   int in_at [$];
+  int lats [$];
   int lat_min = 1 << 30;
   int lat_max = 0;
   int first_in = -1;
@@ -331,6 +334,7 @@ module raypipe_dpi_tb;
           if (failed <= max_errors) $display("FAIL: a result at edge %0d with no vector outstanding", cycle);
         end else begin
           if (first_in < 0) first_in = in_at[0];
+          lats.push_back(cycle - in_at[0]);
           if (cycle - in_at[0] < lat_min) lat_min = cycle - in_at[0];
           if (cycle - in_at[0] > lat_max) lat_max = cycle - in_at[0];
           last_out = cycle;

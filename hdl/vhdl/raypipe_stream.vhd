@@ -36,6 +36,11 @@ architecture rtl of raypipe_slab_stream is
   signal rp, wp : natural range 0 to DEPTH - 1 := 0;
   signal count, inflight : natural range 0 to DEPTH := 0;
   signal take, core_valid, ready_i, valid_i, pop : std_logic;
+  function to_sl(b : boolean) return std_logic is
+  begin
+    if b then return '1'; else return '0'; end if;
+  end function;
+  constant DROP_BIT : std_logic := to_sl(DROP);
   signal core_out : std_logic_vector(SLAB_EXPECTED_W - 1 downto 0);
   signal core_stg : std_logic_vector(SLAB_STAGES_W - 1 downto 0);
 begin
@@ -47,7 +52,7 @@ begin
   take <= in_valid and ready_i;
   valid_i <= '1' when count /= 0 else '0';
   out_valid <= valid_i;
-  pop <= valid_i and (out_ready or ('1' when DROP else '0'));
+  pop <= valid_i and (out_ready or DROP_BIT);
   out_row <= mem(rp)(PW - 1 downto SLAB_STAGES_W);
   stg_row <= mem(rp)(SLAB_STAGES_W - 1 downto 0);
   process (clk)

@@ -12,7 +12,7 @@
 -- seeded STALL percent of the cycles, results are scored in input order at any latency, a result
 -- offered without out_ready must stay unchanged until its transfer (else a protocol failure),
 -- and the oldest vector without a result for 4 x (LATENCY + 2) + 64 ready cycles fails the run,
--- named; latency min / max are reported. DROP = true passes the wrapper's protocol bug.
+-- named; latency min / median / max are reported. DROP = true passes the wrapper's protocol bug.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -83,6 +83,8 @@ begin
     constant timeout : natural := 4 * (LATENCY + 2) + 64;
     variable drawn, waited, lat, lat_max, protocol : natural := 0;
     variable lat_min : natural := natural'high;
+    variable hist : integer_vector(0 to 4095) := (others => 0);  -- latencies (the last bin: 4095 or more)
+    variable acc, med : natural := 0;
     variable offering, will_take, rdy, held : boolean := false;
     variable held_out : std_logic_vector(SLAB_EXPECTED_W - 1 downto 0);
     variable held_stg : std_logic_vector(SLAB_STAGES_W - 1 downto 0);
@@ -216,7 +218,7 @@ begin
           fail("protocol at edge " & integer'image(cycle) & ": a result offered without out_ready changed before its transfer");
         end if;
         rdy := STALL = 0 or pick(100) >= STALL;
-        out_ready <= '1' when rdy else '0';
+        if rdy then out_ready <= '1'; else out_ready <= '0'; end if;
         held := false;
         if out_valid = '1' and rdy then
           -- transferred at the next rising edge
@@ -225,6 +227,7 @@ begin
           else
             lat := cycle + 1 - sent_at(got);
             lat_min := minimum(lat_min, lat);
+            hist(minimum(lat, hist'high)) := hist(minimum(lat, hist'high)) + 1;
             lat_max := maximum(lat_max, lat);
             if first_diff_slab_expected_t(out_row, outs(got)) /= "none" or first_diff_slab_stages_t(stg_row, stgs(got)) /= "none" then
               fail("vector " & integer'image(got) & ": first output to differ: " & first_diff_slab_expected_t(out_row, outs(got)) &
@@ -260,8 +263,16 @@ begin
         will_take := in_ready = '1';
       end loop;
       if got > 0 then
-        report "latency (edges from input to output transfer): min " & integer'image(lat_min) & ", max " &
-          integer'image(lat_max) & " over " & integer'image(got) & " results" severity note;
+        acc := 0;
+        for b in hist'range loop
+          acc := acc + hist(b);
+          if 2 * acc > got then
+            med := b;
+            exit;
+          end if;
+        end loop;
+        report "latency (edges from input to output transfer): min " & integer'image(lat_min) & ", median " &
+          integer'image(med) & ", max " & integer'image(lat_max) & " over " & integer'image(got) & " results" severity note;
       end if;
     else
       loop
