@@ -9,8 +9,8 @@
 // m_axis_tuser is the stage row as the set's stage file lays it out. The fixed-latency core
 // sits behind raypipe_stream_fifo (hdl/sv/raypipe_stream.sv): one test per clock while
 // m_axis_tready is 1, results in input order; s_axis_tid comes back on m_axis_tid (IDW bits).
-// RAYPIPE_STREAM_SWAP: each two consecutive results leave swapped (raypipe_stream_swap), ids and
-// all — a test that a testbench matches out-of-order results by id.
+// RAYPIPE_STREAM_SWAP: the FIFO lets each two consecutive results leave swapped, ids and all — a
+// test that a testbench matches out-of-order results by id.
 module raypipe_rti_hf_axis
   import raypipe_set_pkg::*;
   import raypipe_rti_pkg::*;
@@ -42,27 +42,14 @@ module raypipe_rti_hf_axis
     for (int k = 0; k < 17; k++) row[(16 - k) * W +: W] = s_axis_tdata[k * W +: W];
   end
   logic take, core_valid;
-  logic f_valid, f_ready;
-  logic [OUT_W+STG_W-1:0] f_data;
-  logic [IDW-1:0] f_id;
   rti_expected_t core_out, out;
   logic [STG_W-1:0] core_stg;
   raypipe_rti_hf core (.clk(aclk), .rst_n(aresetn), .in_valid(take), .in_row(row), .out_valid(core_valid),
                        .out_row(core_out), .stg_row(core_stg));
   raypipe_stream_fifo #(.W(OUT_W + STG_W), .IDW(IDW), .DEPTH(DEPTH)) fifo (
     .clk(aclk), .rst_n(aresetn), .in_valid(s_axis_tvalid), .in_ready(s_axis_tready), .in_id(s_axis_tid),
-    .take(take), .core_valid(core_valid), .core_data({core_out, core_stg}), .out_valid(f_valid),
-    .out_ready(f_ready), .out_data(f_data), .out_id(f_id));
-`ifdef RAYPIPE_STREAM_SWAP
-  // a test of a testbench's id matching: each two consecutive results leave swapped
-  raypipe_stream_swap #(.W(OUT_W + STG_W + IDW)) swap (
-    .clk(aclk), .rst_n(aresetn), .in_valid(f_valid), .in_ready(f_ready), .in_data({f_data, f_id}),
-    .out_valid(m_axis_tvalid), .out_ready(m_axis_tready), .out_data({out, m_axis_tuser, m_axis_tid}));
-`else
-  assign m_axis_tvalid = f_valid;
-  assign f_ready = m_axis_tready;
-  assign {out, m_axis_tuser, m_axis_tid} = {f_data, f_id};
-`endif
+    .take(take), .core_valid(core_valid), .core_data({core_out, core_stg}), .out_valid(m_axis_tvalid),
+    .out_ready(m_axis_tready), .out_data({out, m_axis_tuser}), .out_id(m_axis_tid));
   assign m_axis_tdata = MW'({out.v, out.u, out.t, out.hit, out.valid});
 endmodule
 

@@ -8,6 +8,7 @@
 //   order; a result is offered (out_valid) while the FIFO is not empty and leaves at an edge
 //   with out_ready = 1. With DEPTH >= the core's latency + 1 and out_ready always 1, the unit
 //   takes one input per clock. An id (IDW bits) given with each input comes out with its result.
+//   With RAYPIPE_STREAM_SWAP the results leave through raypipe_stream_swap (out of order).
 //   Define RAYPIPE_FAULT_STREAM_DROP for a protocol bug: the FIFO drops its head at an edge
 //   where out_valid is 1 and out_ready is 0 (a result lost under a stall; a testbench must fail).
 //
@@ -18,7 +19,7 @@
 // raypipe_stream_of: the kit's ports (raypipe_tb.sv) with valid/ready around the core named by
 //   the CORE macro (hdl/run --handshake sets it: the unit's reference DUT, or your --dut); with
 //   RAYPIPE_ID_W defined it has the in_id / out_id ports of raypipe_stream_tb.sv, and with
-//   RAYPIPE_STREAM_SWAP it delivers results out of order through raypipe_stream_swap.
+//   RAYPIPE_STREAM_SWAP its FIFO delivers results out of order.
 module raypipe_stream_fifo #(
   parameter int W = 1,
   parameter int IDW = 1,
@@ -42,12 +43,16 @@ module raypipe_stream_fifo #(
   logic [IDW-1:0] ids [0:DEPTH-1];  // in input order; the head belongs to the FIFO's head
   logic [AW-1:0] rp, wp, ip, count, inflight;
   assign take = in_valid && in_ready;
-  wire pop = out_valid && (out_ready
+  // the queue's head (q_*), then the ports: directly, or through raypipe_stream_swap
+  logic q_valid, q_ready;
+  logic [W-1:0] q_data;
+  logic [IDW-1:0] q_id;
+  wire pop = q_valid && (q_ready
 `ifdef RAYPIPE_FAULT_STREAM_DROP
-                           || 1'b1
+                         || 1'b1
 `endif
-                          );
-  assign out_valid = count != 0;
+                        );
+  assign q_valid = count != 0;
   assign in_ready = rst_n && (inflight + count < DEPTH);
   always @(posedge clk) begin
     if (!rst_n) begin
@@ -71,9 +76,18 @@ module raypipe_stream_fifo #(
     end
   end
   always @* begin
-    out_data = mem[rp];
-    out_id = ids[rp];
+    q_data = mem[rp];
+    q_id = ids[rp];
   end
+`ifdef RAYPIPE_STREAM_SWAP
+  raypipe_stream_swap #(.W(W + IDW)) swap (
+    .clk(clk), .rst_n(rst_n), .in_valid(q_valid), .in_ready(q_ready), .in_data({q_data, q_id}),
+    .out_valid(out_valid), .out_ready(out_ready), .out_data({out_data, out_id}));
+`else
+  assign out_valid = q_valid;
+  assign q_ready = out_ready;
+  assign {out_data, out_id} = {q_data, q_id};
+`endif
 endmodule
 
 module raypipe_stream_swap #(
@@ -150,25 +164,13 @@ module raypipe_stream_of
   wire [IDW-1:0] in_id = '0;
   wire [IDW-1:0] out_id;
 `endif
-  localparam int P = OUT_W + STG_W + IDW;
-  logic take, core_valid, f_valid, f_ready;
+  logic take, core_valid;
   logic [OUT_W-1:0] core_out;
   logic [STG_W-1:0] core_stg;
-  logic [OUT_W+STG_W-1:0] f_data;
-  logic [IDW-1:0] f_id;
   `CORE core (.clk(clk), .rst_n(rst_n), .in_valid(take), .in_row(in_row), .out_valid(core_valid),
               .out_row(core_out), .stg_row(core_stg));
   raypipe_stream_fifo #(.W(OUT_W + STG_W), .IDW(IDW), .DEPTH(DEPTH)) fifo (
     .clk(clk), .rst_n(rst_n), .in_valid(in_valid), .in_ready(in_ready), .in_id(in_id), .take(take),
-    .core_valid(core_valid), .core_data({core_out, core_stg}), .out_valid(f_valid), .out_ready(f_ready),
-    .out_data(f_data), .out_id(f_id));
-`ifdef RAYPIPE_STREAM_SWAP
-  raypipe_stream_swap #(.W(P)) swap (
-    .clk(clk), .rst_n(rst_n), .in_valid(f_valid), .in_ready(f_ready), .in_data({f_data, f_id}),
-    .out_valid(out_valid), .out_ready(out_ready), .out_data({out_row, stg_row, out_id}));
-`else
-  assign out_valid = f_valid;
-  assign f_ready = out_ready;
-  assign {out_row, stg_row, out_id} = {f_data, f_id};
-`endif
+    .core_valid(core_valid), .core_data({core_out, core_stg}), .out_valid(out_valid), .out_ready(out_ready),
+    .out_data({out_row, stg_row}), .out_id(out_id));
 endmodule
