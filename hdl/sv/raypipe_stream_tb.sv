@@ -294,12 +294,6 @@ module raypipe_stream_tb;
              last_at - sent_at[0] + 1, real'(got) / real'(last_at - sent_at[0] + 1));
   endtask
 `define RAYPIPE_WAVES_TOP raypipe_stream_tb
+`define RAYPIPE_FAILURES (failed + proto)
 `include "raypipe_waves.svh"
-  bit first_failure_shown = 0;
-  always @(failed or proto) begin
-    if ((failed > 0 || proto > 0) && !first_failure_shown) begin
-      first_failure_shown = 1;
-      $display("first failure at simulation time %0t", $time);
-    end
-  end
 endmodule

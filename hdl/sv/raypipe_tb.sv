@@ -140,11 +140,4 @@ module raypipe_tb;
   end
 `define RAYPIPE_WAVES_TOP raypipe_tb
 `include "raypipe_waves.svh"
-  bit first_failure_shown = 0;
-  always @(failed) begin
-    if (failed > 0 && !first_failure_shown) begin
-      first_failure_shown = 1;
-      $display("first failure at simulation time %0t", $time);
-    end
-  end
 endmodule

@@ -163,11 +163,4 @@ module raypipe_traverse_tb;
   end
 `define RAYPIPE_WAVES_TOP raypipe_traverse_tb
 `include "raypipe_waves.svh"
-  bit first_failure_shown = 0;
-  always @(failed) begin
-    if (failed > 0 && !first_failure_shown) begin
-      first_failure_shown = 1;
-      $display("first failure at simulation time %0t", $time);
-    end
-  end
 endmodule

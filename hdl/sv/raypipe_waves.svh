@@ -1,5 +1,7 @@
-// raypipe HDL kit: the waveform dump of the kit's SystemVerilog testbenches (included inside the
-// testbench module after `define RAYPIPE_WAVES_TOP <module name>).
+// raypipe HDL kit: the waveform dump of the kit's SystemVerilog testbenches and the line that
+// times their first failure (included inside the testbench module after `define
+// RAYPIPE_WAVES_TOP <module name>; `define RAYPIPE_FAILURES <expression> when the failure count
+// is not the module's `failed`).
 // +wavefile=F dumps to F (FST with Icarus' -fst and Verilator's --trace-fst, as hdl/run builds
 // them); with +waves_from=T0 [+waves_to=T1] only that window of simulation time. hdl/run passes
 // them (+waves: the whole run; after a failure, a re-run dumps the window around the first
@@ -18,5 +20,15 @@
           #(waves_to - waves_from) $dumpoff;
         end
       end
+    end
+  end
+`ifndef RAYPIPE_FAILURES
+`define RAYPIPE_FAILURES failed
+`endif
+  bit first_failure_shown = 0;
+  always @(`RAYPIPE_FAILURES) begin
+    if (`RAYPIPE_FAILURES > 0 && !first_failure_shown) begin
+      first_failure_shown = 1;
+      $display("first failure at simulation time %0t", $time);
     end
   end
