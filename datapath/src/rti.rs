@@ -14,7 +14,7 @@
 use crate::fault::{Cmp, Fault, NoFault};
 use crate::format::{DivMode, Format};
 use crate::probe::{NoProbe, Probe};
-pub use crate::stage::{Op, SigDef};
+pub use crate::stage::{Op, Rule, SigDef};
 use crate::{record, record_flags};
 
 /// A ray in the datapath's format: origin, direction and the accepted t interval.
@@ -88,10 +88,10 @@ impl Default for RtiConfig {
 }
 
 const fn s(stage: u8, name: &'static str, op: Op, a: &'static str, b: &'static str) -> SigDef {
-    SigDef { stage, name, op, a, b, note: "" }
+    SigDef { stage, name, op, a, b, note: "", rule: Rule::Arith }
 }
-const fn l(stage: u8, name: &'static str, note: &'static str) -> SigDef {
-    SigDef { stage, name, op: Op::Logic, a: "", b: "", note }
+const fn l(stage: u8, name: &'static str, rule: Rule, note: &'static str) -> SigDef {
+    SigDef { stage, name, op: Op::Logic, a: "", b: "", note, rule }
 }
 
 /// Input signal names: ray origin, direction, t interval, triangle vertices, and the constant one.
@@ -154,32 +154,33 @@ const STAGES_1_TO_7: [SigDef; 53] = [
     s(6, "tp", Op::Add, "tp_xy", "tpz"),
     // stage 7: uv = up + vp and the division-free validity test; the valid bit may be cleared here
     s(7, "uv", Op::Add, "up", "vp"),
-    l(7, "det_ok", "two-sided: threshold < |det|; backface culling: threshold < det"),
-    l(7, "u_ok", "det > 0 ? 0 <= up : up <= 0"),
-    l(7, "v_ok", "det > 0 ? 0 <= vp : vp <= 0"),
-    l(7, "uv_ok", "det > 0 ? uv <= det : det <= uv"),
-    l(7, "t_ok", "det > 0 ? 0 <= tp : tp <= 0"),
+    l(7, "det_ok", Rule::DetOk("det"), "two-sided: threshold < |det|; backface culling: threshold < det"),
+    l(7, "u_ok", Rule::Oriented("zero", "up"), "det > 0 ? 0 <= up : up <= 0"),
+    l(7, "v_ok", Rule::Oriented("zero", "vp"), "det > 0 ? 0 <= vp : vp <= 0"),
+    l(7, "uv_ok", Rule::Oriented("uv", "det"), "det > 0 ? uv <= det : det <= uv"),
+    l(7, "t_ok", Rule::Oriented("zero", "tp"), "det > 0 ? 0 <= tp : tp <= 0"),
 ];
 
-const VALID: SigDef = l(7, "valid", "det_ok & u_ok & v_ok & uv_ok & t_ok");
+const VALID: SigDef =
+    l(7, "valid", Rule::All(&["det_ok", "u_ok", "v_ok", "uv_ok", "t_ok"]), "det_ok & u_ok & v_ok & uv_ok & t_ok");
 
 const RECIP_TAIL: [SigDef; 7] = [
     s(8, "inv_det", Op::Div, "one", "det"),
     s(9, "t", Op::Mul, "tp", "inv_det"),
     s(9, "u", Op::Mul, "up", "inv_det"),
     s(9, "v", Op::Mul, "vp", "inv_det"),
-    l(10, "tmin_ok", "tmin <= t"),
-    l(10, "tmax_ok", "t <= tmax"),
-    l(10, "hit", "valid & tmin_ok & tmax_ok"),
+    l(10, "tmin_ok", Rule::Le("tmin", "t"), "tmin <= t"),
+    l(10, "tmax_ok", Rule::Le("t", "tmax"), "t <= tmax"),
+    l(10, "hit", Rule::All(&["valid", "tmin_ok", "tmax_ok"]), "valid & tmin_ok & tmax_ok"),
 ];
 
 const DIVIDE_TAIL: [SigDef; 6] = [
     s(8, "t", Op::Div, "tp", "det"),
     s(8, "u", Op::Div, "up", "det"),
     s(8, "v", Op::Div, "vp", "det"),
-    l(9, "tmin_ok", "tmin <= t"),
-    l(9, "tmax_ok", "t <= tmax"),
-    l(9, "hit", "valid & tmin_ok & tmax_ok"),
+    l(9, "tmin_ok", Rule::Le("tmin", "t"), "tmin <= t"),
+    l(9, "tmax_ok", Rule::Le("t", "tmax"), "t <= tmax"),
+    l(9, "hit", Rule::All(&["valid", "tmin_ok", "tmax_ok"]), "valid & tmin_ok & tmax_ok"),
 ];
 
 /// The stage table of the RTI datapath for a division mode, in the order signals are produced.

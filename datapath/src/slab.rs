@@ -47,7 +47,7 @@
 use crate::fault::{Cmp, Fault, NoFault};
 use crate::format::Format;
 use crate::probe::{NoProbe, Probe};
-use crate::stage::{Op, SigDef};
+use crate::stage::{Op, Rule, SigDef};
 use crate::{record, record_flags};
 
 /// What the compare unit does with a NaN slab distance.
@@ -108,58 +108,66 @@ pub const MIN_MAN_BITS: u32 = 4;
 /// take-on-false, embree), in the order the probe reports the signals. Stage 0 runs once per
 /// ray; `sel*` rows are the compare unit's compare-selects; `step*` rows the widening.
 pub const SLAB_TABLE: [SigDef; 39] = [
-    l(0, "dx", "input read of d.x: a NaN reads as the canonical NaN (quieted, payload kept, under propagate); a subnormal as ±0 under FTZ; o, tmin, tmax are read the same way"),
-    l(0, "dy", "input read of d.y (as dx)"),
-    l(0, "dz", "input read of d.z (as dx)"),
-    l(0, "pdx", "embree: |dx| < δ ? ±δ : dx; else dx"),
-    l(0, "pdy", "likewise"),
-    l(0, "pdz", "likewise"),
-    s(0, "inv_dx", Op::Div, "one", "pdx"),
-    s(0, "inv_dy", Op::Div, "one", "pdy"),
-    s(0, "inv_dz", Op::Div, "one", "pdz"),
+    l(0, "dx", Rule::Read("in_dx"), "input read of d.x: a NaN reads as the canonical NaN (quieted, payload kept, under propagate); a subnormal as ±0 under FTZ; o, tmin, tmax are read the same way"),
+    l(0, "dy", Rule::Read("in_dy"), "input read of d.y (as dx)"),
+    l(0, "dz", Rule::Read("in_dz"), "input read of d.z (as dx)"),
+    l(0, "pdx", Rule::Prep("dx"), "embree: |dx| < δ ? ±δ : dx; else dx"),
+    l(0, "pdy", Rule::Prep("dy"), "likewise"),
+    l(0, "pdz", Rule::Prep("dz"), "likewise"),
+    g(0, "inv_dx", Op::Div, "one", "pdx", Rule::ArithGuardRecip),
+    g(0, "inv_dy", Op::Div, "one", "pdy", Rule::ArithGuardRecip),
+    g(0, "inv_dz", Op::Div, "one", "pdz", Rule::ArithGuardRecip),
     // (guard, conservative only: 1 ⊘ pd of a finite nonzero pd that is not a normal number
     // is the canonical NaN; a subtract of finite operands that gives ±∞ is the canonical NaN)
-    s(1, "lox", Op::Sub, "minx", "ox"),
-    s(1, "hix", Op::Sub, "maxx", "ox"),
-    s(1, "loy", Op::Sub, "miny", "oy"),
-    s(1, "hiy", Op::Sub, "maxy", "oy"),
-    s(1, "loz", Op::Sub, "minz", "oz"),
-    s(1, "hiz", Op::Sub, "maxz", "oz"),
+    g(1, "lox", Op::Sub, "minx", "ox", Rule::ArithGuardSub),
+    g(1, "hix", Op::Sub, "maxx", "ox", Rule::ArithGuardSub),
+    g(1, "loy", Op::Sub, "miny", "oy", Rule::ArithGuardSub),
+    g(1, "hiy", Op::Sub, "maxy", "oy", Rule::ArithGuardSub),
+    g(1, "loz", Op::Sub, "minz", "oz", Rule::ArithGuardSub),
+    g(1, "hiz", Op::Sub, "maxz", "oz", Rule::ArithGuardSub),
     s(2, "tlox", Op::Mul, "lox", "inv_dx"),
     s(2, "thix", Op::Mul, "hix", "inv_dx"),
     s(2, "tloy", Op::Mul, "loy", "inv_dy"),
     s(2, "thiy", Op::Mul, "hiy", "inv_dy"),
     s(2, "tloz", Op::Mul, "loz", "inv_dz"),
     s(2, "thiz", Op::Mul, "hiz", "inv_dz"),
-    l(3, "negx", "sign bit of inv_dx"),
-    l(3, "negy", "sign bit of inv_dy"),
-    l(3, "negz", "sign bit of inv_dz"),
-    l(3, "nearx", "negx ? thix : tlox"),
-    l(3, "farx", "negx ? tlox : thix"),
-    l(3, "neary", "negy ? thiy : tloy"),
-    l(3, "fary", "negy ? tloy : thiy"),
-    l(3, "nearz", "negz ? thiz : tloz"),
-    l(3, "farz", "negz ? tloz : thiz"),
-    l(4, "tn_x", "selnear(tmin, nearx)"),
-    l(4, "tn_xy", "selnear(tn_x, neary)"),
-    l(4, "tn_xyz", "selnear(tn_xy, nearz)"),
-    l(4, "tf_x", "selfar(tmax, farx)"),
-    l(4, "tf_xy", "selfar(tf_x, fary)"),
-    l(4, "tf_xyz", "selfar(tf_xy, farz)"),
-    l(5, "t_near", "tn_xyz stepped widen_ulps times toward −∞ (IEEE nextDown; toward +∞, nextUp, if widen_ulps < 0)"),
-    l(5, "t_far", "tf_xyz stepped widen_ulps times toward +∞ (IEEE nextUp; toward −∞, nextDown, if widen_ulps < 0)"),
-    l(6, "hit", "t_near <= t_far"),
+    l(3, "negx", Rule::SignBit("inv_dx"), "sign bit of inv_dx"),
+    l(3, "negy", Rule::SignBit("inv_dy"), "sign bit of inv_dy"),
+    l(3, "negz", Rule::SignBit("inv_dz"), "sign bit of inv_dz"),
+    l(3, "nearx", Rule::Mux("negx", "thix", "tlox"), "negx ? thix : tlox"),
+    l(3, "farx", Rule::Mux("negx", "tlox", "thix"), "negx ? tlox : thix"),
+    l(3, "neary", Rule::Mux("negy", "thiy", "tloy"), "negy ? thiy : tloy"),
+    l(3, "fary", Rule::Mux("negy", "tloy", "thiy"), "negy ? tloy : thiy"),
+    l(3, "nearz", Rule::Mux("negz", "thiz", "tloz"), "negz ? thiz : tloz"),
+    l(3, "farz", Rule::Mux("negz", "tloz", "thiz"), "negz ? tloz : thiz"),
+    l(4, "tn_x", Rule::SelNear("tmin", "nearx"), "selnear(tmin, nearx)"),
+    l(4, "tn_xy", Rule::SelNear("tn_x", "neary"), "selnear(tn_x, neary)"),
+    l(4, "tn_xyz", Rule::SelNear("tn_xy", "nearz"), "selnear(tn_xy, nearz)"),
+    l(4, "tf_x", Rule::SelFar("tmax", "farx"), "selfar(tmax, farx)"),
+    l(4, "tf_xy", Rule::SelFar("tf_x", "fary"), "selfar(tf_x, fary)"),
+    l(4, "tf_xyz", Rule::SelFar("tf_xy", "farz"), "selfar(tf_xy, farz)"),
+    l(5, "t_near", Rule::Widen("tn_xyz", false), "tn_xyz stepped widen_ulps times toward −∞ (IEEE nextDown; toward +∞, nextUp, if widen_ulps < 0)"),
+    l(5, "t_far", Rule::Widen("tf_xyz", true), "tf_xyz stepped widen_ulps times toward +∞ (IEEE nextUp; toward −∞, nextDown, if widen_ulps < 0)"),
+    l(6, "hit", Rule::Le("t_near", "t_far"), "t_near <= t_far"),
 ];
+
+/// Input names of the slab unit, in the vector files' order: origin, direction, t interval,
+/// box min and max corners.
+pub const SLAB_INPUTS: [&str; 14] =
+    ["ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax", "minx", "miny", "minz", "maxx", "maxy", "maxz"];
 
 /// The rules of the grid steps of stage 5 (and of the directed variant), in words: what
 /// nextUp / nextDown return at the special values.
 pub const STEP_RULES: &str = "nextUp(x) is the least format value greater than x and nextDown(x) the greatest value less than x (IEEE 754 nextUp/nextDown: toward +inf and toward -inf, whatever the sign of x); nextUp(+inf) = +inf, nextDown(-inf) = -inf, nextUp(-inf) = -max, nextDown(+inf) = +max; nextUp(+0) = nextUp(-0) = the least positive value (the smallest subnormal, or under FTZ the smallest normal) and nextDown(±0) its negative; a NaN stays the same NaN (bits unchanged); under FTZ the subnormals are skipped (nextDown of the smallest positive normal is +0, nextUp of its negative is -0); fixed point: plus or minus one step, the most positive and most negative values unchanged";
 
 const fn s(stage: u8, name: &'static str, op: Op, a: &'static str, b: &'static str) -> SigDef {
-    SigDef { stage, name, op, a, b, note: "" }
+    SigDef { stage, name, op, a, b, note: "", rule: Rule::Arith }
 }
-const fn l(stage: u8, name: &'static str, note: &'static str) -> SigDef {
-    SigDef { stage, name, op: Op::Logic, a: "", b: "", note }
+const fn g(stage: u8, name: &'static str, op: Op, a: &'static str, b: &'static str, rule: Rule) -> SigDef {
+    SigDef { stage, name, op, a, b, note: "", rule }
+}
+const fn l(stage: u8, name: &'static str, rule: Rule, note: &'static str) -> SigDef {
+    SigDef { stage, name, op: Op::Logic, a: "", b: "", note, rule }
 }
 
 /// The named slab variants: `plain` (Ignore, Plain, 0), `conservative` (Ignore, Plain, +4),

@@ -12,8 +12,10 @@ pub mod man;
 pub mod merge;
 pub mod ops;
 pub mod plan;
+pub mod prove;
 pub mod render;
 pub mod report;
+pub mod smt;
 pub mod speed;
 pub mod stages;
 pub mod stats;
@@ -77,6 +79,10 @@ pub enum Cmd {
     Stress(stress::Args),
     /// Print the RTI stage table (markdown).
     Stages(stages::Args),
+    /// Emit a unit's stage model as SMT-LIB 2, generated from its stage table and format contract.
+    Smt(smt::Args),
+    /// Prove a guarantee with an SMT solver: PROVEN (0), a counterexample (1) or unknown (3).
+    Prove(prove::Args),
 }
 
 /// Runs a command (none: the main job, `raypipe verify` with every default).
@@ -100,5 +106,7 @@ pub fn dispatch(cmd: Option<Cmd>) -> Result<Outcome, String> {
         Some(Cmd::Speed(a)) => speed::run(a),
         Some(Cmd::Stress(a)) => stress::run(a),
         Some(Cmd::Stages(a)) => stages::run(a),
+        Some(Cmd::Smt(a)) => smt::run(a),
+        Some(Cmd::Prove(a)) => prove::run(a),
     }
 }

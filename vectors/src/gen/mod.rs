@@ -396,8 +396,7 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
                 .iter()
                 .map(|d| Stage { stage: d.stage, name: d.name.into(), op: op_text(d.op, d.a, d.b, d.note) })
                 .collect();
-            let names =
-                ["ox", "oy", "oz", "dx", "dy", "dz", "tmin", "tmax", "minx", "miny", "minz", "maxx", "maxy", "maxz"];
+            let names = datapath::slab::SLAB_INPUTS;
             let out = Layout(vec![
                 ("hit".into(), "out", Kind::Flag, 1, Some(6)),
                 ("t_near".into(), "out", k.clone(), w, Some(5)),

@@ -1,0 +1,1 @@
+//! Proofs of raypipe's guarantees.

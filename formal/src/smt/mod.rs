@@ -1,0 +1,285 @@
+//! The stage models as SMT-LIB 2, generated from the stage tables ([`datapath::rti::stage_table`],
+//! [`datapath::slab::SLAB_TABLE`]) and the format's contract ([`ieee::IeeeSmt`]).
+//!
+//! Naming: each unit input `x` is a declared constant `in_x` (its encoding as received) and
+//! `x` is its stage-0 read; each stage signal is a nullary `define-fun` named as in the stage
+//! table (values: bit-vectors of the format's width; flags: `Bool`). An arithmetic row's value
+//! is the declared constant `NAME!r` (and `NAME!q`, the reciprocal in `recip` division mode)
+//! tied to its operands by an assertion (see [`ieee`]). Nothing else is asserted: every model
+//! of the declared inputs extends to exactly one model of the whole script, the datapath's.
+
+pub mod ieee;
+
+use datapath::format::FormatKind;
+use datapath::rti::{stage_table, Cull, Rti, RtiConfig, RTI_INPUTS};
+use datapath::slab::{DirPrep, Slab, SlabConfig, SlabNan, SLAB_INPUTS, SLAB_TABLE};
+use datapath::stage::{Op, Rule, SigDef};
+use datapath::{AnyFormat, Format};
+use ieee::IeeeSmt;
+use std::fmt::Write;
+
+/// The units `raypipe smt` emits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    /// Ray–triangle intersection.
+    Rti,
+    /// Ray–box slab test.
+    Slab,
+    /// One operation (op code, a, b).
+    Op,
+}
+
+impl std::str::FromStr for Unit {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "rti" => Ok(Unit::Rti),
+            "slab" => Ok(Unit::Slab),
+            "op" => Ok(Unit::Op),
+            o => Err(format!("unknown unit '{o}' for SMT: rti, slab, op")),
+        }
+    }
+}
+
+/// What to emit.
+#[derive(Clone, Debug)]
+pub struct Request {
+    /// Unit.
+    pub unit: Unit,
+    /// Format with its options.
+    pub format: AnyFormat,
+    /// RTI options.
+    pub rti: RtiConfig,
+    /// Slab variant name.
+    pub variant: String,
+}
+
+/// A unit's emitted model: the script and the names a caller reads back.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// The SMT-LIB 2 text (declarations, definitions, assertions; no `check-sat`).
+    pub text: String,
+    /// Input names, in the vector files' order (declared as `in_NAME`).
+    pub inputs: Vec<String>,
+    /// Stage signals in table order, with whether each is a flag.
+    pub signals: Vec<(String, bool)>,
+    /// Encoding width of a value.
+    pub width: u32,
+}
+
+/// The SMT-LIB 2 model of a unit in a format, or why it cannot be emitted.
+pub fn emit(req: &Request) -> Result<Model, String> {
+    datapath::with_format!(&req.format, |f| emit_in(req, f))
+}
+
+fn float_of<F: Format>(f: &F) -> Result<IeeeSmt, String> {
+    match f.kind() {
+        FormatKind::Float(lay) => Ok(IeeeSmt { lay, ftz: f.flushes(), propagate: f.nan_propagates(), div: f.div_mode() }),
+        FormatKind::Fixed { .. } => Err(format!(
+            "SMT emission covers the IEEE-like float formats (f32, fp16, bf16, eEmM); {} is fixed point and is not emitted yet",
+            f.name()
+        )),
+    }
+}
+
+fn emit_in<F: Format>(req: &Request, f: &F) -> Result<Model, String> {
+    let x = float_of(f)?;
+    let mut e = Emitter { x, text: String::new(), signals: Vec::new(), flags: Vec::new() };
+    let _ = writeln!(
+        e.text,
+        "; raypipe {} SMT-LIB 2 model of the {:?} unit in {}",
+        env!("CARGO_PKG_VERSION"),
+        req.unit,
+        f.name()
+    );
+    let _ = writeln!(e.text, "(set-logic QF_BVFP)");
+    e.text.push_str(&x.prelude());
+    let inputs: Vec<String> = match req.unit {
+        Unit::Rti => {
+            let rti = Rti::new(*f, req.rti);
+            let _ = writeln!(e.text, "; rti: cull {:?}, det threshold {}", req.rti.cull, f.hex(rti.det_thr));
+            let env = Env { thr: f.to_bits(rti.det_thr), cull: req.rti.cull, slab: None, delta: 0 };
+            e.inputs(&RTI_INPUTS, &[]);
+            for d in stage_table(f.div_mode()) {
+                e.row(&d, &env)?;
+            }
+            RTI_INPUTS.iter().map(|s| s.to_string()).collect()
+        }
+        Unit::Slab => {
+            let cfg = SlabConfig::named_for(&req.variant, f)?;
+            if cfg.directed {
+                return Err("the directed slab variant has no stage table of fixed shape (its signals depend on the data); SMT emission covers plain, conservative, take-on-false, embree".into());
+            }
+            let delta = f.to_bits(Slab::new(*f, cfg).delta());
+            let _ = writeln!(e.text, "; slab variant {}: {cfg:?}", req.variant);
+            let env = Env { thr: 0, cull: Cull::TwoSided, slab: Some(cfg), delta };
+            // d is read by the table's own rows (dx, dy, dz)
+            e.inputs(&SLAB_INPUTS, &["dx", "dy", "dz"]);
+            for d in SLAB_TABLE.iter() {
+                e.row(d, &env)?;
+            }
+            SLAB_INPUTS.iter().map(|s| s.to_string()).collect()
+        }
+        Unit::Op => {
+            e.op_unit();
+            vec!["opcode".into(), "a".into(), "b".into()]
+        }
+    };
+    Ok(Model { text: e.text, inputs, signals: e.signals.into_iter().zip(e.flags).collect(), width: x.width() })
+}
+
+struct Env {
+    thr: u64,
+    cull: Cull,
+    slab: Option<SlabConfig>,
+    delta: u64,
+}
+
+struct Emitter {
+    x: IeeeSmt,
+    text: String,
+    signals: Vec<String>,
+    flags: Vec<bool>,
+}
+
+impl Emitter {
+    fn inputs(&mut self, names: &[&str], read_by_table: &[&str]) {
+        let b = self.x.bv_sort();
+        let _ = writeln!(self.text, "; inputs (encodings as received) and their stage-0 reads");
+        for n in names {
+            let _ = writeln!(self.text, "(declare-const in_{n} {b})");
+        }
+        for n in names.iter().filter(|n| !read_by_table.contains(n)) {
+            let _ = writeln!(self.text, "(define-fun {n} () {b} (rp_read in_{n}))");
+        }
+        let _ = writeln!(self.text, "(define-fun one () {b} {})", self.x.lit(self.x.one()));
+        let _ = writeln!(self.text, "(define-fun zero () {b} {})", self.x.lit(0));
+    }
+
+    fn value(&mut self, name: &str, term: &str) {
+        let _ = writeln!(self.text, "(define-fun {name} () {} {term})", self.x.bv_sort());
+        self.signals.push(name.into());
+        self.flags.push(false);
+    }
+
+    fn flag(&mut self, name: &str, term: &str) {
+        let _ = writeln!(self.text, "(define-fun {name} () Bool {term})");
+        self.signals.push(name.into());
+        self.flags.push(true);
+    }
+
+    fn arith(&mut self, name: &str, op: Op, a: &str, b: &str) -> String {
+        let x = self.x;
+        let fop = match op {
+            Op::Add => "fp.add",
+            Op::Sub => "fp.sub",
+            Op::Mul => "fp.mul",
+            Op::Div => return x.div(&mut self.text, name, a, b),
+            Op::Logic => unreachable!("a logic row has no arithmetic"),
+        };
+        x.result(&mut self.text, &format!("{name}!r"), fop, a, b);
+        format!("{name}!r")
+    }
+
+    fn row(&mut self, d: &SigDef, env: &Env) -> Result<(), String> {
+        let cnan = self.x.lit(self.x.lay.canonical_nan());
+        let guard = env.slab.is_some_and(|c| c.guard);
+        let _ = writeln!(self.text, "; stage {} {}", d.stage, d.name);
+        match d.rule {
+            Rule::Arith => {
+                let r = self.arith(d.name, d.op, d.a, d.b);
+                self.value(d.name, &r);
+            }
+            Rule::ArithGuardRecip => {
+                let r = self.arith(d.name, d.op, d.a, d.b);
+                let t = if guard { format!("(ite (rp_grecip {} {r}) {cnan} {r})", d.b) } else { r };
+                self.value(d.name, &t);
+            }
+            Rule::ArithGuardSub => {
+                let r = self.arith(d.name, d.op, d.a, d.b);
+                let t = if guard { format!("(ite (rp_gsub {} {} {r}) {cnan} {r})", d.a, d.b) } else { r };
+                self.value(d.name, &t);
+            }
+            Rule::Read(i) => self.value(d.name, &format!("(rp_read {i})")),
+            Rule::Prep(v) => {
+                let cfg = env.slab.ok_or("Prep outside the slab unit")?;
+                match cfg.prep {
+                    DirPrep::Plain => self.value(d.name, v),
+                    DirPrep::Embree => {
+                        // |v| < δ ? (sign(v) ? 0 ⊖ δ : δ) : v
+                        let delta = self.x.lit(env.delta);
+                        let neg = format!("{}!negdelta", d.name);
+                        self.x.result(&mut self.text, &neg, "fp.sub", "zero", &delta);
+                        let t = format!("(ite (rp_lt (rp_abs {v}) {delta}) (ite (rp_neg {v}) {neg} {delta}) {v})");
+                        self.value(d.name, &t);
+                    }
+                }
+            }
+            Rule::SignBit(v) => self.flag(d.name, &format!("(rp_neg {v})")),
+            Rule::Mux(c, a, b) => self.value(d.name, &format!("(ite {c} {a} {b})")),
+            Rule::Le(a, b) => self.flag(d.name, &format!("(rp_le {a} {b})")),
+            Rule::DetOk(det) => {
+                let thr = self.x.lit(env.thr);
+                let t = match env.cull {
+                    Cull::TwoSided => format!("(rp_lt {thr} (rp_abs {det}))"),
+                    Cull::Backface => format!("(rp_lt {thr} {det})"),
+                };
+                self.flag(d.name, &t);
+            }
+            Rule::Oriented(a, b) => {
+                self.flag(d.name, &format!("(ite (rp_lt zero det) (rp_le {a} {b}) (rp_le {b} {a}))"));
+            }
+            Rule::All(fs) => self.flag(d.name, &format!("(and {})", fs.join(" "))),
+            Rule::SelNear(acc, v) => {
+                let cfg = env.slab.ok_or("SelNear outside the slab unit")?;
+                let t = match cfg.nan {
+                    SlabNan::Ignore => format!("(ite (rp_lt {acc} {v}) {v} {acc})"),
+                    SlabNan::TakeOnFalse => format!("(ite (rp_le {v} {acc}) {acc} {v})"),
+                };
+                self.value(d.name, &t);
+            }
+            Rule::SelFar(acc, v) => {
+                let cfg = env.slab.ok_or("SelFar outside the slab unit")?;
+                let t = match cfg.nan {
+                    SlabNan::Ignore => format!("(ite (rp_lt {v} {acc}) {v} {acc})"),
+                    SlabNan::TakeOnFalse => format!("(ite (rp_le {acc} {v}) {acc} {v})"),
+                };
+                self.value(d.name, &t);
+            }
+            Rule::Widen(v, up) => {
+                let cfg = env.slab.ok_or("Widen outside the slab unit")?;
+                let step_up = up != (cfg.widen_ulps < 0);
+                let f = if step_up { "rp_up" } else { "rp_down" };
+                let mut t = v.to_string();
+                for _ in 0..cfg.widen_ulps.unsigned_abs() {
+                    t = format!("({f} {t})");
+                }
+                self.value(d.name, &t);
+            }
+        }
+        Ok(())
+    }
+
+    /// The op unit: the four arithmetic results and two compares of (a, b), selected by the
+    /// op code (0 add, 1 sub, 2 mul, 3 div, 4 lt, 5 le; result 0 for compares, cmp false for
+    /// arithmetic). Its inputs are not read (the op unit applies the operations directly).
+    fn op_unit(&mut self) {
+        let b = self.x.bv_sort();
+        let _ = writeln!(self.text, "(declare-const in_opcode (_ BitVec 4))");
+        let _ = writeln!(self.text, "(declare-const in_a {b})");
+        let _ = writeln!(self.text, "(declare-const in_b {b})");
+        let _ = writeln!(self.text, "(define-fun one () {b} {})", self.x.lit(self.x.one()));
+        for (name, op) in [("add", Op::Add), ("sub", Op::Sub), ("mul", Op::Mul), ("div", Op::Div)] {
+            let r = self.arith(name, op, "in_a", "in_b");
+            self.value(name, &r);
+        }
+        self.flag("lt", "(rp_lt in_a in_b)");
+        self.flag("le", "(rp_le in_a in_b)");
+        let z = self.x.lit(0);
+        let code = |c: u64| format!("(= in_opcode {})", ieee::bv(c, 4));
+        let result =
+            format!("(ite {} add (ite {} sub (ite {} mul (ite {} div {z}))))", code(0), code(1), code(2), code(3));
+        self.value("result", &result);
+        self.flag("cmp", &format!("(ite {} lt (ite {} le false))", code(4), code(5)));
+    }
+}
