@@ -145,3 +145,39 @@ impl ArchArgs {
         }
     }
 }
+
+/// Changes to a named slab variant, to build the mutants a proof must refute.
+#[derive(clap::Args, Clone, Default)]
+pub struct SlabMutation {
+    /// Widen t_near / t_far by N grid steps instead of the variant's own number.
+    #[arg(long, allow_hyphen_values = true)]
+    pub widen: Option<i32>,
+    /// Leave out the conservative variant's guard.
+    #[arg(long)]
+    pub no_guard: bool,
+}
+
+impl SlabMutation {
+    /// The variant `cfg` with these changes.
+    pub fn apply(&self, mut cfg: SlabConfig) -> SlabConfig {
+        if let Some(w) = self.widen {
+            cfg.widen_ulps = w;
+        }
+        if self.no_guard {
+            cfg.guard = false;
+        }
+        cfg
+    }
+
+    /// The options as typed (for a reproducing command).
+    pub fn flags(&self) -> String {
+        let mut s = String::new();
+        if let Some(w) = self.widen {
+            s += &format!(" --widen {w}");
+        }
+        if self.no_guard {
+            s += " --no-guard";
+        }
+        s
+    }
+}

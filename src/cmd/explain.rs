@@ -37,11 +37,14 @@ pub struct Args {
     /// Run the RTI model with this fault of the bank (as `verify --inject`).
     #[arg(long)]
     pub inject: Option<String>,
+    /// Slab variant changes (a mutant, as `raypipe prove` refutes them).
+    #[command(flatten)]
+    pub mutation: SlabMutation,
 }
 
 /// Runs `raypipe explain`.
 pub fn run(a: Args) -> Result<Outcome, String> {
-    let Args { unit, format, ray, tri, aabb, variant, tmin, tmax, rti, json, inject } = a;
+    let Args { unit, format, ray, tri, aabb, variant, tmin, tmax, rti, json, inject, mutation } = a;
     let cfg = rti.config()?;
     let inject = inject.as_deref().map(rti_fault).transpose()?;
     if inject.is_some() && unit != "rti" {
@@ -61,7 +64,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
             let b = parse_list("--box", aabb.as_deref().ok_or("--unit slab needs --box")?, 6)?;
             let (lo, hi) = ([b[0], b[1], b[2]], [b[3], b[4], b[5]]);
             let t = with_format!(format, |f| {
-                let sc = SlabConfig::named_for(&variant, &f)?;
+                let sc = mutation.apply(SlabConfig::named_for(&variant, &f)?);
                 raypipe::explain::trace_slab(&Slab::new(f, sc), &variant, &ray, lo, hi)
             })?;
             emit(json, &t, raypipe::explain::render_slab)?;

@@ -18,6 +18,9 @@ pub struct Args {
     /// RTI options.
     #[command(flatten)]
     pub rti: RtiArgs,
+    /// Slab variant changes (mutants).
+    #[command(flatten)]
+    pub mutation: SlabMutation,
     /// Write model.smt2 and model.json (inputs, signals) into DIR instead of printing the script.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -27,12 +30,32 @@ pub struct Args {
 }
 
 /// The request `a` names.
-pub fn request(unit: &str, format: &str, variant: &str, rti: &RtiArgs) -> Result<formal::smt::Request, String> {
+pub fn request(
+    unit: &str,
+    format: &str,
+    variant: &str,
+    rti: &RtiArgs,
+    m: &SlabMutation,
+) -> Result<formal::smt::Request, String> {
     Ok(formal::smt::Request {
         unit: unit.parse()?,
         format: parse_format(format)?,
         rti: rti.config()?,
         variant: variant.to_string(),
+        widen: m.widen,
+        no_guard: m.no_guard,
+    })
+}
+
+/// A slab request (no RTI options).
+pub fn request_slab(format: &str, variant: &str, m: &SlabMutation) -> Result<formal::smt::Request, String> {
+    Ok(formal::smt::Request {
+        unit: formal::smt::Unit::Slab,
+        format: parse_format(format)?,
+        rti: RtiConfig::default(),
+        variant: variant.to_string(),
+        widen: m.widen,
+        no_guard: m.no_guard,
     })
 }
 
@@ -49,7 +72,7 @@ pub fn model_json(m: &formal::smt::Model, command: &str) -> serde_json::Value {
 
 /// Runs `raypipe smt`.
 pub fn run(a: Args) -> Result<Outcome, String> {
-    let req = request(&a.unit, &a.format, &a.variant, &a.rti)?;
+    let req = request(&a.unit, &a.format, &a.variant, &a.rti, &a.mutation)?;
     let out = match &a.out {
         Some(d) => Some(OutDir::check(d, &["model.smt2", "model.json"])?),
         None => None,

@@ -52,6 +52,24 @@ pub struct Request {
     pub rti: RtiConfig,
     /// Slab variant name.
     pub variant: String,
+    /// Slab mutation: widen by this many steps instead of the variant's number.
+    pub widen: Option<i32>,
+    /// Slab mutation: leave the guard out.
+    pub no_guard: bool,
+}
+
+impl Request {
+    /// The slab variant this request names, with its mutation, for format `f`.
+    pub fn slab_config<F: Format>(&self, f: &F) -> Result<SlabConfig, String> {
+        let mut cfg = SlabConfig::named_for(&self.variant, f)?;
+        if let Some(w) = self.widen {
+            cfg.widen_ulps = w;
+        }
+        if self.no_guard {
+            cfg.guard = false;
+        }
+        Ok(cfg)
+    }
 }
 
 /// A unit's emitted model: the script and the names a caller reads back.
@@ -65,6 +83,8 @@ pub struct Model {
     pub signals: Vec<(String, bool)>,
     /// Encoding width of a value.
     pub width: u32,
+    /// The format as SMT.
+    pub float: IeeeSmt,
 }
 
 /// The SMT-LIB 2 model of a unit in a format, or why it cannot be emitted.
@@ -106,7 +126,7 @@ fn emit_in<F: Format>(req: &Request, f: &F) -> Result<Model, String> {
             RTI_INPUTS.iter().map(|s| s.to_string()).collect()
         }
         Unit::Slab => {
-            let cfg = SlabConfig::named_for(&req.variant, f)?;
+            let cfg = req.slab_config(f)?;
             if cfg.directed {
                 return Err("the directed slab variant has no stage table of fixed shape (its signals depend on the data); SMT emission covers plain, conservative, take-on-false, embree".into());
             }
@@ -125,7 +145,13 @@ fn emit_in<F: Format>(req: &Request, f: &F) -> Result<Model, String> {
             vec!["opcode".into(), "a".into(), "b".into()]
         }
     };
-    Ok(Model { text: e.text, inputs, signals: e.signals.into_iter().zip(e.flags).collect(), width: x.width() })
+    Ok(Model {
+        text: e.text,
+        inputs,
+        signals: e.signals.into_iter().zip(e.flags).collect(),
+        width: x.width(),
+        float: x,
+    })
 }
 
 struct Env {
