@@ -117,16 +117,10 @@ class Session:
                          if line.startswith(("(declare-const", "(define-fun", "(define-sort", "(declare-fun")))
 
     def push(self):
-        if self.name == "bitwuzla":
-            self.s.push(1)
-        else:
-            self.s.push() if self.name == "z3" else self.s.push(1)
+        self.s.push() if self.name == "z3" else self.s.push(1)
 
     def pop(self):
-        if self.name == "bitwuzla":
-            self.s.pop(1)
-        else:
-            self.s.pop() if self.name == "z3" else self.s.pop(1)
+        self.s.pop() if self.name == "z3" else self.s.pop(1)
 
     def check(self):
         if self.name == "bitwuzla":
@@ -149,7 +143,6 @@ class Session:
             v = self.s.getValue(t)
             return int(v.getBitVectorValue(10)) if t.getSort().isBitVector() else int(v.getBooleanValue())
         m = self.s.model()
-        d = {str(x): x for x in m.decls()}
         v = m.eval(self.z3.parse_smt2_string(self._z3_decls() + f"(assert (= {name} {name}))")[0].arg(0),
                    model_completion=True)
         return int(v.as_long()) if self.z3.is_bv(v) else int(self.z3.is_true(v))

@@ -35,17 +35,22 @@ pub fn exact_sort(l: FloatLayout) -> Option<(u32, u32)> {
     }
 }
 
+/// [`exact_sort`], or why the layout has none.
+fn exact_sort_for(lay: FloatLayout) -> Result<(u32, u32), String> {
+    exact_sort(lay).ok_or_else(|| {
+        format!(
+            "no exact sort: a difference of two values of e{}m{} times a value needs more than 113 bits (binary128); not provable this way",
+            lay.exp_bits, lay.man_bits
+        )
+    })
+}
+
 /// The theorem in words.
 pub const THEOREM: &str = "for every input whose 14 encodings are finite (no NaN, no infinity), with min <= max on each axis and tmin <= tmax, if the exact real-number slab interval [max(tmin, L_x, L_y, L_z), min(tmax, H_x, H_y, H_z)] is non-empty (an axis with d = +-0 and min <= o <= max imposes no constraint; with o outside it empties the interval), the model reports hit";
 
 /// The query: satisfiable exactly when some input is an exact hit the model misses.
 pub fn query(m: &Model, lay: FloatLayout) -> Result<String, String> {
-    let (ee, ss) = exact_sort(lay).ok_or_else(|| {
-        format!(
-            "no exact sort: a difference of two values of e{}m{} times a value needs more than 113 bits (binary128); not provable this way",
-            lay.exp_bits, lay.man_bits
-        )
-    })?;
+    let (ee, ss) = exact_sort_for(lay)?;
     let mut q = m.text.clone();
     let x = |t: &str| format!("((_ to_fp {ee} {ss}) RNE (rp_fp {t}))");
     let _ = writeln!(q, "; ---- slab-never-misses: the exact interval is non-empty and the model misses");
@@ -102,12 +107,7 @@ pub fn query(m: &Model, lay: FloatLayout) -> Result<String, String> {
 /// `L`, or `far` below the exact exit `H` (for `d = ±0` with `min <= o <= max`: `near` not
 /// −∞ or `far` not +∞).
 pub fn lemma_query(m: &Model, lay: FloatLayout, a: &str, w: u32) -> Result<String, String> {
-    let (ee, ss) = exact_sort(lay).ok_or_else(|| {
-        format!(
-            "no exact sort: a difference of two values of e{}m{} times a value needs more than 113 bits (binary128); not provable this way",
-            lay.exp_bits, lay.man_bits
-        )
-    })?;
+    let (ee, ss) = exact_sort_for(lay)?;
     let mut q = m.text.clone();
     let x = |t: &str| format!("((_ to_fp {ee} {ss}) RNE (rp_fp {t}))");
     let _ = writeln!(

@@ -21,7 +21,7 @@
 //! `t_near = nextDown^w(max(tmin, near_x, near_y, near_z)) <= max(tmin, L_x, L_y, L_z)` and
 //! `t_far >= min(tmax, H_x, H_y, H_z)`: an exact non-empty interval is a hit (docs/proofs.md).
 
-use datapath::format::{FormatKind, Subnormals};
+use datapath::format::FormatKind;
 use datapath::slab::{guarded_recip, guarded_sub, DirPrep, SlabConfig, SlabNan};
 use datapath::Format;
 
@@ -71,7 +71,6 @@ pub fn enumerate<F: Format>(f: &F, cfg: SlabConfig, threads: usize) -> Result<En
     if cfg.nan != SlabNan::Ignore || cfg.prep != DirPrep::Plain || cfg.widen_ulps < 0 || cfg.directed {
         return Err("the lemma is stated for the Ignore comparator, plain preparation and widening >= 0".into());
     }
-    let _ = Subnormals::Ieee;
     let n = 1u64 << l.width();
     let w = cfg.widen_ulps as u32;
     let guard = cfg.guard;
