@@ -308,60 +308,72 @@ pub fn history_traverse_faulty<B, X: crate::fault::Logic>(
         return r;
     }
     let n_limit = x.limit("n_limit", n);
+    let mut prev_end = None;
+    while history_pass_faulty(t, n_limit, &mut test, &mut r, &mut prev_end, x) {}
+    r
+}
+
+/// One pass of [`history_traverse_faulty`] from the root, on a ray whose root box was hit
+/// and whose state `r` holds the history between passes (`prev_end`: the level where the
+/// previous pass ended). True when another pass follows: fewer than `n_limit` leaves and a
+/// level in 10. The box tests and choices are exactly those of the whole traversal, which
+/// is this function in a loop (the formal proof drives it pass by pass).
+pub fn history_pass_faulty<B, X: crate::fault::Logic>(
+    t: &HwTree<B>,
+    n_limit: usize,
+    mut test: impl FnMut(&B) -> Option<f64>,
+    r: &mut StacklessResult,
+    prev_end: &mut Option<usize>,
+    x: &X,
+) -> bool {
     // (nearer, farther) side of a pair where both children hit
     let near_far = |el: f64, er: f64| if x.less("near", er, el) { (1, 0) } else { (0, 1) };
     let h = &mut r.state;
-    let mut prev_end: Option<usize> = None;
-    loop {
-        r.passes += 1;
-        let resume = if x.flag("resume", true) {
-            h.iter().rposition(|&s| s == hist::SPLIT)
-        } else {
-            h.iter().position(|&s| s == hist::SPLIT)
-        };
-        if let (Some(end), Some(k)) = (prev_end, resume) {
-            r.back_distances.push(end.abs_diff(k) as u32);
-        }
-        let end = pass(t, &mut test, &mut r.box_tests, &mut r.leaves, |level, el, er| {
-            match (h[level], el, er) {
-                (hist::NEW, Some(a), Some(b)) => {
-                    if x.flag("mark_split", true) {
-                        h[level] = hist::SPLIT;
-                    }
-                    Some(near_far(a, b).0)
-                }
-                (hist::NEW, Some(_), None) | (hist::PASS, Some(_), None) => {
-                    if x.flag("mark_pass", true) {
-                        h[level] = hist::PASS;
-                    }
-                    Some(0)
-                }
-                (hist::NEW, None, Some(_)) | (hist::PASS, None, Some(_)) => {
-                    if x.flag("mark_pass", true) {
-                        h[level] = hist::PASS;
-                    }
-                    Some(1)
-                }
-                (hist::SPLIT, Some(a), Some(b)) if resume == Some(level) => {
-                    h[level] = hist::DONE;
-                    if x.flag("reset_deeper", true) {
-                        h[level + 1..].fill(hist::NEW);
-                    }
-                    Some(near_far(a, b).1)
-                }
-                (hist::SPLIT, Some(a), Some(b)) => Some(near_far(a, b).0),
-                (hist::DONE, Some(a), Some(b)) => Some(near_far(a, b).1),
-                // NEW with no hit: dead end. Other combinations cannot occur with a
-                // deterministic tester; they end the pass as a dead end too.
-                _ => None,
-            }
-        });
-        prev_end = Some(end);
-        if r.leaves.len() >= n_limit || !x.flag("more", h.contains(&hist::SPLIT)) {
-            break;
-        }
+    r.passes += 1;
+    let resume = if x.flag("resume", true) {
+        h.iter().rposition(|&s| s == hist::SPLIT)
+    } else {
+        h.iter().position(|&s| s == hist::SPLIT)
+    };
+    if let (Some(end), Some(k)) = (*prev_end, resume) {
+        r.back_distances.push(end.abs_diff(k) as u32);
     }
-    r
+    let end = pass(t, &mut test, &mut r.box_tests, &mut r.leaves, |level, el, er| {
+        match (h[level], el, er) {
+            (hist::NEW, Some(a), Some(b)) => {
+                if x.flag("mark_split", true) {
+                    h[level] = hist::SPLIT;
+                }
+                Some(near_far(a, b).0)
+            }
+            (hist::NEW, Some(_), None) | (hist::PASS, Some(_), None) => {
+                if x.flag("mark_pass", true) {
+                    h[level] = hist::PASS;
+                }
+                Some(0)
+            }
+            (hist::NEW, None, Some(_)) | (hist::PASS, None, Some(_)) => {
+                if x.flag("mark_pass", true) {
+                    h[level] = hist::PASS;
+                }
+                Some(1)
+            }
+            (hist::SPLIT, Some(a), Some(b)) if resume == Some(level) => {
+                h[level] = hist::DONE;
+                if x.flag("reset_deeper", true) {
+                    h[level + 1..].fill(hist::NEW);
+                }
+                Some(near_far(a, b).1)
+            }
+            (hist::SPLIT, Some(a), Some(b)) => Some(near_far(a, b).0),
+            (hist::DONE, Some(a), Some(b)) => Some(near_far(a, b).1),
+            // NEW with no hit: dead end. Other combinations cannot occur with a
+            // deterministic tester; they end the pass as a dead end too.
+            _ => None,
+        }
+    });
+    *prev_end = Some(end);
+    r.leaves.len() < n_limit && x.flag("more", r.state.contains(&hist::SPLIT))
 }
 
 /// Laine's restart trail (HPG 2010), one bit per level: 0 = take the nearer child, 1 = take the

@@ -1,4 +1,5 @@
-//! `raypipe prove`: prove one of raypipe's guarantees with an SMT solver (docs/proofs.md).
+//! `raypipe prove`: prove one of raypipe's guarantees (docs/proofs.md): by SMT solver and
+//! enumeration (slab-never-misses) or explicit-state search (history-equals-stack).
 //! Exit 0 PROVEN, 1 counterexample, 3 unknown (timeout: nothing proven).
 
 use super::prelude::*;
@@ -7,14 +8,27 @@ use datapath::Format;
 /// The options of `raypipe prove`.
 #[derive(clap::Args, Clone)]
 pub struct Args {
-    /// Property: slab-never-misses.
+    /// Property: slab-never-misses, history-equals-stack.
     pub property: String,
-    /// Format (IEEE-like floats with at most 6 exponent bits: fp16, e5mM, e4mM, ...).
-    #[arg(long, default_value = "fp16")]
-    pub format: String,
-    /// Slab variant.
-    #[arg(long, default_value = "conservative")]
-    pub variant: String,
+    /// Format of slab-never-misses (IEEE-like floats: fp16, e5mM, e4mM, ...; default fp16).
+    #[arg(long)]
+    pub format: Option<String>,
+    /// Slab variant of slab-never-misses (default conservative).
+    #[arg(long)]
+    pub variant: Option<String>,
+    /// history-equals-stack: every tree of 1 to this many levels.
+    #[arg(long, default_value_t = 6)]
+    pub depth: usize,
+    /// history-equals-stack: every N (leaves asked for) from 0 to this.
+    #[arg(long, default_value_t = 4)]
+    pub n: usize,
+    /// history-equals-stack: also offer NaN entry distances (checks that NaN orders as a tie).
+    #[arg(long)]
+    pub nan: bool,
+    /// history-equals-stack: a mutant of the control logic the proof must refute
+    /// (resume-shallowest, no-reset-deeper, no-mark-split, one-pass, ties-right, no-mark-pass).
+    #[arg(long)]
+    pub mutant: Option<String>,
     /// Slab variant changes (a mutant the proof must refute).
     #[command(flatten)]
     pub mutation: SlabMutation,
@@ -40,21 +54,31 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     if !matches!(a.solver.as_str(), "auto" | "bitwuzla" | "cvc5" | "z3") {
         return Err(format!("unknown solver '{}': auto, bitwuzla, cvc5, z3", a.solver));
     }
+    if a.property == "history-equals-stack" {
+        return history(&a);
+    }
+    if a.mutant.is_some() || a.nan {
+        return Err("--mutant and --nan belong to history-equals-stack".into());
+    }
+    let format = a.format.clone().unwrap_or_else(|| "fp16".into());
+    let variant = a.variant.clone().unwrap_or_else(|| "conservative".into());
     let p = match a.property.as_str() {
         "slab-never-misses" => {
-            let req = super::smt::request_slab(&a.format, &a.variant, &a.mutation)?;
+            let req = super::smt::request_slab(&format, &variant, &a.mutation)?;
             let threads =
                 a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
             formal::prove::slab::prove(&req, &a.solver, a.timeout, threads)?
         }
-        other => return Err(format!("unknown property '{other}'; properties: slab-never-misses")),
+        other => {
+            return Err(format!("unknown property '{other}'; properties: slab-never-misses, history-equals-stack"))
+        }
     };
-    let explain = (p.verdict.result == "sat").then(|| explain_command(&a, &p));
+    let explain = (p.verdict.result == "sat").then(|| explain_command(&format, &variant, &a.mutation, &p));
     let j = serde_json::json!({
         "command": command_as_typed(),
         "property": p.property,
         "format": p.format,
-        "variant": a.variant,
+        "variant": variant,
         "mutation": a.mutation.flags().trim(),
         "status": p.status(),
         "theorem": p.theorem,
@@ -71,7 +95,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
             p.property,
             p.status(),
             p.format,
-            a.variant,
+            variant,
             a.mutation.flags(),
             p.verdict.solver,
             p.verdict.version,
@@ -100,9 +124,57 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     })
 }
 
+/// `raypipe prove history-equals-stack`: the explicit-state search over the history control.
+fn history(a: &Args) -> Result<Outcome, String> {
+    if a.format.is_some() || a.variant.is_some() || !a.mutation.flags().is_empty() {
+        return Err("history-equals-stack is about the traversal's control logic: --format, --variant, --widen and --no-guard do not apply".into());
+    }
+    let mutant =
+        a.mutant.as_deref().map_or(Ok(formal::prove::history::Mutant::None), formal::prove::history::Mutant::parse)?;
+    let threads = a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
+    let p = formal::prove::history::prove(a.depth, a.n, a.nan, mutant, threads)?;
+    let j = serde_json::json!({
+        "command": command_as_typed(),
+        "property": "history-equals-stack",
+        "depth": a.depth,
+        "n": a.n,
+        "nan": a.nan,
+        "mutant": a.mutant,
+        "status": p.status,
+        "statement": p.statement,
+        "method": "explicit-state search over datapath::bvh::history_pass_faulty (docs/proofs.md)",
+        "seconds": p.seconds,
+        "states": p.cases.iter().map(|&(levels, n, states)| serde_json::json!({"levels": levels, "n": n, "states": states})).collect::<Vec<_>>(),
+        "counterexample": p.counterexample,
+    });
+    emit(a.json, &j, |_| {
+        let states: u64 = p.cases.iter().map(|c| c.2).sum();
+        let mut s = format!(
+            "history-equals-stack: {} for 1..={} levels, N 0..={}{}{} — explicit-state search, {} merged states in {:.1} s\n",
+            p.status,
+            a.depth,
+            a.n,
+            if a.nan { ", NaN entries" } else { "" },
+            a.mutant.as_ref().map_or(String::new(), |m| format!(", mutant {m}")),
+            states,
+            p.seconds
+        );
+        match p.status {
+            "PROVEN" => s += &format!("theorem: {}\n", p.statement),
+            _ => s += &format!("{}\n{}\n", p.statement, p.counterexample.clone().unwrap_or_default()),
+        }
+        s
+    })?;
+    Ok(match p.status {
+        "PROVEN" => Outcome::Pass,
+        "COUNTEREXAMPLE" => Outcome::Fail,
+        _ => Outcome::Inconclusive,
+    })
+}
+
 /// The `raypipe explain` command that replays a slab counterexample.
-fn explain_command(a: &Args, p: &formal::prove::Proof) -> String {
-    let f = parse_format(&a.format).expect("parsed before");
+fn explain_command(format: &str, variant: &str, mutation: &SlabMutation, p: &formal::prove::Proof) -> String {
+    let f = parse_format(format).expect("parsed before");
     let val = |n: &str| {
         let bits = p.witness.iter().find(|(k, _)| k == n).map_or(0, |(_, v)| *v);
         with_format!(&f, |f| f.to_f64(f.from_bits(bits)))
@@ -110,9 +182,9 @@ fn explain_command(a: &Args, p: &formal::prove::Proof) -> String {
     let list = |ns: &[&str]| ns.iter().map(|n| format!("{:?}", val(n))).collect::<Vec<_>>().join(",");
     format!(
         "raypipe explain --unit slab --format {} --variant {}{} --ray {} --box {} --tmin {:?} --tmax {:?}",
-        a.format,
-        a.variant,
-        a.mutation.flags(),
+        format,
+        variant,
+        mutation.flags(),
         list(&["ox", "oy", "oz", "dx", "dy", "dz"]),
         list(&["minx", "miny", "minz", "maxx", "maxy", "maxz"]),
         val("tmin"),

@@ -3,6 +3,7 @@
 //! assertions are satisfiable exactly when the guarantee fails. `unsat` is PROVEN; `sat`
 //! gives a counterexample; `unknown` (a timeout) proves nothing.
 
+pub mod history;
 pub mod slab;
 pub mod slab_planes;
 
