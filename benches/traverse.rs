@@ -95,6 +95,7 @@ fn bench_export(c: &mut Criterion) {
         tree: None,
         leaves: 8,
         max_levels: 64,
+        explicit: None,
     };
     g.throughput(Throughput::Elements(12 * 64));
     g.bench_function("rti_f32_generate_and_write", |bch| {

@@ -61,6 +61,7 @@ fn request(unit: Unit, scene: &Scene) -> Request {
         tree,
         leaves: 4,
         max_levels: 64,
+        explicit: None,
     }
 }
 
@@ -137,6 +138,7 @@ pub fn field_reference() -> Result<String, String> {
     for (k, v) in MANIFEST_KEYS {
         out += &format!("| `{k}` | {v} |\n");
     }
-    out += "| `minimal` | (a minimal set only) what it was cut from and the faults it keeps detecting |\n\n";
+    out += "| `minimal` | (a minimal set only) what it was cut from and the faults it keeps detecting |\n";
+    out += "| `origin` | (a set of given rows only, e.g. a proof's counterexample: `raypipe prove slab-never-misses --out`) the command that wrote the input rows; `vectors --check` rebuilds the set from its own input rows instead of the seed |\n\n";
     Ok(out + &sections)
 }

@@ -21,6 +21,7 @@ fn request(unit: Unit, format: &str, rti: RtiConfig, variant: &str) -> Request {
         tree: None,
         leaves: 8,
         max_levels: 64,
+        explicit: None,
         threads: 1,
     }
 }

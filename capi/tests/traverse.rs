@@ -45,6 +45,7 @@ fn request(format: &str) -> Request {
         tree: Some(tree()),
         leaves: 8,
         max_levels: 64,
+        explicit: None,
         threads: 1,
     }
 }

@@ -41,6 +41,9 @@ pub struct Args {
     /// Threads of an exhaustive enumeration (default: every core); the result does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     pub threads: Option<u64>,
+    /// slab-never-misses: write a counterexample as a vector set (class smt) to DIR.
+    #[arg(long)]
+    pub out: Option<std::path::PathBuf>,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -60,6 +63,10 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     if a.mutant.is_some() || a.nan {
         return Err("--mutant and --nan belong to history-equals-stack".into());
     }
+    if let Some(out) = &a.out {
+        // before the work: never overwrite what raypipe did not write
+        vectors::write::check_out(out)?;
+    }
     let format = a.format.clone().unwrap_or_else(|| "fp16".into());
     let variant = a.variant.clone().unwrap_or_else(|| "conservative".into());
     let p = match a.property.as_str() {
@@ -74,6 +81,10 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         }
     };
     let explain = (p.verdict.result == "sat").then(|| explain_command(&format, &variant, &a.mutation, &p));
+    let written = match (&a.out, p.verdict.result.as_str()) {
+        (Some(out), "sat") => Some(write_counterexample(out, &format, &variant, &a.mutation, &p)?),
+        _ => None,
+    };
     let j = serde_json::json!({
         "command": command_as_typed(),
         "property": p.property,
@@ -87,6 +98,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         "seconds": p.verdict.seconds,
         "witness": p.witness.iter().map(|(n, v)| (n.clone(), serde_json::json!(format!("{v:#x}")))).collect::<serde_json::Map<_, _>>(),
         "explain": explain,
+        "vectors": written.as_ref().map(|d| d.display().to_string()),
         "steps": p.steps.iter().map(|(what, v)| serde_json::json!({"query": what, "result": v.result, "solver": v.solver, "seconds": v.seconds})).collect::<Vec<_>>(),
     });
     emit(a.json, &j, |_| {
@@ -112,6 +124,9 @@ pub fn run(a: Args) -> Result<Outcome, String> {
                     p.witness.iter().map(|(n, v)| format!("{n}={v:#x}")).collect::<Vec<_>>().join(" "),
                     explain.clone().unwrap_or_default()
                 );
+                if let Some(d) = &written {
+                    s += &format!("vector set (class smt): {}\n", d.display());
+                }
             }
             _ => s += "nothing proven: the solver gave up (raise --timeout)\n",
         }
@@ -126,6 +141,9 @@ pub fn run(a: Args) -> Result<Outcome, String> {
 
 /// `raypipe prove history-equals-stack`: the explicit-state search over the history control.
 fn history(a: &Args) -> Result<Outcome, String> {
+    if a.out.is_some() {
+        return Err("history-equals-stack prints its counterexample tree; --out writes slab vector sets".into());
+    }
     if a.format.is_some() || a.variant.is_some() || !a.mutation.flags().is_empty() {
         return Err("history-equals-stack is about the traversal's control logic: --format, --variant, --widen and --no-guard do not apply".into());
     }
@@ -170,6 +188,46 @@ fn history(a: &Args) -> Result<Outcome, String> {
         "COUNTEREXAMPLE" => Outcome::Fail,
         _ => Outcome::Inconclusive,
     })
+}
+
+/// Writes a slab counterexample as a one-vector set of class `smt` whose expected outputs are
+/// the unmutated variant's (a DUT with the mutant's bug fails it); returns the set's directory.
+fn write_counterexample(
+    out: &std::path::Path,
+    format: &str,
+    variant: &str,
+    mutation: &SlabMutation,
+    p: &formal::prove::Proof,
+) -> Result<std::path::PathBuf, String> {
+    let row: Vec<u64> = datapath::slab::SLAB_INPUTS
+        .iter()
+        .map(|n| p.witness.iter().find(|(k, _)| k == n).map(|(_, v)| *v).ok_or(format!("the witness has no {n}")))
+        .collect::<Result<_, _>>()?;
+    let req = vectors::gen::Request {
+        unit: vectors::gen::Unit::Slab,
+        format: parse_format(format)?,
+        count: 1,
+        seed: 0,
+        level: 1,
+        threads: 1,
+        command: command_as_typed(),
+        rti: datapath::rti::RtiConfig::default(),
+        slab_variant: variant.to_string(),
+        tree: None,
+        leaves: 8,
+        max_levels: 64,
+        explicit: Some(vectors::gen::Explicit {
+            class: "smt".into(),
+            covers: format!(
+                "a counterexample of raypipe prove slab-never-misses for variant {variant}{}: an input whose exact slab interval is non-empty and which that mutant misses; the expected outputs are the {variant} variant's own",
+                mutation.flags()
+            ),
+            origin: command_as_typed(),
+            rows: vec![row],
+        }),
+    };
+    let set = vectors::gen::generate(&req)?;
+    vectors::write::write_set(&set, out)
 }
 
 /// The `raypipe explain` command that replays a slab counterexample.

@@ -140,6 +140,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         tree,
         leaves: leaves as usize,
         max_levels: levels as usize,
+        explicit: None,
         threads: threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
         format,
         count: count as usize,

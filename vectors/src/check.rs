@@ -115,7 +115,24 @@ fn request_from(m: &Manifest, unit: Unit, format: AnyFormat, contents: &[Vec<Vec
         tree,
         leaves,
         max_levels,
+        explicit: explicit_from(m, unit, contents)?,
     })
+}
+
+/// A set whose manifest names an `origin` holds given input rows (one class): they are what
+/// the regenerated set is built from (the class field dropped).
+fn explicit_from(m: &Manifest, unit: Unit, contents: &[Vec<Vec<u64>>]) -> Result<Option<crate::gen::Explicit>, String> {
+    let Some(origin) = &m.origin else { return Ok(None) };
+    if unit != Unit::Slab || m.classes.len() != 1 {
+        return Err("manifest.json: field origin: given input rows are a one-class slab set".into());
+    }
+    let rows = contents.first().ok_or("the set has no input file")?;
+    Ok(Some(crate::gen::Explicit {
+        class: m.classes[0].name.clone(),
+        covers: m.classes[0].covers.clone(),
+        origin: origin.clone(),
+        rows: rows.iter().map(|r| r.iter().skip(1).copied().collect()).collect(),
+    }))
 }
 
 /// The traverse set's tree from its root row and level banks, in the breadth-first order the

@@ -143,6 +143,10 @@ pub struct Manifest {
     /// detects every fault of the bank the default set detects; absent for a full set.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub minimal: Option<Minimal>,
+    /// What wrote the input rows when they are not drawn from the seed (a proof's
+    /// counterexamples: `raypipe prove ... --out`); absent for a generated set.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub origin: Option<String>,
 }
 
 /// What a minimal set was cut from and what it keeps detecting.

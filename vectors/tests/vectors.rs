@@ -22,6 +22,7 @@ fn req(unit: Unit, format: &str, count: usize) -> Request {
         tree: (unit == Unit::Traverse).then(builtin_tree),
         leaves: 8,
         max_levels: 64,
+        explicit: None,
         threads: 1,
     }
 }
@@ -515,4 +516,41 @@ fn the_slab_input_read_canonicalizes_or_quiets_nans_and_flushes_ftz_subnormals()
     zero[3] = 0x8000_0000;
     assert_eq!(rows("f32:ftz", &sub), rows("f32:ftz", &zero));
     assert_ne!(rows("f32", &sub), rows("f32", &zero));
+}
+
+/// A set of given rows (a proof's counterexample): written with its origin, accepted by
+/// `check_set`, which rebuilds it from its own rows; a wrong expected bit is caught; only the
+/// slab unit takes given rows.
+#[test]
+fn given_rows_make_a_checked_one_class_set() {
+    // fp16: a ray along +x from the origin into the box [1, 2] x [-1, 1] x [-1, 1]; t in [0, inf]
+    let one = 0x3c00u64;
+    let row = vec![0, 0, 0, one, 0, 0, 0, 0x7c00, one, 0xbc00, 0xbc00, 0x4000, one, one];
+    let ex = vectors::gen::Explicit {
+        class: "smt".into(),
+        covers: "a given row".into(),
+        origin: "test".into(),
+        rows: vec![row.clone(), row],
+    };
+    let set = generate(&Request { explicit: Some(ex.clone()), ..req(Unit::Slab, "fp16", 1) }).unwrap();
+    assert_eq!(set.manifest.origin.as_deref(), Some("test"));
+    assert_eq!(set.manifest.classes.len(), 1);
+    assert_eq!((set.manifest.classes[0].name.as_str(), set.manifest.classes[0].count), ("smt", 2));
+    let expected = &set.files.iter().find(|(n, _)| n == "slab_expected.hex").unwrap().1;
+    // hit = 1, t_near = 1.0 and t_far = 2.0 widened by the conservative variant's 4 steps:
+    // 0x3c00 - 4 and 0x4000 + 4
+    assert_eq!(expected.lines().next().unwrap(), "13bfc4004");
+    let dir = tmp("given");
+    write_set(&set, &dir).unwrap();
+    assert_eq!(check_set(&dir).unwrap(), 2);
+    // the expected hit bit cleared, the hash made to match: the model comparison catches it
+    let path = dir.join("slab_expected.hex");
+    let text = std::fs::read_to_string(&path).unwrap().replacen("13bfc4004", "03bfc4004", 1);
+    std::fs::write(&path, &text).unwrap();
+    let mut m: vectors::manifest::Manifest =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    m.files[1].sha256 = vectors::write::sha256_hex(text.as_bytes());
+    std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&m).unwrap()).unwrap();
+    assert!(check_set(&dir).is_err());
+    assert!(generate(&Request { explicit: Some(ex), ..req(Unit::Rti, "fp16", 1) }).unwrap_err().contains("slab"));
 }

@@ -96,6 +96,21 @@ pub struct Request {
     pub leaves: usize,
     /// Level pipelines the hardware has (unit traverse).
     pub max_levels: usize,
+    /// Input rows given instead of drawn from the seed (unit slab): a proof's counterexamples.
+    pub explicit: Option<Explicit>,
+}
+
+/// A set's input rows given by their writer (e.g. `raypipe prove --out`), one class.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Explicit {
+    /// The class name (e.g. `smt`).
+    pub class: String,
+    /// What the class covers, in words.
+    pub covers: String,
+    /// What wrote the rows (the manifest's `origin`).
+    pub origin: String,
+    /// Input rows: the unit's input encodings in its input order (slab: `SLAB_INPUTS`).
+    pub rows: Vec<Vec<u64>>,
 }
 
 /// A generated set: the manifest (hashes filled on writing) and the file contents.
@@ -175,6 +190,9 @@ pub fn generate(req: &Request) -> Result<VectorSet, String> {
 }
 
 pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, String> {
+    if req.explicit.is_some() && req.unit != Unit::Slab {
+        return Err("given input rows are supported for the slab unit only".into());
+    }
     let w = f.width();
     let k = kind_of(&f);
     let mut r = SplitMix64::new(req.seed);
@@ -390,7 +408,10 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
                 u64::try_from(sc.widen_ulps).map_err(|_| "vectors support only non-negative widening")?,
             );
             let crosses = slab_crosses(req.level);
-            classes = crosses.iter().map(|c| c.describe()).collect();
+            classes = match &req.explicit {
+                Some(ex) => vec![(ex.class.clone(), ex.covers.clone())],
+                None => crosses.iter().map(|c| c.describe()).collect(),
+            };
             latency = 7;
             stages = SLAB_TABLE
                 .iter()
@@ -434,52 +455,65 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
                 lines: vec![],
             });
             let float = is_float(&f);
-            let per_class = pool.install(|| {
-                per_class_rows(req.seed, crosses.len(), req.count, |c, r| {
-                    let cross = crosses[c];
-                    if cross.special && !float {
-                        return Ok(None);
+            if let Some(ex) = &req.explicit {
+                let mut rows = Vec::new();
+                for bits in &ex.rows {
+                    if bits.len() != names.len() {
+                        return Err(format!("a slab input row has {} fields, not {}", bits.len(), names.len()));
                     }
-                    let case_bits = |r: &mut SplitMix64| -> Result<Vec<u64>, String> {
-                        let x = slab_case(cross, r, datapath::format::edges(&f));
-                        let b =
-                            slab.store_box([x[8], x[9], x[10]], [x[11], x[12], x[13]]).map_err(|e| e.to_string())?;
-                        let mut bits: Vec<u64> = x[..8].iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
-                        bits.extend(b.min.iter().chain(b.max.iter()).map(|&v| f.to_bits(v)));
-                        any_nans(&f, r, &x[..8], &mut bits);
-                        // an origin placed on a face plane stays on it once the box is stored
-                        // (outward-rounded)
-                        for a in 0..3 {
-                            if x[a] == x[8 + a] {
-                                bits[a] = bits[8 + a];
-                            } else if x[a] == x[11 + a] {
-                                bits[a] = bits[11 + a];
-                            }
+                    let bits: Vec<u64> = bits.iter().map(|&b| f.to_bits(f.from_bits(b))).collect();
+                    rows.push(slab_rows(&slab, 0, &bits).to_vec());
+                }
+                counts = push_rows(&mut files, vec![rows]);
+            } else {
+                let per_class = pool.install(|| {
+                    per_class_rows(req.seed, crosses.len(), req.count, |c, r| {
+                        let cross = crosses[c];
+                        if cross.special && !float {
+                            return Ok(None);
                         }
-                        Ok(bits)
-                    };
-                    let mut bits = case_bits(r)?;
-                    match cross.ray {
-                        // t_at_limits: placements until the model finds a hit with number limits
-                        // (at most 16)
-                        8 => {
-                            for _ in 0..16 {
-                                if let Some(b) = slab_at_limits(&slab, &bits, r) {
-                                    bits = b;
-                                    break;
+                        let case_bits = |r: &mut SplitMix64| -> Result<Vec<u64>, String> {
+                            let x = slab_case(cross, r, datapath::format::edges(&f));
+                            let b = slab
+                                .store_box([x[8], x[9], x[10]], [x[11], x[12], x[13]])
+                                .map_err(|e| e.to_string())?;
+                            let mut bits: Vec<u64> = x[..8].iter().map(|&v| f.to_bits(f.from_f64(v))).collect();
+                            bits.extend(b.min.iter().chain(b.max.iter()).map(|&v| f.to_bits(v)));
+                            any_nans(&f, r, &x[..8], &mut bits);
+                            // an origin placed on a face plane stays on it once the box is stored
+                            // (outward-rounded)
+                            for a in 0..3 {
+                                if x[a] == x[8 + a] {
+                                    bits[a] = bits[8 + a];
+                                } else if x[a] == x[11 + a] {
+                                    bits[a] = bits[11 + a];
                                 }
-                                bits = case_bits(r)?;
                             }
+                            Ok(bits)
+                        };
+                        let mut bits = case_bits(r)?;
+                        match cross.ray {
+                            // t_at_limits: placements until the model finds a hit with number limits
+                            // (at most 16)
+                            8 => {
+                                for _ in 0..16 {
+                                    if let Some(b) = slab_at_limits(&slab, &bits, r) {
+                                        bits = b;
+                                        break;
+                                    }
+                                    bits = case_bits(r)?;
+                                }
+                            }
+                            9 | 10 if !float => return Ok(None),
+                            9 => slab_ties(&f, r, &mut bits),
+                            10 => slab_subnormal_gap(&f, r, &mut bits),
+                            _ => {}
                         }
-                        9 | 10 if !float => return Ok(None),
-                        9 => slab_ties(&f, r, &mut bits),
-                        10 => slab_subnormal_gap(&f, r, &mut bits),
-                        _ => {}
-                    }
-                    Ok(Some(slab_rows(&slab, c as u64, &bits).to_vec()))
-                })
-            })?;
-            counts = push_rows(&mut files, per_class);
+                        Ok(Some(slab_rows(&slab, c as u64, &bits).to_vec()))
+                    })
+                })?;
+                counts = push_rows(&mut files, per_class);
+            }
         }
         Unit::Capture => {
             let rti = Rti::new(f, RtiConfig { tie: req.rti.tie, ..RtiConfig::default() });
@@ -635,6 +669,7 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
             .map(|(i, (n, c))| Class { id: i as u32, name: n.clone(), covers: c.clone(), count: counts[i] })
             .collect(),
         minimal: None,
+        origin: req.explicit.as_ref().map(|e| e.origin.clone()),
     };
     Ok(VectorSet { manifest, files: files.into_iter().map(|fr| (fr.name, fr.lines.join("\n") + "\n")).collect() })
 }
