@@ -6,6 +6,7 @@ pub mod arch;
 pub mod args;
 pub mod common;
 pub mod completions;
+pub mod equiv;
 pub mod explain;
 pub mod faults;
 pub mod man;
@@ -83,6 +84,8 @@ pub enum Cmd {
     Smt(smt::Args),
     /// Prove a guarantee with an SMT solver: PROVEN (0), a counterexample (1) or unknown (3).
     Prove(prove::Args),
+    /// Prove a Verilog DUT's outputs equal to the model's signals (yosys + SMT): PROVEN (0), a counterexample (1) or unknown (3).
+    Equiv(equiv::Args),
 }
 
 /// Runs a command (none: the main job, `raypipe verify` with every default).
@@ -108,5 +111,6 @@ pub fn dispatch(cmd: Option<Cmd>) -> Result<Outcome, String> {
         Some(Cmd::Stages(a)) => stages::run(a),
         Some(Cmd::Smt(a)) => smt::run(a),
         Some(Cmd::Prove(a)) => prove::run(a),
+        Some(Cmd::Equiv(a)) => equiv::run(a),
     }
 }
