@@ -58,3 +58,25 @@ fn history_requests_that_do_not_apply_exit_2() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn the_directed_slab_never_misses_in_small_formats_without_a_solver() {
+    // the directed variant's lemma is enumerated (no SMT): e5m6 (12-bit float), q4.4 (fixed point)
+    for f in ["e5m6", "q4.4"] {
+        let o = raypipe(&["prove", "slab-never-misses", "--variant", "directed", "--format", f, "--json"]);
+        assert_eq!(o.status.code(), Some(0), "{f}: {}", String::from_utf8_lossy(&o.stderr));
+        let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(j["status"], "PROVEN");
+        assert_eq!(j["solver"], "enumeration");
+        assert!(j["steps"][0]["query"].as_str().unwrap().contains("pairs enumerated"));
+    }
+    // what the directed variant does not take
+    for args in [
+        &["prove", "slab-never-misses", "--variant", "directed", "--no-guard"][..],
+        &["prove", "slab-never-misses", "--variant", "directed", "--format", "f32"],
+        &["prove", "slab-never-misses", "--variant", "directed", "--format", "fp16:ftz"],
+    ] {
+        let o = raypipe(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    }
+}

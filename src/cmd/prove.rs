@@ -10,10 +10,11 @@ use datapath::Format;
 pub struct Args {
     /// Property: slab-never-misses, history-equals-stack.
     pub property: String,
-    /// Format of slab-never-misses (IEEE-like floats: fp16, e5mM, e4mM, ...; default fp16).
+    /// Format of slab-never-misses (default fp16): floats of at most 16 bits (fp16, bf16, eEmM);
+    /// with --variant directed also saturating fixed point of at most 16 bits (q8.8, ...).
     #[arg(long)]
     pub format: Option<String>,
-    /// Slab variant of slab-never-misses (default conservative).
+    /// Slab variant of slab-never-misses: conservative (default) or directed.
     #[arg(long)]
     pub variant: Option<String>,
     /// history-equals-stack: every tree of 1 to this many levels.

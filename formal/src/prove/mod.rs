@@ -5,6 +5,7 @@
 
 pub mod history;
 pub mod slab;
+pub mod slab_directed;
 pub mod slab_planes;
 
 use crate::solver::Verdict;
