@@ -6,6 +6,7 @@ pub mod arch;
 pub mod args;
 pub mod common;
 pub mod completions;
+pub mod cover;
 pub mod equiv;
 pub mod explain;
 pub mod faults;
@@ -86,6 +87,8 @@ pub enum Cmd {
     Prove(prove::Args),
     /// Prove a Verilog DUT's outputs equal to the model's signals (yosys + SMT): PROVEN (0), a counterexample (1) or unknown (3).
     Equiv(equiv::Args),
+    /// The functional coverage of vector sets: every signal's bins, merged over the sets, holes listed.
+    Cover(cover::Args),
 }
 
 /// Runs a command (none: the main job, `raypipe verify` with every default).
@@ -112,5 +115,6 @@ pub fn dispatch(cmd: Option<Cmd>) -> Result<Outcome, String> {
         Some(Cmd::Smt(a)) => smt::run(a),
         Some(Cmd::Prove(a)) => prove::run(a),
         Some(Cmd::Equiv(a)) => equiv::run(a),
+        Some(Cmd::Cover(a)) => cover::run(a),
     }
 }

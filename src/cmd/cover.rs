@@ -1,0 +1,112 @@
+//! `raypipe cover`: the functional coverage of vector sets — every input, expected output and
+//! stage signal's bins (value classes, flags, classes), merged over the sets given, with the
+//! holes listed (docs/coverage.md).
+
+use super::prelude::*;
+
+/// The options of `raypipe cover`.
+#[derive(clap::Args, Clone)]
+pub struct Args {
+    /// Vector set directories (one unit, format and options; their counts are added).
+    #[arg(required = true)]
+    pub sets: Vec<PathBuf>,
+    /// Fail (exit 1) when fewer than this percentage of the bins are hit.
+    #[arg(long)]
+    pub fail_under: Option<f64>,
+    /// List at most this many empty bins (0: all).
+    #[arg(long, default_value_t = 20)]
+    pub holes: usize,
+    /// Print the coverage as JSON (every coverpoint and bin count).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `raypipe cover`.
+pub fn run(a: Args) -> Result<Outcome, String> {
+    if let Some(p) = a.fail_under {
+        if !(0.0..=100.0).contains(&p) {
+            return Err(format!("--fail-under must be a percentage in 0..=100, got {p}"));
+        }
+    }
+    let mut total: Option<vectors::cover::Coverage> = None;
+    for dir in &a.sets {
+        let path = dir.join("manifest.json");
+        let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let m: vectors::manifest::Manifest =
+            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        let contents = vectors::read::read_files(dir, &m).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let c = vectors::cover::Coverage::measure(&m, &contents).map_err(|e| format!("{}: {e}", dir.display()))?;
+        match &mut total {
+            None => total = Some(c),
+            Some(t) => t.merge(&c).map_err(|e| format!("{}: {e}", dir.display()))?,
+        }
+    }
+    let c = total.expect("at least one set");
+    let (hit, bins) = c.totals();
+    let pct = if bins == 0 { 0.0 } else { 100.0 * hit as f64 / bins as f64 };
+    let holes: Vec<String> = c
+        .coverpoints
+        .iter()
+        .flat_map(|p| {
+            p.bins.iter().filter(|b| b.count == 0 && b.unreachable.is_none()).map(move |b| {
+                let stage = p.stage.map_or(String::new(), |s| format!(" (stage {s})"));
+                format!("{} {}{stage}: {}", p.role, p.signal, b.name)
+            })
+        })
+        .collect();
+    let contradictions = c.contradictions();
+    if !contradictions.is_empty() {
+        return Err(format!(
+            "a bin marked unreachable was hit (the coverage model is wrong): {}",
+            contradictions.join("; ")
+        ));
+    }
+    let unreachable = c.coverpoints.iter().flat_map(|p| &p.bins).filter(|b| b.unreachable.is_some()).count();
+    let j = serde_json::json!({
+        "command": command_as_typed(),
+        "sets": a.sets.iter().map(|d| d.display().to_string()).collect::<Vec<_>>(),
+        "unit": c.unit,
+        "format": c.format,
+        "vectors": c.vectors,
+        "bins_hit": hit,
+        "bins": bins,
+        "bins_unreachable": unreachable,
+        "percent": pct,
+        "holes": holes,
+        "coverpoints": c.coverpoints,
+    });
+    emit(a.json, &j, |_| {
+        let mut s = format!(
+            "coverage of {} set(s), unit {}, format {}: {} vectors; {hit} of {bins} reachable bins hit ({pct:.1} %); {unreachable} bins unreachable (reasons in --json)\n",
+            a.sets.len(),
+            c.unit,
+            c.format,
+            c.vectors
+        );
+        let mut last = String::new();
+        for p in &c.coverpoints {
+            if p.role != last {
+                s += &format!("  {}:\n", p.role);
+                last = p.role.clone();
+            }
+            let h = p.bins.iter().filter(|b| b.count > 0).count();
+            let stage = p.stage.map_or(String::new(), |x| format!(" [{x}]"));
+            s += &format!("    {}{stage} ({}): {h}/{}\n", p.signal, p.kind, p.bins.len());
+        }
+        let shown = if a.holes == 0 { holes.len() } else { a.holes.min(holes.len()) };
+        if !holes.is_empty() {
+            s += &format!("empty bins ({} of {} shown):\n", shown, holes.len());
+            for h in &holes[..shown] {
+                s += &format!("  {h}\n");
+            }
+        }
+        s
+    })?;
+    Ok(match a.fail_under {
+        Some(p) if pct < p => {
+            eprintln!("coverage {pct:.1} % is under --fail-under {p}");
+            Outcome::Fail
+        }
+        _ => Outcome::Pass,
+    })
+}

@@ -1,0 +1,72 @@
+//! `raypipe cover` from the command line: the report and its JSON, merging sets, --fail-under,
+//! and bad input (exit 2).
+
+mod common;
+use common::raypipe;
+
+fn set(dir: &std::path::Path, args: &[&str]) {
+    let mut a = vec!["vectors"];
+    a.extend_from_slice(args);
+    let out = dir.display().to_string();
+    a.extend(["--out", &out]);
+    let o = raypipe(&a);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn cover_reports_merges_and_gates() {
+    let tmp = std::env::temp_dir().join(format!("raypipe-cover-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).unwrap();
+    let (a, b, f32set) = (tmp.join("a"), tmp.join("b"), tmp.join("f32"));
+    set(&a, &["--unit", "op", "--format", "fp16", "--count", "2", "--seed", "1"]);
+    set(&b, &["--unit", "op", "--format", "fp16", "--count", "2", "--seed", "2"]);
+    set(&f32set, &["--unit", "op", "--format", "f32", "--count", "2"]);
+    let json = |args: &[&str]| -> serde_json::Value {
+        let mut v = vec!["cover", "--json"];
+        v.extend_from_slice(args);
+        let o = raypipe(&v);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let (sa, sb) = (a.display().to_string(), b.display().to_string());
+    let ja = json(&[&sa]);
+    let jb = json(&[&sb]);
+    let jab = json(&[&sa, &sb]);
+    // merged counts are the sums, bin by bin
+    assert_eq!(jab["vectors"].as_u64().unwrap(), ja["vectors"].as_u64().unwrap() + jb["vectors"].as_u64().unwrap());
+    let bins = |j: &serde_json::Value| -> Vec<u64> {
+        j["coverpoints"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|p| p["bins"].as_array().unwrap().iter().map(|b| b["count"].as_u64().unwrap()))
+            .collect()
+    };
+    let sum: Vec<u64> = bins(&ja).iter().zip(bins(&jb)).map(|(x, y)| x + y).collect();
+    assert_eq!(bins(&jab), sum);
+    // the op unit's default set reaches every reachable bin; result's "other NaN" is unreachable
+    assert_eq!(ja["bins_hit"], ja["bins"]);
+    assert!(ja["bins_unreachable"].as_u64().unwrap() >= 1);
+    assert!(raypipe(&["cover", &sa, "--fail-under", "100"]).status.success());
+    // an rti set does not reach everything: --fail-under 100 fails it (exit 1)
+    let r = tmp.join("rti");
+    set(&r, &["--unit", "rti", "--format", "fp16", "--count", "1"]);
+    let o = raypipe(&["cover", &r.display().to_string(), "--fail-under", "100"]);
+    assert_eq!(o.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("empty bins") && text.contains("reachable bins hit"), "{text}");
+    // bad input: other formats together, a percentage out of range, no set
+    for args in [
+        vec!["cover".to_string(), sa.clone(), f32set.display().to_string()],
+        vec!["cover".to_string(), sa.clone(), "--fail-under".to_string(), "101".to_string()],
+        vec!["cover".to_string(), tmp.join("none").display().to_string()],
+    ] {
+        let v: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = raypipe(&v);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(!err.contains("panicked"));
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}

@@ -1,0 +1,318 @@
+//! Functional coverage of vector sets: a coverage model read from a set's manifest (every
+//! field of the inputs, the expected outputs and the stage signals is a coverpoint, with bins
+//! by the field's kind) and the counts a set's rows put into its bins. Counts merge exactly
+//! (integer sums), so the coverage of shards merged is the coverage of one pass.
+//!
+//! Bins (first version: the value classes of issue #37's item 1; rounding events, per-unit
+//! events and crosses are not modelled yet):
+//! - an IEEE-like float field: `+0`, `-0`, `+subnormal`, `-subnormal`, `+min normal`,
+//!   `-min normal`, `+normal`, `-normal`, `+max finite`, `-max finite`, `+inf`, `-inf`,
+//!   `canonical NaN` (the contract's: exponent all ones, only the top fraction bit set, either
+//!   sign) and `other NaN` (any other payload, quiet or signaling); a normal bin excludes the
+//!   smallest and the largest normal, which have their own bins;
+//! - a fixed-point field: `0`, `+1 step`, `-1 step`, `+max` (saturated high), `min`
+//!   (saturated low), `positive`, `negative` (the others of each sign);
+//! - a flag: `0`, `1`;
+//! - the class column: one bin per class of the manifest.
+//!
+//! Unreachable bins, with the reason, left out of the totals: in a format with the canonical
+//! NaN rule, `other NaN` of every output and stage signal; under flush-to-zero, the subnormal
+//! bins of every output and stage signal. (Inputs can hold anything.)
+//!
+//! A field the manifest marks `care_when F` is counted only in rows whose expected `F` is 1 (the
+//! rows where its value is defined).
+
+use crate::manifest::{Field, Kind, Manifest};
+use serde::Serialize;
+
+/// One bin and its count.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Bin {
+    /// Bin name.
+    pub name: String,
+    /// Hits.
+    pub count: u64,
+    /// Why no vector can reach it (it is then left out of the totals), if it cannot.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unreachable: Option<&'static str>,
+}
+
+/// Why a canonical-NaN format's signals never hold another NaN.
+pub const WHY_CANONICAL: &str =
+    "the contract's NaN rule: every NaN result and every NaN input read is the canonical NaN (contract.nan)";
+/// Why a flush-to-zero format's signals never hold a subnormal.
+pub const WHY_FTZ: &str =
+    "flush-to-zero: every subnormal result and every subnormal input read is a zero of its sign (contract.subnormals)";
+
+/// One coverpoint: a field of a set file and its bins.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Coverpoint {
+    /// Field (signal) name.
+    pub signal: String,
+    /// The file it belongs to (`inputs`, `expected outputs`, `stage signals`).
+    pub role: String,
+    /// Pipeline stage (outputs and stage signals).
+    pub stage: Option<u8>,
+    /// What the bins are: `value class`, `flag`, `class`.
+    pub kind: String,
+    /// Bins in their fixed order.
+    pub bins: Vec<Bin>,
+}
+
+/// The coverage of one or more sets of one unit, format and options.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Coverage {
+    /// Unit.
+    pub unit: String,
+    /// Format.
+    pub format: String,
+    /// Vectors counted.
+    pub vectors: u64,
+    /// Coverpoints in file and field order.
+    pub coverpoints: Vec<Coverpoint>,
+}
+
+/// The bins of a float field (see the module documentation).
+pub const FLOAT_BINS: [&str; 14] = [
+    "+0",
+    "-0",
+    "+subnormal",
+    "-subnormal",
+    "+min normal",
+    "-min normal",
+    "+normal",
+    "-normal",
+    "+max finite",
+    "-max finite",
+    "+inf",
+    "-inf",
+    "canonical NaN",
+    "other NaN",
+];
+
+/// The bins of a fixed-point field.
+pub const FIXED_BINS: [&str; 7] = ["0", "+1 step", "-1 step", "+max", "min", "positive", "negative"];
+
+/// The float bin of encoding `v` with `exp` exponent and `man` fraction bits.
+pub fn float_bin(v: u64, exp: u32, man: u32) -> usize {
+    let neg = (v >> (exp + man)) & 1 == 1;
+    let e = (v >> man) & ((1 << exp) - 1);
+    let m = v & ((1 << man) - 1);
+    let top = (1 << exp) - 1;
+    let s = usize::from(neg);
+    if e == top {
+        if m == 0 {
+            return 10 + s;
+        }
+        return if m == 1 << (man - 1) { 12 } else { 13 };
+    }
+    if e == 0 {
+        return if m == 0 { s } else { 2 + s };
+    }
+    if e == 1 && m == 0 {
+        return 4 + s;
+    }
+    if e == top - 1 && m == (1 << man) - 1 {
+        return 8 + s;
+    }
+    6 + s
+}
+
+/// The fixed-point bin of a `width`-bit two's-complement encoding `v`.
+pub fn fixed_bin(v: u64, width: u32) -> usize {
+    let mask = if width == 64 { u64::MAX } else { (1 << width) - 1 };
+    let v = v & mask;
+    let max = mask >> 1;
+    let min = max + 1;
+    match v {
+        0 => 0,
+        1 => 1,
+        x if x == mask => 2,
+        x if x == max => 3,
+        x if x == min => 4,
+        x if x < min => 5,
+        _ => 6,
+    }
+}
+
+impl Coverage {
+    /// The empty coverage model of a set with manifest `m`.
+    pub fn model(m: &Manifest) -> Self {
+        let mut coverpoints = Vec::new();
+        for (i, f) in m.files.iter().enumerate() {
+            if !per_vector(m, i) {
+                continue;
+            }
+            for x in &f.fields {
+                let (kind, bins): (&str, Vec<String>) = match &x.kind {
+                    Kind::Ieee { .. } => ("value class", FLOAT_BINS.iter().map(|s| s.to_string()).collect()),
+                    Kind::Fixed { .. } => ("value class", FIXED_BINS.iter().map(|s| s.to_string()).collect()),
+                    Kind::Flag => ("flag", vec!["0".into(), "1".into()]),
+                    Kind::Uint if x.name == "class" => ("class", m.classes.iter().map(|c| c.name.clone()).collect()),
+                    Kind::Uint => continue,
+                };
+                let out = x.dir == "out" && matches!(x.kind, Kind::Ieee { .. });
+                let canonical = !m.format.contains("propagate");
+                let ftz = m.format.contains("ftz");
+                let why = |name: &str| -> Option<&'static str> {
+                    match name {
+                        "other NaN" if out && canonical => Some(WHY_CANONICAL),
+                        "+subnormal" | "-subnormal" if out && ftz => Some(WHY_FTZ),
+                        _ => None,
+                    }
+                };
+                coverpoints.push(Coverpoint {
+                    signal: x.name.clone(),
+                    role: role_name(&f.role).into(),
+                    stage: x.stage,
+                    kind: kind.into(),
+                    bins: bins.into_iter().map(|name| Bin { unreachable: why(&name), name, count: 0 }).collect(),
+                });
+            }
+        }
+        Coverage { unit: m.unit.clone(), format: m.format.clone(), vectors: 0, coverpoints }
+    }
+
+    /// The coverage of a set's rows (`contents`: every file's rows, unpacked, as
+    /// [`crate::read::read_files`] gives them).
+    pub fn measure(m: &Manifest, contents: &[Vec<Vec<u64>>]) -> Result<Self, String> {
+        let mut c = Self::model(m);
+        let rows = contents.first().map_or(0, |r| r.len());
+        c.add_rows(m, contents, 0..rows)?;
+        Ok(c)
+    }
+
+    /// Counts the rows `range` of a set into the bins.
+    pub fn add_rows(
+        &mut self,
+        m: &Manifest,
+        contents: &[Vec<Vec<u64>>],
+        range: std::ops::Range<usize>,
+    ) -> Result<(), String> {
+        // the expected-output row's flag named by a care_when
+        let out_flag = |row: usize, name: &str| -> Option<bool> {
+            let f = m.files.get(1)?;
+            let k = f.fields.iter().position(|x| x.name == name)?;
+            Some(contents.get(1)?.get(row)?.get(k)? & 1 == 1)
+        };
+        for row in range {
+            let mut cp = 0;
+            for (i, f) in m.files.iter().enumerate() {
+                if !per_vector(m, i) {
+                    continue;
+                }
+                let vals = contents.get(i).and_then(|c| c.get(row)).ok_or(format!("{}: no row {}", f.name, row + 1))?;
+                for (k, x) in f.fields.iter().enumerate() {
+                    let Some(bin) = bin_of(x, vals[k], m) else { continue };
+                    let p = &mut self.coverpoints[cp];
+                    cp += 1;
+                    if let Some(flag) = &x.care_when {
+                        if out_flag(row, flag) == Some(false) {
+                            continue;
+                        }
+                    }
+                    if let Some(b) = p.bins.get_mut(bin) {
+                        b.count += 1;
+                    }
+                }
+            }
+            self.vectors += 1;
+        }
+        Ok(())
+    }
+
+    /// Adds `other`'s counts (the same unit, format and coverage model).
+    pub fn merge(&mut self, other: &Coverage) -> Result<(), String> {
+        if other.unit != self.unit || other.format != self.format {
+            return Err(format!(
+                "cannot merge coverage of {} {} into {} {}",
+                other.unit, other.format, self.unit, self.format
+            ));
+        }
+        let shape = |c: &Coverage| -> Vec<(String, String, Vec<String>)> {
+            c.coverpoints
+                .iter()
+                .map(|p| (p.role.clone(), p.signal.clone(), p.bins.iter().map(|b| b.name.clone()).collect()))
+                .collect()
+        };
+        if shape(self) != shape(other) {
+            return Err("cannot merge: the sets have different coverage models (options or classes differ)".into());
+        }
+        for (p, q) in self.coverpoints.iter_mut().zip(&other.coverpoints) {
+            for (b, c) in p.bins.iter_mut().zip(&q.bins) {
+                b.count += c.count;
+            }
+        }
+        self.vectors += other.vectors;
+        Ok(())
+    }
+
+    /// (reachable bins hit, reachable bins).
+    pub fn totals(&self) -> (u64, u64) {
+        let bins = self.coverpoints.iter().flat_map(|p| &p.bins).filter(|b| b.unreachable.is_none());
+        (bins.clone().filter(|b| b.count > 0).count() as u64, bins.count() as u64)
+    }
+
+    /// Bins marked unreachable that a vector hit: a contradiction (empty when the model is right).
+    pub fn contradictions(&self) -> Vec<String> {
+        self.coverpoints
+            .iter()
+            .flat_map(|p| {
+                p.bins
+                    .iter()
+                    .filter(|b| b.unreachable.is_some() && b.count > 0)
+                    .map(move |b| format!("{} {}: {}", p.role, p.signal, b.name))
+            })
+            .collect()
+    }
+}
+
+/// Whether file `i` of the manifest holds one row per vector.
+fn per_vector(m: &Manifest, i: usize) -> bool {
+    i < 2 || m.files[i].role == crate::hdl::STAGE_ROLE
+}
+
+/// A short name for a file's role.
+fn role_name(role: &str) -> &'static str {
+    if role.starts_with("inputs") {
+        "inputs"
+    } else if role == crate::hdl::STAGE_ROLE {
+        "stage signals"
+    } else {
+        "expected outputs"
+    }
+}
+
+/// The bin of value `v` of field `x` (None: a field without coverpoint).
+fn bin_of(x: &Field, v: u64, m: &Manifest) -> Option<usize> {
+    match &x.kind {
+        Kind::Ieee { exp, man } => Some(float_bin(v, *exp, *man)),
+        Kind::Fixed { .. } => Some(fixed_bin(v, x.width)),
+        Kind::Flag => Some((v & 1) as usize),
+        Kind::Uint if x.name == "class" => Some((v as usize).min(m.classes.len())),
+        Kind::Uint => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fp16_and_fixed_bins_by_hand() {
+        let b = |v| FLOAT_BINS[float_bin(v, 5, 10)];
+        assert_eq!(
+            [b(0x0000), b(0x8000), b(0x0001), b(0x83ff), b(0x0400), b(0x8400), b(0x3c00), b(0xbc00)],
+            ["+0", "-0", "+subnormal", "-subnormal", "+min normal", "-min normal", "+normal", "-normal"]
+        );
+        assert_eq!(
+            [b(0x7bff), b(0xfbff), b(0x7c00), b(0xfc00), b(0x7e00), b(0xfe00), b(0x7c01), b(0x7e01)],
+            ["+max finite", "-max finite", "+inf", "-inf", "canonical NaN", "canonical NaN", "other NaN", "other NaN"]
+        );
+        let q = |v| FIXED_BINS[fixed_bin(v, 16)];
+        assert_eq!(
+            [q(0), q(1), q(0xffff), q(0x7fff), q(0x8000), q(0x0100), q(0xff00)],
+            ["0", "+1 step", "-1 step", "+max", "min", "positive", "negative"]
+        );
+    }
+}
