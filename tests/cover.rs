@@ -68,5 +68,18 @@ fn cover_reports_merges_and_gates() {
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
         assert!(!err.contains("panicked"));
     }
+    // --ucis: written, replaced when raypipe wrote it, never over a stranger's file
+    let x = tmp.join("cov.xml");
+    let xs = x.display().to_string();
+    for _ in 0..2 {
+        assert!(raypipe(&["cover", &sa, "--ucis", &xs]).status.success());
+    }
+    let text = std::fs::read_to_string(&x).unwrap();
+    assert!(text.starts_with("<?xml") && text.contains("writtenBy=\"raypipe ") && text.contains("<coverpointBin"));
+    let mine = tmp.join("mine.xml");
+    std::fs::write(&mine, "mine").unwrap();
+    let o = raypipe(&["cover", &sa, "--ucis", &mine.display().to_string()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "mine");
     let _ = std::fs::remove_dir_all(&tmp);
 }

@@ -16,6 +16,9 @@ pub struct Args {
     /// List at most this many empty bins (0: all).
     #[arg(long, default_value_t = 20)]
     pub holes: usize,
+    /// Also write the coverage as UCIS 1.0 XML to FILE (read by pyucis and coverage tools).
+    #[arg(long)]
+    pub ucis: Option<PathBuf>,
     /// Print the coverage as JSON (every coverpoint and bin count).
     #[arg(long)]
     pub json: bool,
@@ -27,6 +30,10 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         if !(0.0..=100.0).contains(&p) {
             return Err(format!("--fail-under must be a percentage in 0..=100, got {p}"));
         }
+    }
+    if let Some(u) = &a.ucis {
+        // before the work: a file raypipe did not write is never replaced
+        check_ucis_path(u)?;
     }
     let mut total: Option<vectors::cover::Coverage> = None;
     for dir in &a.sets {
@@ -60,6 +67,10 @@ pub fn run(a: Args) -> Result<Outcome, String> {
             "a bin marked unreachable was hit (the coverage model is wrong): {}",
             contradictions.join("; ")
         ));
+    }
+    if let Some(u) = &a.ucis {
+        let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+        vectors::outdir::atomic_write(u, c.ucis_xml(&vectors::cover::utc(now), &command_as_typed()).as_bytes())?;
     }
     let unreachable = c.coverpoints.iter().flat_map(|p| &p.bins).filter(|b| b.unreachable.is_some()).count();
     let j = serde_json::json!({
@@ -109,4 +120,24 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         }
         _ => Outcome::Pass,
     })
+}
+
+/// Refuses a `--ucis` path raypipe may not write, before any work: a directory, a missing
+/// parent directory, or an existing file raypipe did not write.
+fn check_ucis_path(path: &std::path::Path) -> Result<(), String> {
+    let shown = path.display();
+    if path.is_dir() {
+        return Err(format!("--ucis {shown} is a directory"));
+    }
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    if !parent.is_dir() {
+        return Err(format!("--ucis {shown}: no directory {}", parent.display()));
+    }
+    if path.exists() {
+        let text = std::fs::read_to_string(path).unwrap_or_default();
+        if !text.lines().take(2).any(|l| l.contains("writtenBy=\"raypipe ")) {
+            return Err(format!("--ucis {shown} exists and raypipe did not write it: not replacing it"));
+        }
+    }
+    Ok(())
 }

@@ -267,6 +267,83 @@ impl Coverage {
     }
 }
 
+/// XML text escaping for attribute values.
+fn xml(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// A UTC date and time (`YYYY-MM-DDThh:mm:ss`) from seconds since 1970.
+pub fn utc(secs: u64) -> String {
+    let (days, rem) = (secs / 86_400, secs % 86_400);
+    // civil from days (H. Hinnant's algorithm)
+    let z = days as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}", rem / 3600, rem / 60 % 60, rem % 60)
+}
+
+impl Coverage {
+    /// The coverage as UCIS 1.0 XML (the Accellera interchange format that pyucis and the
+    /// simulators' coverage tools read): one instance `raypipe_<unit>`, one covergroup per file
+    /// role (`inputs`, `expected_outputs`, `stage_signals`), one coverpoint per signal, one bin
+    /// per bin (`type="ignore"`: unreachable). `written` is the writing time (UTC), `command` the
+    /// command that measured it (the history node's `cmd`).
+    pub fn ucis_xml(&self, written: &str, command: &str) -> String {
+        let mut s = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+        s += &format!(
+            "<UCIS xmlns:ucis=\"http://www.w3.org/2001/XMLSchema-instance\" writtenBy=\"raypipe {}\" writtenTime=\"{written}\" ucisVersion=\"1.0\">\n",
+            env!("CARGO_PKG_VERSION")
+        );
+        s += "  <sourceFiles fileName=\"manifest.json\" id=\"1\"/>\n";
+        s += &format!(
+            "  <historyNodes historyNodeId=\"0\" logicalName=\"raypipe cover\" physicalName=\"raypipe-cover.xml\" kind=\"1\" testStatus=\"true\" simtime=\"0.0\" timeunit=\"ns\" runCwd=\".\" cpuTime=\"0.0\" seed=\"0\" cmd=\"{}\" args=\"\" compulsory=\"0\" date=\"{written}\" userName=\"raypipe\" cost=\"0.0\" toolCategory=\"UCIS:simulator\" ucisVersion=\"1.0\" vendorId=\"raypipe\" vendorTool=\"raypipe\" vendorToolVersion=\"{}\"/>\n",
+            xml(command),
+            env!("CARGO_PKG_VERSION")
+        );
+        let unit = xml(&self.unit);
+        s += &format!(
+            "  <instanceCoverages name=\"raypipe_{unit}\" key=\"0\" instanceId=\"0\" moduleName=\"raypipe_{unit}_{}\">\n    <id file=\"1\" line=\"1\" inlineCount=\"1\"/>\n    <covergroupCoverage>\n",
+            xml(&self.format.replace([':', '+', '.'], "_"))
+        );
+        let mut roles: Vec<&str> = Vec::new();
+        for p in &self.coverpoints {
+            if !roles.contains(&p.role.as_str()) {
+                roles.push(&p.role);
+            }
+        }
+        for role in roles {
+            let cg = role.replace(' ', "_");
+            s += &format!(
+                "      <cgInstance name=\"{cg}\" key=\"0\">\n        <options weight=\"1\" goal=\"100\" at_least=\"1\" per_instance=\"true\" merge_instances=\"true\"/>\n        <cgId cgName=\"{cg}\" moduleName=\"raypipe_{unit}\">\n          <cginstSourceId file=\"1\" line=\"1\" inlineCount=\"1\"/>\n          <cgSourceId file=\"1\" line=\"1\" inlineCount=\"1\"/>\n        </cgId>\n"
+            );
+            for p in self.coverpoints.iter().filter(|p| p.role == role) {
+                s += &format!(
+                    "        <coverpoint name=\"{}\" key=\"0\">\n          <options weight=\"1\" goal=\"100\" at_least=\"1\" auto_bin_max=\"64\" detect_overlap=\"false\"/>\n",
+                    xml(&p.signal)
+                );
+                for b in &p.bins {
+                    s += &format!(
+                        "          <coverpointBin name=\"{}\" type=\"{}\" key=\"0\">\n            <range from=\"-1\" to=\"-1\">\n              <contents coverageCount=\"{}\"/>\n            </range>\n          </coverpointBin>\n",
+                        xml(&b.name),
+                        if b.unreachable.is_some() { "ignore" } else { "bins" },
+                        b.count
+                    );
+                }
+                s += "        </coverpoint>\n";
+            }
+            s += "      </cgInstance>\n";
+        }
+        s += "    </covergroupCoverage>\n  </instanceCoverages>\n</UCIS>\n";
+        s
+    }
+}
+
 /// Whether file `i` of the manifest holds one row per vector.
 fn per_vector(m: &Manifest, i: usize) -> bool {
     i < 2 || m.files[i].role == crate::hdl::STAGE_ROLE
@@ -297,6 +374,13 @@ fn bin_of(x: &Field, v: u64, m: &Manifest) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn utc_dates() {
+        assert_eq!(utc(0), "1970-01-01T00:00:00");
+        assert_eq!(utc(951_782_400), "2000-02-29T00:00:00");
+        assert_eq!(utc(1_796_390_257), "2026-12-04T13:17:37");
+    }
 
     #[test]
     fn fp16_and_fixed_bins_by_hand() {
