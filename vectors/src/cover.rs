@@ -13,7 +13,10 @@
 //! - a fixed-point field: `0`, `+1 step`, `-1 step`, `+max` (saturated high), `min`
 //!   (saturated low), `positive`, `negative` (the others of each sign);
 //! - a flag: `0`, `1`;
-//! - the class column: one bin per class of the manifest.
+//! - the class column: one bin per class of the manifest;
+//! - every compare of the stage table (rti `tmin_ok`, `tmax_ok`; slab `hit` and the
+//!   compare-select chain `tn_*`, `tf_*`): the outcome of its operands as the datapath reads
+//!   them (FTZ: a subnormal as zero) — `<`, `=`, `>`, `unordered` (a NaN operand).
 //!
 //! Unreachable bins, with the reason, left out of the totals: in a format with the canonical
 //! NaN rule, `other NaN` of every output and stage signal; under flush-to-zero, the subnormal
@@ -170,6 +173,23 @@ impl Coverage {
                 });
             }
         }
+        for (stage, name, a, b) in compares(m) {
+            let fixed = !matches!(field(m, a).map(|x| &x.1.kind), Some(Kind::Ieee { .. }));
+            coverpoints.push(Coverpoint {
+                signal: format!("{name} ({a} vs {b})"),
+                role: "stage signals".into(),
+                stage: Some(stage),
+                kind: "compare".into(),
+                bins: COMPARE_BINS
+                    .iter()
+                    .map(|&n| Bin {
+                        name: n.into(),
+                        count: 0,
+                        unreachable: (n == "unordered" && fixed).then_some(WHY_FIXED_ORDERED),
+                    })
+                    .collect(),
+            });
+        }
         Coverage { unit: m.unit.clone(), format: m.format.clone(), vectors: 0, coverpoints }
     }
 
@@ -215,6 +235,21 @@ impl Coverage {
                         b.count += 1;
                     }
                 }
+            }
+            let ftz = m.format.contains("ftz");
+            for (_, _, a, b) in compares(m) {
+                let (Some(x), Some(y)) = (operand(m, contents, row, a, ftz), operand(m, contents, row, b, ftz)) else {
+                    cp += 1;
+                    continue;
+                };
+                let bin = match (x, y) {
+                    (None, _) | (_, None) => 3,
+                    (Some(x), Some(y)) if x < y => 0,
+                    (Some(x), Some(y)) if x == y => 1,
+                    _ => 2,
+                };
+                self.coverpoints[cp].bins[bin].count += 1;
+                cp += 1;
             }
             self.vectors += 1;
         }
@@ -342,6 +377,89 @@ impl Coverage {
         s += "    </covergroupCoverage>\n  </instanceCoverages>\n</UCIS>\n";
         s
     }
+}
+
+/// The bins of a compare.
+pub const COMPARE_BINS: [&str; 4] = ["<", "=", ">", "unordered"];
+
+/// Why a fixed-point compare is never unordered.
+pub const WHY_FIXED_ORDERED: &str = "fixed point has no NaN: every compare is ordered";
+
+/// The compares of the set's unit: (stage, signal, a, b) from its stage table.
+fn compares(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str)> {
+    use datapath::stage::Rule;
+    let table: Vec<datapath::stage::SigDef> = match m.unit.as_str() {
+        "rti" => {
+            let div = if m.format.contains("divide") {
+                datapath::format::DivMode::Divide
+            } else {
+                datapath::format::DivMode::RecipMul
+            };
+            datapath::rti::stage_table(div)
+        }
+        "slab" => datapath::slab::SLAB_TABLE.to_vec(),
+        _ => Vec::new(),
+    };
+    table
+        .into_iter()
+        .filter_map(|d| match d.rule {
+            Rule::Le(a, b) | Rule::SelNear(a, b) | Rule::SelFar(a, b) => Some((d.stage, d.name, a, b)),
+            _ => None,
+        })
+        .filter(|(_, _, a, b)| field(m, a).is_some() && field(m, b).is_some())
+        .collect()
+}
+
+/// The per-vector file index and field of signal `name`.
+fn field<'a>(m: &'a Manifest, name: &str) -> Option<(usize, &'a Field, usize)> {
+    m.files
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| per_vector(m, *i))
+        .find_map(|(i, f)| f.fields.iter().position(|x| x.name == name).map(|k| (i, &f.fields[k], k)))
+}
+
+/// Operand `name` of row `row` as the datapath's compare reads it: `Some(None)` a NaN,
+/// `Some(Some(v))` a number; `None` when the value is don't-care in this row (care_when).
+fn operand(m: &Manifest, contents: &[Vec<Vec<u64>>], row: usize, name: &str, ftz: bool) -> Option<Option<f64>> {
+    let (i, x, k) = field(m, name)?;
+    if let Some(flag) = &x.care_when {
+        let f = m.files.get(1)?;
+        let j = f.fields.iter().position(|y| &y.name == flag)?;
+        if contents.get(1)?.get(row)?.get(j)? & 1 == 0 {
+            return None;
+        }
+    }
+    let v = *contents.get(i)?.get(row)?.get(k)?;
+    Some(match x.kind {
+        Kind::Ieee { exp, man } => {
+            let neg = (v >> (exp + man)) & 1 == 1;
+            let e = (v >> man) & ((1 << exp) - 1);
+            let f = v & ((1 << man) - 1);
+            let bias = (1i64 << (exp - 1)) - 1;
+            let mag = if e == (1 << exp) - 1 {
+                if f != 0 {
+                    return Some(None);
+                }
+                f64::INFINITY
+            } else if e == 0 {
+                if ftz {
+                    0.0
+                } else {
+                    f as f64 * (2f64).powi((1 - bias - man as i64) as i32)
+                }
+            } else {
+                (f as f64 + (1u64 << man) as f64) * (2f64).powi((e as i64 - bias - man as i64) as i32)
+            };
+            Some(if neg { -mag } else { mag })
+        }
+        Kind::Fixed { .. } => {
+            let w = x.width;
+            let s = if w == 64 { v as i64 } else { ((v << (64 - w)) as i64) >> (64 - w) };
+            Some(s as f64)
+        }
+        _ => Some(v as f64),
+    })
 }
 
 /// Whether file `i` of the manifest holds one row per vector.

@@ -16,7 +16,7 @@ fn req(unit: Unit, format: &str) -> Request {
         level: 1,
         command: "test".into(),
         rti: RtiConfig::default(),
-        slab_variant: if format.contains("ftz") { "plain" } else { "conservative" }.into(),
+        slab_variant: if format.contains("ftz") || format.starts_with('q') { "plain" } else { "conservative" }.into(),
         tree: None,
         leaves: 8,
         max_levels: 64,
@@ -48,9 +48,9 @@ fn halves_merged_equal_one_pass() {
 
 #[test]
 fn unreachable_bins_are_never_hit_and_op_sets_reach_every_other_bin() {
-    for format in ["fp16", "f32", "bf16", "fp16:ftz", "f32:ftz+propagate", "e5m6:divide"] {
+    for format in ["fp16", "f32", "bf16", "fp16:ftz", "f32:ftz+propagate", "e5m6:divide", "q8.24:divide", "q16.16"] {
         for unit in [Unit::Rti, Unit::Slab, Unit::Op, Unit::Capture] {
-            if unit == Unit::Op && format.starts_with("e5") {
+            if unit == Unit::Op && (format.starts_with("e5") || format.starts_with('q')) {
                 continue;
             }
             let set = generate(&Request { count: 8, ..req(unit, format) }).unwrap();
@@ -58,9 +58,43 @@ fn unreachable_bins_are_never_hit_and_op_sets_reach_every_other_bin() {
             assert!(c.contradictions().is_empty(), "{unit:?} {format}: {:?}", c.contradictions());
             let (hit, bins) = c.totals();
             assert!(hit > 0 && hit <= bins);
+            // every compare coverpoint of the unit is there, with its four outcomes
+            let compares = c.coverpoints.iter().filter(|p| p.kind == "compare").count();
+            let want = match unit {
+                Unit::Rti => 2,
+                Unit::Slab => 7,
+                _ => 0,
+            };
+            assert_eq!(compares, want, "{unit:?} {format}");
             if unit == Unit::Op && !format.contains("ftz") {
                 assert_eq!(hit, bins, "{format}: the op sets reach every reachable bin");
             }
         }
     }
+}
+
+/// Compare outcomes on hand-made slab rows (fp16, plain): a ray along +x from the origin, the
+/// box's x slab [1, 2] (hit: t_near 1 < t_far 2), [1, 1] (1 = 1), [2, 1] (2 > 1), and tmin NaN
+/// (the near selects compare NaN: unordered).
+#[test]
+fn compare_outcomes_by_hand() {
+    let (one, two, nan, inf, m1) = (0x3c00u64, 0x4000, 0x7e00, 0x7c00, 0xbc00);
+    let row = |tmin: u64, lo: u64, hi: u64| vec![0, 0, 0, one, 0, 0, tmin, inf, lo, m1, m1, hi, one, one];
+    let ex = vectors::gen::Explicit {
+        class: "hand".into(),
+        covers: "hand-made rows".into(),
+        origin: "test".into(),
+        rows: vec![row(0, one, two), row(0, one, one), row(0, two, one), row(nan, one, two)],
+    };
+    let set =
+        generate(&Request { explicit: Some(ex), slab_variant: "plain".into(), ..req(Unit::Slab, "fp16") }).unwrap();
+    let c = Coverage::measure(&set.manifest, &set_rows(&set).unwrap()).unwrap();
+    let counts = |sig: &str| -> Vec<u64> {
+        c.coverpoints.iter().find(|p| p.signal.starts_with(sig)).unwrap().bins.iter().map(|b| b.count).collect()
+    };
+    // hit (t_near vs t_far): rows 1..3 give <, =, >; in row 4 the select keeps its NaN
+    // accumulator (it takes x only when acc < x, false with a NaN), so t_near is NaN: unordered
+    assert_eq!(counts("hit ("), [1, 1, 1, 1]);
+    // tn_x (tmin vs nearx): 0 < 1 in rows 1..2, 0 < 2 in row 3, NaN in row 4
+    assert_eq!(counts("tn_x ("), [3, 0, 0, 1]);
 }
