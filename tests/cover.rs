@@ -81,5 +81,18 @@ fn cover_reports_merges_and_gates() {
     let o = raypipe(&["cover", &sa, "--ucis", &mine.display().to_string()]);
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(std::fs::read_to_string(&mine).unwrap(), "mine");
+    // traverse: leaves returned, passes and each level's history state, one bin per ray each
+    let t = tmp.join("trav");
+    set(&t, &["--unit", "traverse", "--format", "fp16", "--count", "2"]);
+    let jt = json(&[&t.display().to_string()]);
+    let rays = jt["vectors"].as_u64().unwrap();
+    let points = jt["coverpoints"].as_array().unwrap();
+    let sum =
+        |p: &serde_json::Value| p["bins"].as_array().unwrap().iter().map(|b| b["count"].as_u64().unwrap()).sum::<u64>();
+    for kind in ["leaves returned", "passes", "history state"] {
+        let ps: Vec<&serde_json::Value> = points.iter().filter(|p| p["kind"] == kind).collect();
+        assert!(!ps.is_empty(), "{kind}");
+        assert!(ps.iter().all(|p| sum(p) == rays), "{kind}");
+    }
     let _ = std::fs::remove_dir_all(&tmp);
 }

@@ -14,6 +14,8 @@
 //!   (saturated low), `positive`, `negative` (the others of each sign);
 //! - a flag: `0`, `1`;
 //! - the class column: one bin per class of the manifest;
+//! - traverse: the leaves returned (`0`, `1 to N-1`, `N`: the N-limit reached), the passes
+//!   (`0`, `1`, `2`, `3 or more`) and each level's final history state (`00` … `11`);
 //! - every compare of the stage table (rti `tmin_ok`, `tmax_ok`; slab `hit` and the
 //!   compare-select chain `tn_*`, `tf_*`): the outcome of its operands as the datapath reads
 //!   them (FTZ: a subnormal as zero) — `<`, `=`, `>`, `unordered` (a NaN operand).
@@ -152,7 +154,10 @@ impl Coverage {
                     Kind::Fixed { .. } => ("value class", FIXED_BINS.iter().map(|s| s.to_string()).collect()),
                     Kind::Flag => ("flag", vec!["0".into(), "1".into()]),
                     Kind::Uint if x.name == "class" => ("class", m.classes.iter().map(|c| c.name.clone()).collect()),
-                    Kind::Uint => continue,
+                    Kind::Uint => match traverse_bins(m, &x.name) {
+                        Some((kind, bins)) => (kind, bins.iter().map(|b| b.to_string()).collect()),
+                        None => continue,
+                    },
                 };
                 let out = x.dir == "out" && matches!(x.kind, Kind::Ieee { .. });
                 let canonical = !m.format.contains("propagate");
@@ -379,6 +384,20 @@ impl Coverage {
     }
 }
 
+/// The traverse unit's counters and history registers: (kind, bins), for its fields `count`
+/// (leaves returned), `passes` and `hist_<level>` (the final 2-bit history of each level).
+fn traverse_bins(m: &Manifest, name: &str) -> Option<(&'static str, &'static [&'static str])> {
+    if m.unit != "traverse" {
+        return None;
+    }
+    match name {
+        "count" => Some(("leaves returned", &["0", "1 to N-1", "N (the N-limit reached)"])),
+        "passes" => Some(("passes", &["0 (root missed)", "1", "2", "3 or more"])),
+        n if n.starts_with("hist_") => Some(("history state", &["00 new", "01 pass", "10 split", "11 done"])),
+        _ => None,
+    }
+}
+
 /// The bins of a compare.
 pub const COMPARE_BINS: [&str; 4] = ["<", "=", ">", "unordered"];
 
@@ -485,7 +504,17 @@ fn bin_of(x: &Field, v: u64, m: &Manifest) -> Option<usize> {
         Kind::Fixed { .. } => Some(fixed_bin(v, x.width)),
         Kind::Flag => Some((v & 1) as usize),
         Kind::Uint if x.name == "class" => Some((v as usize).min(m.classes.len())),
-        Kind::Uint => None,
+        Kind::Uint => {
+            traverse_bins(m, &x.name)?;
+            let n = m.params.get("leaves").copied().unwrap_or(0);
+            Some(match x.name.as_str() {
+                "count" if v == 0 => 0,
+                "count" if v < n => 1,
+                "count" => 2,
+                "passes" => (v as usize).min(3),
+                _ => (v & 3) as usize,
+            })
+        }
     }
 }
 
