@@ -47,6 +47,8 @@ fn history_requests_that_do_not_apply_exit_2() {
         &["prove", "history-equals-stack", "--format", "fp16"][..],
         &["prove", "history-equals-stack", "--no-guard"],
         &["prove", "history-equals-stack", "--depth", "0"],
+        &["prove", "history-equals-stack", "--depth", "7"],
+        &["prove", "history-equals-stack", "--depth", "6", "--n", "5"],
         &["prove", "history-equals-stack", "--n", "9"],
         &["prove", "history-equals-stack", "--mutant", "nope"],
         &["prove", "slab-never-misses", "--mutant", "one-pass"],

@@ -17,10 +17,10 @@ pub struct Args {
     /// Slab variant of slab-never-misses: conservative (default) or directed.
     #[arg(long)]
     pub variant: Option<String>,
-    /// history-equals-stack: every tree of 1 to this many levels.
+    /// history-equals-stack: every tree of 1 to this many levels (at most 6).
     #[arg(long, default_value_t = 6)]
     pub depth: usize,
-    /// history-equals-stack: every N (leaves asked for) from 0 to this.
+    /// history-equals-stack: every N (leaves asked for) from 0 to this (at most 8; 4 at depth 6).
     #[arg(long, default_value_t = 4)]
     pub n: usize,
     /// history-equals-stack: also offer NaN entry distances (checks that NaN orders as a tie).
