@@ -220,6 +220,9 @@ impl Coverage {
             let k = f.fields.iter().position(|x| x.name == name)?;
             Some(contents.get(1)?.get(row)?.get(k)? & 1 == 1)
         };
+        // per call, not per row: the compares and where their operands are
+        let ftz = m.format.contains("ftz");
+        let cmps = compares(m);
         for row in range {
             let mut cp = 0;
             for (i, f) in m.files.iter().enumerate() {
@@ -241,8 +244,7 @@ impl Coverage {
                     }
                 }
             }
-            let ftz = m.format.contains("ftz");
-            for (_, _, a, b) in compares(m) {
+            for &(_, _, a, b) in &cmps {
                 let (Some(x), Some(y)) = (operand(m, contents, row, a, ftz), operand(m, contents, row, b, ftz)) else {
                     cp += 1;
                     continue;
