@@ -61,3 +61,67 @@ def test_pyucis_reads_the_totals_raypipe_reports(unit, fmt, opts, tmp_path):
         assert (hit, total, ignored) == (j["bins_hit"], j["bins"], j["bins_unreachable"]), (unit, fmt, chosen)
         assert points == len(j["coverpoints"])
         assert 0 < hit <= total
+
+
+def _fp16(bits):
+    """An fp16 encoding's exact value (a Fraction), ('inf', sign), or None for a NaN."""
+    from fractions import Fraction as F
+    bits = int(bits)
+    sgn = -1 if bits >> 15 else 1
+    e, f = (bits >> 10) & 31, bits & 1023
+    if e == 31:
+        return None if f else ("inf", sgn)
+    if e == 0:
+        return sgn * F(f, 2 ** 24)
+    return sgn * F(1024 + f) * F(2) ** (e - 25)
+
+
+def test_rounding_events_match_exact_rational_arithmetic(tmp_path):
+    """The rounding events `raypipe cover` counts for a subtract and a multiply of the fp16 RTI
+    set equal an independent classification in exact rational arithmetic (fractions)."""
+    import bisect
+    from collections import Counter
+    from fractions import Fraction as F
+    import raypipe
+
+    e = exe()
+    d = tmp_path / "rti"
+    subprocess.run([e, "vectors", "--unit", "rti", "--format", "fp16", "--out", str(d)], check=True,
+                   capture_output=True)
+    j = json.loads(subprocess.run([e, "cover", str(d), "--json"], check=True, capture_output=True,
+                                  text=True).stdout)
+    s = raypipe.read_set(str(d))
+    names = {f["name"]: [x["name"] for x in f["fields"]] for f in s["manifest"]["files"]}
+    ins, st = s["files"]["rti_inputs.hex"], s["files"]["rti_stages.hex"]
+
+    def get(k, n):
+        if n in names["rti_inputs.hex"]:
+            return ins[k, names["rti_inputs.hex"].index(n)]
+        return st[k, names["rti_stages.hex"].index(n)]
+
+    finite = sorted({v for v in map(_fp16, range(1 << 16)) if v is not None and not isinstance(v, tuple)})
+    min_normal = F(1, 2 ** 14)
+
+    def event(x, y, r, op):
+        if x is None or y is None or r is None:
+            return "NaN"
+        if isinstance(x, tuple) or isinstance(y, tuple):
+            return "exact"
+        if isinstance(r, tuple):
+            return "overflow"
+        exact = x - y if op == "sub" else x * y
+        if exact == r:
+            return "exact"
+        i = bisect.bisect_left(finite, exact)
+        lo, hi = finite[i - 1], finite[i]
+        if exact - lo == hi - exact:
+            return "tie"
+        return "underflow" if abs(exact) < min_normal else "inexact"
+
+    # e1x = v1x - v0x (stage 1), pxa = dy * e2z (stage 2): datapath/src/rti.rs
+    for name, op, a, b in [("e1x", "sub", "v1x", "v0x"), ("pxa", "mul", "dy", "e2z")]:
+        want = Counter(event(_fp16(get(k, a)), _fp16(get(k, b)), _fp16(get(k, name)), op) for k in range(len(ins)))
+        [p] = [p for p in j["coverpoints"] if p["kind"] == "rounding" and p["signal"] == f"{name} ({op})"]
+        got = {b["name"]: b["count"] for b in p["bins"] if b["count"]}
+        assert got == dict(want), (name, got, dict(want))
+        assert got.get("tie", 0) > 0 and got.get("inexact", 0) > 0

@@ -18,7 +18,14 @@
 //!   (`0`, `1`, `2`, `3 or more`) and each level's final history state (`00` … `11`);
 //! - every compare of the stage table (rti `tmin_ok`, `tmax_ok`; slab `hit` and the
 //!   compare-select chain `tn_*`, `tf_*`): the outcome of its operands as the datapath reads
-//!   them (FTZ: a subnormal as zero) — `<`, `=`, `>`, `unordered` (a NaN operand).
+//!   them (FTZ: a subnormal as zero) — `<`, `=`, `>`, `unordered` (a NaN operand);
+//! - every rounded operation of the stage table (add, sub, mul, div rows) in an IEEE-like
+//!   format: its rounding event — `exact`, `inexact` (rounded, not a tie), `tie` (the exact
+//!   result halfway between two neighbours), `overflow` (±inf from finite operands),
+//!   `underflow` (tiny and inexact), `flushed` (FTZ: a nonzero tiny result written as zero),
+//!   `NaN` (a NaN result: a NaN operand, an invalid operation or the conservative guard).
+//!   Exact values: sums by TwoSum in binary64, products exactly in binary64 (significands of
+//!   at most 26 bits), quotients by comparing `r × b` with `a` exactly.
 //!
 //! Unreachable bins, with the reason, left out of the totals: in a format with the canonical
 //! NaN rule, `other NaN` of every output and stage signal; under flush-to-zero, the subnormal
@@ -195,6 +202,27 @@ impl Coverage {
                     .collect(),
             });
         }
+        let ftz = m.format.contains("ftz");
+        for (stage, name, op, _, _) in arith_rows(m) {
+            coverpoints.push(Coverpoint {
+                signal: format!("{name} ({op})"),
+                role: "stage signals".into(),
+                stage: Some(stage),
+                kind: "rounding".into(),
+                bins: ROUNDING_BINS
+                    .iter()
+                    .map(|&n| Bin {
+                        name: n.into(),
+                        count: 0,
+                        unreachable: match n {
+                            "flushed" if !ftz => Some(WHY_NO_FTZ),
+                            "underflow" if ftz => Some(WHY_FTZ_UNDERFLOW),
+                            _ => None,
+                        },
+                    })
+                    .collect(),
+            });
+        }
         Coverage { unit: m.unit.clone(), format: m.format.clone(), vectors: 0, coverpoints }
     }
 
@@ -223,6 +251,7 @@ impl Coverage {
         // per call, not per row: the compares and where their operands are
         let ftz = m.format.contains("ftz");
         let cmps = compares(m);
+        let ariths = arith_rows(m);
         for row in range {
             let mut cp = 0;
             for (i, f) in m.files.iter().enumerate() {
@@ -256,6 +285,13 @@ impl Coverage {
                     _ => 2,
                 };
                 self.coverpoints[cp].bins[bin].count += 1;
+                cp += 1;
+            }
+            for &(_, name, op, a, b) in &ariths {
+                let bin = rounding_event(m, contents, row, name, op, a, b, ftz);
+                if let Some(bin) = bin {
+                    self.coverpoints[cp].bins[bin].count += 1;
+                }
                 cp += 1;
             }
             self.vectors += 1;
@@ -400,16 +436,38 @@ fn traverse_bins(m: &Manifest, name: &str) -> Option<(&'static str, &'static [&'
     }
 }
 
-/// The bins of a compare.
-pub const COMPARE_BINS: [&str; 4] = ["<", "=", ">", "unordered"];
+/// The bins of a rounded operation.
+pub const ROUNDING_BINS: [&str; 7] = ["exact", "inexact", "tie", "overflow", "underflow", "flushed", "NaN"];
+/// Why a format without flush-to-zero never flushes.
+pub const WHY_NO_FTZ: &str = "the format keeps subnormals: no result is flushed";
+/// Why a flush-to-zero format never underflows.
+pub const WHY_FTZ_UNDERFLOW: &str = "flush-to-zero: every tiny result is flushed (counted as flushed)";
 
-/// Why a fixed-point compare is never unordered.
-pub const WHY_FIXED_ORDERED: &str = "fixed point has no NaN: every compare is ordered";
+/// The rounded operations of the set's unit with IEEE-like operands: (stage, signal, op, a, b).
+fn arith_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str, &'static str)> {
+    use datapath::stage::{Op, Rule};
+    let table = stage_table_of(m);
+    let known = |n: &str| n == "one" || field(m, n).is_some_and(|x| matches!(x.1.kind, Kind::Ieee { .. }));
+    table
+        .into_iter()
+        .filter(|d| matches!(d.rule, Rule::Arith | Rule::ArithGuardRecip | Rule::ArithGuardSub))
+        .filter_map(|d| {
+            let op = match d.op {
+                Op::Add => "add",
+                Op::Sub => "sub",
+                Op::Mul => "mul",
+                Op::Div => "div",
+                Op::Logic => return None,
+            };
+            Some((d.stage, d.name, op, d.a, d.b))
+        })
+        .filter(|&(_, n, _, a, b)| known(n) && known(a) && known(b))
+        .collect()
+}
 
-/// The compares of the set's unit: (stage, signal, a, b) from its stage table.
-fn compares(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str)> {
-    use datapath::stage::Rule;
-    let table: Vec<datapath::stage::SigDef> = match m.unit.as_str() {
+/// The stage table of the set's unit (rti, slab; empty for the others).
+fn stage_table_of(m: &Manifest) -> Vec<datapath::stage::SigDef> {
+    match m.unit.as_str() {
         "rti" => {
             let div = if m.format.contains("divide") {
                 datapath::format::DivMode::Divide
@@ -420,7 +478,127 @@ fn compares(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str)>
         }
         "slab" => datapath::slab::SLAB_TABLE.to_vec(),
         _ => Vec::new(),
+    }
+}
+
+/// The rounding event of operation `name = a op b` in row `row` (None: don't-care).
+#[allow(clippy::too_many_arguments)]
+fn rounding_event(
+    m: &Manifest,
+    contents: &[Vec<Vec<u64>>],
+    row: usize,
+    name: &str,
+    op: &str,
+    a: &str,
+    b: &str,
+    ftz: bool,
+) -> Option<usize> {
+    let (_, rf, _) = field(m, name)?;
+    let Kind::Ieee { exp, man } = rf.kind else { return None };
+    let val = |n: &str, flush: bool| -> Option<Option<f64>> {
+        if n == "one" {
+            return Some(Some(1.0));
+        }
+        operand(m, contents, row, n, flush)
     };
+    let r = val(name, false)?;
+    let (x, y) = (val(a, ftz)?, val(b, ftz)?);
+    let Some(r) = r else { return Some(6) };
+    let (Some(x), Some(y)) = (x, y) else { return Some(6) };
+    if op == "div" && y == 0.0 {
+        // x / ±0 = ±inf exactly (IEEE's divide by zero, not a rounding)
+        return Some(0);
+    }
+    if r.is_infinite() {
+        return Some(if x.is_finite() && y.is_finite() { 3 } else { 0 });
+    }
+    let bias = (1i32 << (exp - 1)) - 1;
+    let min_normal = (2f64).powi(1 - bias);
+    // the exact result as an unevaluated sum s + e (quotients: the sign of a - r*b instead)
+    let (s, e) = match op {
+        "add" | "sub" => {
+            let y = if op == "sub" { -y } else { y };
+            let s = x + y;
+            let bb = s - x;
+            (s, (x - (s - bb)) + (y - bb))
+        }
+        "mul" => (x * y, 0.0),
+        _ => {
+            // x / y against r: the exact quotient's position by r*y vs x (exact products)
+            let diff = x - r * y; // exact: r*y and x are within a rounding of each other
+            let dir = if diff == 0.0 { 0.0 } else { diff.signum() * y.signum() };
+            if dir == 0.0 {
+                return Some(0);
+            }
+            let tiny = x.abs() < min_normal * y.abs();
+            if ftz && tiny {
+                return Some(if r == 0.0 { 5 } else { 1 });
+            }
+            let n = neighbour(r, dir > 0.0, exp, man);
+            let mid = (r + n) / 2.0;
+            let tie = mid * y == x;
+            return Some(if tie {
+                2
+            } else if tiny {
+                4
+            } else {
+                1
+            });
+        }
+    };
+    if s == r && e == 0.0 {
+        return Some(0);
+    }
+    let up = if s != r { s > r } else { e > 0.0 };
+    let tiny = s.abs() < min_normal || (s.abs() == min_normal && e != 0.0 && e.signum() != s.signum());
+    if ftz && tiny {
+        return Some(if r == 0.0 && (s != 0.0 || e != 0.0) { 5 } else { 1 });
+    }
+    let n = neighbour(r, up, exp, man);
+    let mid = (r + n) / 2.0;
+    if s == mid && e == 0.0 {
+        return Some(2);
+    }
+    Some(if tiny { 4 } else { 1 })
+}
+
+/// The format value next to `r` (up: toward +inf), as binary64.
+fn neighbour(r: f64, up: bool, exp: u32, man: u32) -> f64 {
+    let bias = (1i32 << (exp - 1)) - 1;
+    let min_sub = (2f64).powi(1 - bias - man as i32);
+    if r == 0.0 {
+        return if up { min_sub } else { -min_sub };
+    }
+    // the step at r's binade (subnormal step below the smallest normal)
+    let away = (r > 0.0) == up;
+    let a = r.abs();
+    let e = ((a.to_bits() >> 52) & 0x7ff) as i32 - 1023; // a is a binary64 normal
+    let step_at = |e: i32| (2f64).powi(e.max(1 - bias) - man as i32);
+    let step = if away {
+        step_at(e)
+    } else if a == (2f64).powi(e) {
+        step_at(e - 1)
+    } else {
+        step_at(e)
+    };
+    let n = if away { a + step } else { a - step };
+    if r > 0.0 {
+        n
+    } else {
+        -n
+    }
+}
+
+/// The bins of a compare.
+pub const COMPARE_BINS: [&str; 4] = ["<", "=", ">", "unordered"];
+
+/// Why a fixed-point compare is never unordered.
+pub const WHY_FIXED_ORDERED: &str = "fixed point has no NaN: every compare is ordered";
+
+/// The compares of the set's unit: (stage, signal, a, b) from its stage table.
+fn compares(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str)> {
+    use datapath::stage::Rule;
+    let table = stage_table_of(m);
     table
         .into_iter()
         .filter_map(|d| match d.rule {
