@@ -125,3 +125,55 @@ def test_rounding_events_match_exact_rational_arithmetic(tmp_path):
         got = {b["name"]: b["count"] for b in p["bins"] if b["count"]}
         assert got == dict(want), (name, got, dict(want))
         assert got.get("tie", 0) > 0 and got.get("inexact", 0) > 0
+
+
+def test_op_rounding_events_match_exact_rational_arithmetic(tmp_path):
+    """The op unit's result, classified by the operation its opcode selects (fp16, divide
+    mode), against exact rational arithmetic."""
+    import bisect
+    from collections import Counter
+    from fractions import Fraction as F
+    import raypipe
+
+    e = exe()
+    d = tmp_path / "op"
+    subprocess.run([e, "vectors", "--unit", "op", "--format", "fp16:divide", "--out", str(d)], check=True,
+                   capture_output=True)
+    j = json.loads(subprocess.run([e, "cover", str(d), "--json"], check=True, capture_output=True,
+                                  text=True).stdout)
+    s = raypipe.read_set(str(d))
+    ins, out = s["files"]["op_inputs.hex"], s["files"]["op_expected.hex"]
+    finite = sorted({v for v in map(_fp16, range(1 << 16)) if v is not None and not isinstance(v, tuple)})
+    # beyond the largest finite value, its next step (2^16): RNE's overflow midpoint is between
+    finite = [-F(2 ** 16)] + finite + [F(2 ** 16)]
+    min_normal = F(1, 2 ** 14)
+    want = Counter()
+    for k in range(len(ins)):
+        opcode, a, b, r = int(ins[k, 1]), _fp16(ins[k, 2]), _fp16(ins[k, 3]), _fp16(out[k, 0])
+        if opcode > 3:
+            continue
+        if a is None or b is None or r is None:
+            want["NaN"] += 1
+            continue
+        if opcode == 3 and b == 0:
+            want["exact"] += 1
+            continue
+        if isinstance(a, tuple) or isinstance(b, tuple):
+            want["exact"] += 1
+            continue
+        if isinstance(r, tuple):
+            want["overflow"] += 1
+            continue
+        exact = [a + b, a - b, a * b, a / b if b else None][opcode]
+        if exact == r:
+            want["exact"] += 1
+            continue
+        i = bisect.bisect_left(finite, exact)
+        lo, hi = finite[i - 1], finite[i]
+        if exact - lo == hi - exact:
+            want["tie"] += 1
+        else:
+            want["underflow" if abs(exact) < min_normal else "inexact"] += 1
+    [p] = [p for p in j["coverpoints"] if p["kind"] == "rounding"]
+    got = {b["name"]: b["count"] for b in p["bins"] if b["count"]}
+    assert got == dict(want), (got, dict(want))

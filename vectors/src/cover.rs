@@ -203,9 +203,14 @@ impl Coverage {
             });
         }
         let ftz = m.format.contains("ftz");
-        for (stage, name, op, _, _) in arith_rows(m) {
+        let mut rows: Vec<(u8, String)> =
+            arith_rows(m).into_iter().map(|(stage, name, op, _, _)| (stage, format!("{name} ({op})"))).collect();
+        if op_unit_rounding(m) {
+            rows.push((1, "result (add, sub, mul or div by opcode)".into()));
+        }
+        for (stage, signal) in rows {
             coverpoints.push(Coverpoint {
-                signal: format!("{name} ({op})"),
+                signal,
                 role: "stage signals".into(),
                 stage: Some(stage),
                 kind: "rounding".into(),
@@ -252,6 +257,7 @@ impl Coverage {
         let ftz = m.format.contains("ftz");
         let cmps = compares(m);
         let ariths = arith_rows(m);
+        let op_rounding = op_unit_rounding(m);
         for row in range {
             let mut cp = 0;
             for (i, f) in m.files.iter().enumerate() {
@@ -293,6 +299,21 @@ impl Coverage {
                     self.coverpoints[cp].bins[bin].count += 1;
                 }
                 cp += 1;
+            }
+            if op_rounding {
+                // the op unit: the operation the row's opcode selects (0 add, 1 sub, 2 mul,
+                // 3 div in divide mode; the reciprocal mode's a * (1/b) rounds twice: not counted)
+                let opcode = field(m, "opcode").and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied());
+                let op = match opcode {
+                    Some(0) => Some("add"),
+                    Some(1) => Some("sub"),
+                    Some(2) => Some("mul"),
+                    Some(3) if m.format.contains("divide") => Some("div"),
+                    _ => None,
+                };
+                if let Some(bin) = op.and_then(|op| rounding_event(m, contents, row, "result", op, "a", "b", ftz)) {
+                    self.coverpoints[cp].bins[bin].count += 1;
+                }
             }
             self.vectors += 1;
         }
@@ -465,6 +486,13 @@ fn arith_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str
         .collect()
 }
 
+/// Whether the set is an op set with an IEEE-like result (its rounding events are counted).
+fn op_unit_rounding(m: &Manifest) -> bool {
+    m.unit == "op"
+        && field(m, "result").is_some_and(|x| matches!(x.1.kind, Kind::Ieee { .. }))
+        && field(m, "opcode").is_some()
+}
+
 /// The stage table of the set's unit (rti, slab; empty for the others).
 fn stage_table_of(m: &Manifest) -> Vec<datapath::stage::SigDef> {
     match m.unit.as_str() {
@@ -509,8 +537,12 @@ fn rounding_event(
         // x / ±0 = ±inf exactly (IEEE's divide by zero, not a rounding)
         return Some(0);
     }
+    if x.is_infinite() || y.is_infinite() {
+        // an infinite operand with a non-NaN result: the result is exact (±inf, or x / ±inf = ±0)
+        return Some(0);
+    }
     if r.is_infinite() {
-        return Some(if x.is_finite() && y.is_finite() { 3 } else { 0 });
+        return Some(3);
     }
     let bias = (1i32 << (exp - 1)) - 1;
     let min_normal = (2f64).powi(1 - bias);
