@@ -181,3 +181,15 @@ impl SlabMutation {
         s
     }
 }
+
+/// Refuses a solver name `raypipe_solve.py` does not drive, or a timeout that is not a finite
+/// number of seconds >= 0 (0: no limit).
+pub fn check_solver(solver: &str, timeout: f64) -> Result<(), String> {
+    if !(timeout >= 0.0 && timeout.is_finite()) {
+        return Err(format!("--timeout must be a finite number of seconds >= 0, got {timeout}"));
+    }
+    if !matches!(solver, "auto" | "bitwuzla" | "cvc5" | "z3") {
+        return Err(format!("unknown solver '{solver}': auto, bitwuzla, cvc5, z3"));
+    }
+    Ok(())
+}

@@ -51,12 +51,7 @@ pub struct Args {
 
 /// Runs `raypipe equiv`.
 pub fn run(a: Args) -> Result<Outcome, String> {
-    if !(a.timeout >= 0.0 && a.timeout.is_finite()) {
-        return Err(format!("--timeout must be a finite number of seconds >= 0, got {}", a.timeout));
-    }
-    if !matches!(a.solver.as_str(), "auto" | "bitwuzla" | "cvc5" | "z3") {
-        return Err(format!("unknown solver '{}': auto, bitwuzla, cvc5, z3", a.solver));
-    }
+    check_solver(&a.solver, a.timeout)?;
     let params = a
         .param
         .iter()

@@ -52,12 +52,7 @@ pub struct Args {
 
 /// Runs `raypipe prove`.
 pub fn run(a: Args) -> Result<Outcome, String> {
-    if !(a.timeout >= 0.0 && a.timeout.is_finite()) {
-        return Err(format!("--timeout must be a finite number of seconds >= 0, got {}", a.timeout));
-    }
-    if !matches!(a.solver.as_str(), "auto" | "bitwuzla" | "cvc5" | "z3") {
-        return Err(format!("unknown solver '{}': auto, bitwuzla, cvc5, z3", a.solver));
-    }
+    check_solver(&a.solver, a.timeout)?;
     if a.property == "history-equals-stack" {
         return history(&a);
     }
@@ -73,9 +68,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     let p = match a.property.as_str() {
         "slab-never-misses" => {
             let req = super::smt::request_slab(&format, &variant, &a.mutation)?;
-            let threads =
-                a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
-            formal::prove::slab::prove(&req, &a.solver, a.timeout, threads)?
+            formal::prove::slab::prove(&req, &a.solver, a.timeout, threads(a.threads))?
         }
         other => {
             return Err(format!("unknown property '{other}'; properties: slab-never-misses, history-equals-stack"))
@@ -150,8 +143,7 @@ fn history(a: &Args) -> Result<Outcome, String> {
     }
     let mutant =
         a.mutant.as_deref().map_or(Ok(formal::prove::history::Mutant::None), formal::prove::history::Mutant::parse)?;
-    let threads = a.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize);
-    let p = formal::prove::history::prove(a.depth, a.n, a.nan, mutant, threads)?;
+    let p = formal::prove::history::prove(a.depth, a.n, a.nan, mutant, threads(a.threads))?;
     let j = serde_json::json!({
         "command": command_as_typed(),
         "property": "history-equals-stack",
@@ -249,4 +241,9 @@ fn explain_command(format: &str, variant: &str, mutation: &SlabMutation, p: &for
         val("tmin"),
         val("tmax")
     )
+}
+
+/// The `--threads` given, or every core.
+fn threads(t: Option<u64>) -> usize {
+    t.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), |t| t as usize)
 }

@@ -102,35 +102,14 @@ fn enumerate_with<F: Format>(
     let n = 1u64 << f.width();
     let (top, bottom) = (f.from_f64(f64::INFINITY), f.from_f64(f64::NEG_INFINITY));
     let (hi_v, lo_v) = (f.to_f64(top), f.to_f64(bottom));
-    let float = matches!(f.kind(), FormatKind::Float(_));
     // every non-NaN encoding, its value, and the reals whose computed difference it is
     let values: Vec<(u64, f64, f64, f64)> = (0..n)
         .filter(|&b| !f.is_nan(f.from_bits(b)))
         .map(|b| {
             let v = f.from_bits(b);
             let x = f.to_f64(v);
-            let (lo, hi) = if float {
-                match f.kind() {
-                    FormatKind::Float(l) => {
-                        let max = l.max_finite();
-                        if x.is_infinite() {
-                            let ovf = max + l.ulp(max) / 2.0;
-                            if x > 0.0 {
-                                (ovf, 2.0 * max)
-                            } else {
-                                (-2.0 * max, -ovf)
-                            }
-                        } else if l.is_zero(b) || l.is_subnormal(b) {
-                            (x, x)
-                        } else {
-                            let (p, q) = (f.to_f64(f.next_down(v)), f.to_f64(f.next_up(v)));
-                            let lo = if p.is_infinite() { x - l.ulp(max) / 2.0 } else { (p + x) / 2.0 };
-                            let hi = if q.is_infinite() { x + l.ulp(max) / 2.0 } else { (x + q) / 2.0 };
-                            (lo, hi)
-                        }
-                    }
-                    FormatKind::Fixed { .. } => unreachable!(),
-                }
+            let (lo, hi) = if let FormatKind::Float(l) = f.kind() {
+                super::slab_planes::rounding_interval(f, l, b, x)
             } else if x == hi_v {
                 // saturated high: the exact difference is at least the largest value
                 (x, f64::INFINITY)

@@ -21,7 +21,7 @@
 //! `t_near = nextDown^w(max(tmin, near_x, near_y, near_z)) <= max(tmin, L_x, L_y, L_z)` and
 //! `t_far >= min(tmax, H_x, H_y, H_z)`: an exact non-empty interval is a hit (docs/proofs.md).
 
-use datapath::format::FormatKind;
+use datapath::format::{FloatLayout, FormatKind};
 use datapath::slab::{guarded_recip, guarded_sub, DirPrep, SlabConfig, SlabNan};
 use datapath::Format;
 
@@ -63,6 +63,25 @@ pub fn covers<F: Format>(f: &F) -> Result<(), String> {
     }
 }
 
+/// The reals a subtraction rounds to encoding `b` (value `x`) of float format `f` (layout
+/// `l`): its rounding interval; a zero or subnormal difference of two format values is exact;
+/// ±inf stands for an overflow, `[max + ulp(max)/2, 2·max]`.
+pub(crate) fn rounding_interval<F: Format>(f: &F, l: FloatLayout, b: u64, x: f64) -> (f64, f64) {
+    let max = l.max_finite();
+    if x.is_infinite() {
+        let ovf = max + l.ulp(max) / 2.0;
+        return if x > 0.0 { (ovf, 2.0 * max) } else { (-2.0 * max, -ovf) };
+    }
+    if l.is_zero(b) || l.is_subnormal(b) {
+        return (x, x);
+    }
+    let v = f.from_bits(b);
+    let (p, q) = (f.to_f64(f.next_down(v)), f.to_f64(f.next_up(v)));
+    let lo = if p.is_infinite() { x - l.ulp(max) / 2.0 } else { (p + x) / 2.0 };
+    let hi = if q.is_infinite() { x + l.ulp(max) / 2.0 } else { (x + q) / 2.0 };
+    (lo, hi)
+}
+
 /// Checks the lemma on every (diff, d) pair of format `f` with variant `cfg`, on `threads`
 /// threads (the result does not depend on them).
 pub fn enumerate<F: Format>(f: &F, cfg: SlabConfig, threads: usize) -> Result<Enumerated, String> {
@@ -74,24 +93,10 @@ pub fn enumerate<F: Format>(f: &F, cfg: SlabConfig, threads: usize) -> Result<En
     let n = 1u64 << l.width();
     let w = cfg.widen_ulps as u32;
     let guard = cfg.guard;
-    let max = l.max_finite();
     // every non-NaN encoding with its value
     let values: Vec<(u64, f64)> = (0..n).filter(|&b| !l.is_nan(b)).map(|b| (b, f.to_f64(f.from_bits(b)))).collect();
     // the rounding interval of each difference value
-    let interval = |b: u64, x: f64| -> (f64, f64) {
-        if x.is_infinite() {
-            let ovf = max + l.ulp(max) / 2.0;
-            return if x > 0.0 { (ovf, 2.0 * max) } else { (-2.0 * max, -ovf) };
-        }
-        if l.is_zero(b) || l.is_subnormal(b) {
-            return (x, x);
-        }
-        let v = f.from_bits(b);
-        let (p, q) = (f.to_f64(f.next_down(v)), f.to_f64(f.next_up(v)));
-        let lo = if p.is_infinite() { x - l.ulp(max) / 2.0 } else { (p + x) / 2.0 };
-        let hi = if q.is_infinite() { x + l.ulp(max) / 2.0 } else { (x + q) / 2.0 };
-        (lo, hi)
-    };
+    let interval = |b: u64, x: f64| rounding_interval(f, l, b, x);
     let ds: Vec<(u64, f64)> = values.iter().copied().filter(|(_, x)| x.is_finite()).collect();
     let threads = threads.max(1);
     let chunk = ds.len().div_ceil(threads);
