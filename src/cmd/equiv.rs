@@ -35,7 +35,8 @@ pub struct Args {
     /// RTI options.
     #[command(flatten)]
     pub rti: RtiArgs,
-    /// Compare only these outputs (comma-separated; default: every output named like a model signal).
+    /// Compare only these outputs (comma-separated; default: every output named like a model
+    /// signal); with --stage-row: prove only these stage signals.
     #[arg(long, value_delimiter = ',')]
     pub outputs: Vec<String>,
     /// Solver: auto (bitwuzla for binary16/32/64/128 sorts, else cvc5), bitwuzla, cvc5, z3.
@@ -44,6 +45,23 @@ pub struct Args {
     /// Give up on an output after this many seconds (0: no limit); a timeout proves nothing.
     #[arg(long, default_value_t = 600.0)]
     pub timeout: f64,
+    /// The vector set the DUT is built for (its package is read with the sources; its manifest
+    /// gives the unit, format, variant, options and row layouts). Needed with --stage-row.
+    #[arg(long)]
+    pub set: Option<PathBuf>,
+    /// A pipelined DUT's row register: `in=REG` (the input register), or `K=[IN]:[STG][@EDGES]`
+    /// (the registers holding the row after table stage K: inputs part, stage-signal part, and
+    /// the clock edges from the previous row, 1 by default). Repeat for every row; proves the
+    /// DUT stage by stage (docs/proofs.md).
+    #[arg(long = "stage-row")]
+    pub stage_row: Vec<String>,
+    /// Bounded model checking of a stage of several edges: the transaction enters at each
+    /// cycle 1..=P after reset (default: the stage's edges - 1).
+    #[arg(long)]
+    pub phases: Option<u32>,
+    /// Queries run at once (default: the machine's cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -52,6 +70,9 @@ pub struct Args {
 /// Runs `raypipe equiv`.
 pub fn run(a: Args) -> Result<Outcome, String> {
     check_solver(&a.solver, a.timeout)?;
+    if !a.stage_row.is_empty() || a.set.is_some() {
+        return run_stages(&a);
+    }
     let params = a
         .param
         .iter()
@@ -189,6 +210,158 @@ fn prove_in(
     })?;
     Ok(match status {
         "PROVEN" => Outcome::Pass,
+        "COUNTEREXAMPLE" => Outcome::Fail,
+        _ => Outcome::Inconclusive,
+    })
+}
+
+/// The set's row layouts, from its manifest.
+fn layout(m: &vectors::manifest::Manifest) -> Result<formal::equiv::stages::Layout, String> {
+    use formal::equiv::stages::{FieldPos, Layout};
+    let pos = |f: &vectors::manifest::File| -> Vec<FieldPos> {
+        f.fields.iter().map(|x| FieldPos { name: x.name.clone(), lsb: x.lsb, width: x.width }).collect()
+    };
+    let inputs = m.files.first().ok_or("manifest.json: no input file")?;
+    let outputs = m.files.get(1).ok_or("manifest.json: no expected-output file")?;
+    let stages = m
+        .files
+        .iter()
+        .find(|f| f.role == vectors::hdl::STAGE_ROLE)
+        .ok_or("the set has no stage-signal file (write it without --no-stages)")?;
+    Ok(Layout {
+        inputs: pos(inputs),
+        in_w: inputs.width,
+        stages: pos(stages),
+        stg_w: stages.width,
+        outputs: pos(outputs),
+        out_w: outputs.width,
+    })
+}
+
+/// `raypipe equiv --set DIR --stage-row ...`: a pipelined DUT proven stage by stage.
+fn run_stages(a: &Args) -> Result<Outcome, String> {
+    let set = a.set.as_ref().ok_or("--stage-row needs --set DIR (the vector set the DUT is built for)")?;
+    if a.stage_row.is_empty() {
+        return Err("--set proves a pipelined DUT: name its row registers with --stage-row".into());
+    }
+    if !a.param.is_empty() {
+        return Err("--param: a pipelined DUT takes its parameters from the set's package".into());
+    }
+    let m = vectors::manifest::Manifest::read(set)?;
+    let unit: formal::smt::Unit = m.unit.parse().map_err(|e| format!("{}: {e}", set.display()))?;
+    if unit == formal::smt::Unit::Op {
+        return Err("the op unit is combinational: prove it without --set and --stage-row".into());
+    }
+    let format: AnyFormat = m.format.parse().map_err(|e| format!("manifest.json: format: {e}"))?;
+    let req = formal::smt::Request {
+        unit,
+        format,
+        rti: if unit == formal::smt::Unit::Rti { vectors::read::rti_config_from(&m)? } else { RtiConfig::default() },
+        variant: m.options.get("variant").cloned().unwrap_or_else(|| "plain".into()),
+        widen: None,
+        no_guard: false,
+    };
+    let lay = layout(&m)?;
+    let rows = a.stage_row.iter().map(|s| formal::equiv::stages::parse_row(s)).collect::<Result<Vec<_>, _>>()?;
+    let pkg = set.join("raypipe_pkg.sv");
+    if !pkg.is_file() {
+        return Err(format!("{}: no such file (the set's SystemVerilog package)", pkg.display()));
+    }
+    let mut rtl = vec![pkg];
+    rtl.extend(a.rtl.iter().cloned());
+    let dut = formal::equiv::Dut {
+        rtl,
+        incdirs: a.incdir.clone(),
+        defines: a.define.clone(),
+        top: a.top.clone(),
+        params: Vec::new(),
+    };
+    let threads = a.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
+    let work = std::env::temp_dir().join(format!("raypipe-equiv-{}", std::process::id()));
+    std::fs::create_dir_all(&work).map_err(|e| format!("{}: {e}", work.display()))?;
+    let t0 = std::time::Instant::now();
+    let result = formal::equiv::stages::elaborate(&dut, &work).and_then(|n| {
+        formal::equiv::stages::prove(&req, &n, &rows, &lay, a.phases, &a.outputs, &a.solver, a.timeout, threads, &work)
+    });
+    let _ = std::fs::remove_dir_all(&work);
+    let proofs = result?;
+    let seconds = t0.elapsed().as_secs_f64();
+    // a proof of some signals only (--outputs) proves the DUT equal on those
+    let status = if proofs.iter().all(|p| p.verdict.result == "unsat") {
+        if a.outputs.is_empty() {
+            "PROVEN"
+        } else {
+            "PROVEN (the signals named)"
+        }
+    } else if proofs.iter().any(|p| p.verdict.result == "sat") {
+        "COUNTEREXAMPLE"
+    } else {
+        "UNKNOWN"
+    };
+    use formal::equiv::stages::Goal;
+    let goal_name = |g: &Goal| match g {
+        Goal::Signal(s) => s.clone(),
+        Goal::Carried => "(carried fields)".to_string(),
+        Goal::Ports => "(out_row, stg_row)".to_string(),
+    };
+    let stages_of = |p: &formal::equiv::stages::StepProof| match p.stages {
+        Some((lo, hi)) if lo == hi => format!("{lo}"),
+        Some((lo, hi)) => format!("{lo}..={hi}"),
+        None => "ports".into(),
+    };
+    let hex = |v: u64| format!("{v:#x}");
+    let j = serde_json::json!({
+        "command": command_as_typed(),
+        "status": status,
+        "top": a.top,
+        "set": set.display().to_string(),
+        "unit": m.unit,
+        "format": m.format,
+        "seconds": seconds,
+        "steps": proofs.iter().map(|p| serde_json::json!({
+            "stages": stages_of(p),
+            "method": p.method,
+            "goal": goal_name(&p.goal),
+            "result": p.verdict.result,
+            "solver": p.verdict.solver,
+            "solver_version": p.verdict.version,
+            "seconds": p.verdict.seconds,
+            "counterexample": (!p.witness.is_empty()).then(|| p.witness.iter().map(|(k, v)| (k.clone(), serde_json::json!(hex(*v)))).collect::<serde_json::Map<_, _>>()),
+        })).collect::<Vec<_>>(),
+    });
+    emit(a.json, &j, |_| {
+        let mut s = format!(
+            "equiv {} (pipelined, stage by stage) vs the {} model in {} of {}: {status} ({} queries, {:.1} s)\n",
+            a.top,
+            m.unit,
+            m.format,
+            set.display(),
+            proofs.len(),
+            seconds
+        );
+        for p in &proofs {
+            s += &format!(
+                "  stage {:>5} {:<22} {}: {} ({} {:.1} s)\n",
+                stages_of(p),
+                goal_name(&p.goal),
+                p.method,
+                match p.verdict.result.as_str() {
+                    "unsat" => "equal",
+                    "sat" => "DIFFERS",
+                    _ => "unknown",
+                },
+                p.verdict.solver,
+                p.verdict.seconds
+            );
+            if !p.witness.is_empty() {
+                let w: Vec<String> = p.witness.iter().map(|(k, v)| format!("{k}={}", hex(*v))).collect();
+                s += &format!("      {}\n", w.join(" "));
+            }
+        }
+        s
+    })?;
+    Ok(match status {
+        "PROVEN" | "PROVEN (the signals named)" => Outcome::Pass,
         "COUNTEREXAMPLE" => Outcome::Fail,
         _ => Outcome::Inconclusive,
     })

@@ -80,12 +80,14 @@ fn sv_set_package(m: &crate::manifest::Manifest) -> String {
         s += &format!("  localparam int {tag}_W = {w};\n  localparam {tag}_FILE = \"{name}\";\n");
     }
     s += &format!("  localparam bit HAS_STAGES = {};\n", u8::from(stage_file.is_some()));
-    s += "  // the name of coverage class `id` (manifest.json \"classes\")\n";
+    // the string functions are for testbenches: synthesis and formal tools (which define
+    // SYNTHESIS; yosys 0.23 reads no `string`) skip them
+    s += "  // the name of coverage class `id` (manifest.json \"classes\")\n`ifndef SYNTHESIS\n";
     s += "  function automatic string class_name(int id);\n    case (id)\n";
     for c in &m.classes {
         s += &format!("      {}: return \"{}\";\n", c.id, c.name);
     }
-    s += "      default: return \"(not a class of this set)\";\n    endcase\n  endfunction\n";
+    s += "      default: return \"(not a class of this set)\";\n    endcase\n  endfunction\n`endif\n";
     if let Some(root) = m.files.iter().find(|f| f.name == "tree_root.hex") {
         // the traverse unit's BRAM images: entry width and rows per level (both banks alike)
         let levels = m.params.get("levels").copied().unwrap_or(0) as usize;
@@ -130,7 +132,7 @@ fn sv_set_package(m: &crate::manifest::Manifest) -> String {
         let extra = if i == 2 { format!(", logic [{}:0] want_out", out_w - 1) } else { String::new() };
         let row = if i == 2 { "want_out" } else { "want" };
         s += &format!(
-            "  // The first field (in file order: earliest stage first) where got and want differ, or \"none\";\n  // fields the manifest marks care_when F are skipped when F is 0 in the expected output row,\n  // implementation-defined fields unless strict.\n  function automatic string {fname}(logic [{}:0] got, logic [{}:0] want{extra}, bit strict);\n",
+            "  // The first field (in file order: earliest stage first) where got and want differ, or \"none\";\n  // fields the manifest marks care_when F are skipped when F is 0 in the expected output row,\n  // implementation-defined fields unless strict.\n`ifndef SYNTHESIS\n  function automatic string {fname}(logic [{}:0] got, logic [{}:0] want{extra}, bit strict);\n",
             w - 1,
             w - 1
         );
@@ -148,7 +150,7 @@ fn sv_set_package(m: &crate::manifest::Manifest) -> String {
                 s += &format!("    if ({cond}) return \"{}{at}\";\n", fld.name);
             }
         }
-        s += "    return \"none\";\n  endfunction\n";
+        s += "    return \"none\";\n  endfunction\n`endif\n";
     }
     s += "endpackage\n";
     s

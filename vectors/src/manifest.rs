@@ -159,3 +159,12 @@ pub struct Minimal {
     /// Detection is judged on the outputs alone (no stage probes).
     pub outputs_only: bool,
 }
+
+impl Manifest {
+    /// The manifest of the set in `dir` (its `manifest.json`).
+    pub fn read(dir: &std::path::Path) -> Result<Self, String> {
+        let path = dir.join("manifest.json");
+        let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+    }
+}

@@ -81,6 +81,8 @@ pub struct Model {
     pub inputs: Vec<String>,
     /// Stage signals in table order, with whether each is a flag.
     pub signals: Vec<(String, bool)>,
+    /// The stage-table stage of each signal (same order as `signals`; the op unit's: 0).
+    pub stages: Vec<u8>,
     /// Encoding width of a value.
     pub width: u32,
     /// The format as SMT.
@@ -89,7 +91,15 @@ pub struct Model {
 
 /// The SMT-LIB 2 model of a unit in a format, or why it cannot be emitted.
 pub fn emit(req: &Request) -> Result<Model, String> {
-    datapath::with_format!(&req.format, |f| emit_in(req, f))
+    datapath::with_format!(&req.format, |f| emit_in(req, f, None))
+}
+
+/// The model of stages `lo..=hi` cut out of the unit, for proving a pipelined DUT stage by
+/// stage: the signals of the stages before `lo` are declared constants (free, to be tied to the
+/// DUT's registers), the signals of `lo..=hi` are defined from them (and from the inputs) as in
+/// [`emit`], and the later stages' signals are listed in `signals` but not emitted.
+pub fn emit_stage_range(req: &Request, lo: u8, hi: u8) -> Result<Model, String> {
+    datapath::with_format!(&req.format, |f| emit_in(req, f, Some((lo, hi))))
 }
 
 fn float_of<F: Format>(f: &F) -> Result<IeeeSmt, String> {
@@ -102,9 +112,9 @@ fn float_of<F: Format>(f: &F) -> Result<IeeeSmt, String> {
     }
 }
 
-fn emit_in<F: Format>(req: &Request, f: &F) -> Result<Model, String> {
+fn emit_in<F: Format>(req: &Request, f: &F, cut: Option<(u8, u8)>) -> Result<Model, String> {
     let x = float_of(f)?;
-    let mut e = Emitter { x, text: String::new(), signals: Vec::new(), flags: Vec::new() };
+    let mut e = Emitter { x, text: String::new(), signals: Vec::new(), flags: Vec::new(), stages: Vec::new(), cut };
     let _ = writeln!(
         e.text,
         "; raypipe {} SMT-LIB 2 model of the {:?} unit in {}",
@@ -149,6 +159,7 @@ fn emit_in<F: Format>(req: &Request, f: &F) -> Result<Model, String> {
         text: e.text,
         inputs,
         signals: e.signals.into_iter().zip(e.flags).collect(),
+        stages: e.stages,
         width: x.width(),
         float: x,
     })
@@ -166,6 +177,10 @@ struct Emitter {
     text: String,
     signals: Vec<String>,
     flags: Vec<bool>,
+    /// The stage of each signal.
+    stages: Vec<u8>,
+    /// Emitting stages `lo..=hi` only (see [`emit_stage_range`]).
+    cut: Option<(u8, u8)>,
 }
 
 impl Emitter {
@@ -208,6 +223,29 @@ impl Emitter {
     }
 
     fn row(&mut self, d: &SigDef, env: &Env) -> Result<(), String> {
+        let flag =
+            matches!(d.rule, Rule::SignBit(_) | Rule::Le(..) | Rule::DetOk(_) | Rule::Oriented(..) | Rule::All(_));
+        let at = self.signals.len();
+        if let Some((lo, hi)) = self.cut {
+            if !(lo..=hi).contains(&d.stage) {
+                if d.stage < lo {
+                    let sort = if flag { "Bool".to_string() } else { self.x.bv_sort() };
+                    let _ = writeln!(self.text, "; stage {} {} (an earlier stage: tied to the DUT)", d.stage, d.name);
+                    let _ = writeln!(self.text, "(declare-const {} {sort})", d.name);
+                }
+                self.signals.push(d.name.into());
+                self.flags.push(flag);
+                self.stages.push(d.stage);
+                return Ok(());
+            }
+        }
+        self.row_def(d, env)?;
+        debug_assert_eq!(self.flags.get(at), Some(&flag), "{}: flag rule", d.name);
+        self.stages.push(d.stage);
+        Ok(())
+    }
+
+    fn row_def(&mut self, d: &SigDef, env: &Env) -> Result<(), String> {
         let cnan = self.x.lit(self.x.lay.canonical_nan());
         let guard = env.slab.is_some_and(|c| c.guard);
         let _ = writeln!(self.text, "; stage {} {}", d.stage, d.name);
@@ -307,5 +345,6 @@ impl Emitter {
             format!("(ite {} add (ite {} sub (ite {} mul (ite {} div {z}))))", code(0), code(1), code(2), code(3));
         self.value("result", &result);
         self.flag("cmp", &format!("(ite {} lt (ite {} le false))", code(4), code(5)));
+        self.stages = vec![0; self.signals.len()];
     }
 }

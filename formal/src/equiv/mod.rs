@@ -3,8 +3,8 @@
 //! that signal for every input (one query per output: the DUT's inputs tied to the model's,
 //! the output asserted different; `unsat` is PROVEN).
 //!
-//! Scope of this version: combinational DUTs (no register: a sequential DUT is refused, to be
-//! unrolled by its latency in a later version). DUT input ports must be model inputs of the
+//! This module proves combinational DUTs (a DUT with registers is refused here); a pipelined
+//! DUT is proven stage by stage from its row registers ([`stages`]). DUT input ports must be model inputs of the
 //! same width (`ox`, `a`, ...); model inputs the DUT lacks stay free; DUT outputs that are not
 //! model signals are listed and ignored.
 
@@ -14,6 +14,8 @@ use std::process::Command;
 
 use crate::smt::Model;
 use crate::solver::{check, Verdict};
+
+pub mod stages;
 
 /// The DUT: sources, top module and how to elaborate it.
 #[derive(Clone, Debug, Default)]
@@ -105,8 +107,9 @@ endmodule",
     s
 }
 
-/// One yosys run: the sources (and `extra` files) elaborated under `top`, written as SMT-LIB.
-fn yosys_smt(d: &Dut, top: &str, extra: &[PathBuf], work: &Path) -> Result<DutSmt, String> {
+/// The yosys script that reads the sources (and `extra` files) and elaborates `top`: flattened,
+/// processes and flip-flops in the forms `write_smt2` and `write_rtlil` take.
+pub(crate) fn read_script(d: &Dut, top: &str, extra: &[PathBuf]) -> Result<String, String> {
     for f in &d.rtl {
         if !f.is_file() {
             return Err(format!("--rtl {}: no such file", f.display()));
@@ -120,7 +123,6 @@ fn yosys_smt(d: &Dut, top: &str, extra: &[PathBuf], work: &Path) -> Result<DutSm
         return Err(format!("--top '{}' is not a module name", d.top));
     }
     let mut script = String::new();
-    let quote = |p: &Path| format!("\"{}\"", p.display());
     let mut read = String::from("read_verilog");
     for i in &d.incdirs {
         let s = i.display().to_string();
@@ -148,14 +150,17 @@ fn yosys_smt(d: &Dut, top: &str, extra: &[PathBuf], work: &Path) -> Result<DutSm
             let _ = write!(hier, " -chparam {k} {v}");
         }
     }
-    let out = work.join("dut.smt2");
-    let _ = writeln!(
-        script,
-        "{hier}\nproc\nflatten\nsetundef -undriven -zero\nopt -fast\nwrite_smt2 -stbv {}",
-        quote(&out)
-    );
-    let ys = work.join("equiv.ys");
-    std::fs::write(&ys, &script).map_err(|e| format!("{}: {e}", ys.display()))?;
+    // registers as plain flip-flops without reset or enable logic (what write_smt2 reads):
+    // an asynchronous reset becomes synchronous (async2sync), enables and synchronous resets
+    // become multiplexers (dffunmap)
+    let _ = writeln!(script, "{hier}\nproc\nflatten\nsetundef -undriven -zero\nopt -fast\nasync2sync\ndffunmap");
+    Ok(script)
+}
+
+/// Runs a yosys script in `work` (as `name`.ys).
+pub(crate) fn run_yosys(script: &str, work: &Path, name: &str) -> Result<(), String> {
+    let ys = work.join(format!("{name}.ys"));
+    std::fs::write(&ys, script).map_err(|e| format!("{}: {e}", ys.display()))?;
     let run = Command::new("yosys")
         .arg("-q")
         .arg("-s")
@@ -167,6 +172,20 @@ fn yosys_smt(d: &Dut, top: &str, extra: &[PathBuf], work: &Path) -> Result<DutSm
         let out = String::from_utf8_lossy(&run.stdout);
         return Err(format!("yosys could not read the DUT:\n{}{}", out.trim_end(), err.trim_end()));
     }
+    Ok(())
+}
+
+/// A path quoted for a yosys script.
+pub(crate) fn quote(p: &Path) -> String {
+    format!("\"{}\"", p.display())
+}
+
+/// One yosys run: the sources (and `extra` files) elaborated under `top`, written as SMT-LIB.
+fn yosys_smt(d: &Dut, top: &str, extra: &[PathBuf], work: &Path) -> Result<DutSmt, String> {
+    let mut script = read_script(d, top, extra)?;
+    let out = work.join("dut.smt2");
+    let _ = writeln!(script, "write_smt2 -stbv {}", quote(&out));
+    run_yosys(&script, work, "equiv")?;
     let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
     parse(&text, top)
 }
