@@ -255,7 +255,7 @@ pub struct Plan {
 pub fn plan(m: &Model, d: &DutSmt) -> Result<Plan, String> {
     if d.registers > 0 {
         return Err(format!(
-            "{} has {} registers: this version proves combinational DUTs (a pipelined DUT: prove its stages' logic, or wait for the unrolled version)",
+            "{} has {} registers: without --stage-row a DUT must be combinational (a pipelined DUT: name its row registers with --set DIR --stage-row, docs/proofs.md)",
             d.module, d.registers
         ));
     }
@@ -300,15 +300,21 @@ fn input_width(m: &Model, name: &str) -> Option<u32> {
     m.text[at..].split(')').next()?.trim().parse().ok()
 }
 
+/// Appends yosys's SMT-LIB script to a query, without its `set-*` commands (the query sets
+/// its own logic and options).
+pub(crate) fn push_script(q: &mut String, yosys_text: &str) {
+    for line in yosys_text.lines().filter(|l| !l.starts_with("(set-")) {
+        q.push_str(line);
+        q.push('\n');
+    }
+}
+
 /// The query for one output: satisfiable exactly when some input makes it differ.
 pub fn query(m: &Model, d: &DutSmt, output: &str) -> String {
     let md = &d.module;
     let mut q = m.text.clone();
     q += "\n; ---- the DUT, as yosys wrote it\n";
-    for line in d.text.lines().filter(|l| !l.starts_with("(set-")) {
-        q += line;
-        q.push('\n');
-    }
+    push_script(&mut q, &d.text);
     let _ = writeln!(q, "; ---- miter: the DUT's inputs are the model's; output {output} differs");
     let _ = writeln!(q, "(declare-const rp_dut |{md}_s|)");
     let _ = writeln!(q, "(assert (|{md}_h| rp_dut))");

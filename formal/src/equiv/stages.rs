@@ -31,7 +31,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::{quote, read_script, run_yosys, Dut};
+use super::{push_script, quote, read_script, run_yosys, Dut};
 use crate::smt::{emit_stage_range, Model, Request};
 use crate::solver::{check, Verdict};
 
@@ -156,12 +156,12 @@ pub fn elaborate(d: &Dut, work: &Path) -> Result<Netlist, String> {
     for line in text.lines() {
         let w: Vec<&str> = line.split_whitespace().collect();
         // "wire width N [attributes...] \name" inside the top module
+        // (no width: one bit)
         if w.first() == Some(&"wire") {
-            let width = w.iter().position(|x| *x == "width").and_then(|i| w.get(i + 1)).and_then(|x| x.parse().ok());
-            if let (Some(width), Some(name)) = (width, w.last().and_then(|n| n.strip_prefix('\\'))) {
-                wires.push((name.to_string(), width));
-            } else if let Some(name) = w.last().and_then(|n| n.strip_prefix('\\')) {
-                wires.push((name.to_string(), 1));
+            if let Some(name) = w.last().and_then(|n| n.strip_prefix('\\')) {
+                let width =
+                    w.iter().position(|x| *x == "width").and_then(|i| w.get(i + 1)).and_then(|x| x.parse().ok());
+                wires.push((name.to_string(), width.unwrap_or(1)));
             }
         }
     }
@@ -174,12 +174,9 @@ impl Netlist {
     }
 }
 
-/// The kit's port names.
-const PORTS: [&str; 4] = ["rst_n", "in_valid", "in_row", "out_row"];
-
 /// Checks the rows against the netlist and the layout; the rows in pipeline order.
 pub fn check_rows(rows: &[Row], n: &Netlist, lay: &Layout, model: &Model) -> Result<Vec<Row>, String> {
-    for p in PORTS.iter().chain(["stg_row"].iter()) {
+    for p in ["rst_n", "in_valid", "in_row", "out_row", "stg_row"] {
         if n.width(p).is_none() {
             return Err(format!("the DUT has no port {p} (the HDL kit's ports: clk, rst_n, in_valid, in_row, out_valid, out_row, stg_row)"));
         }
@@ -307,10 +304,7 @@ fn step_smt(
         .unwrap_or_default()
         .to_string();
     let mut body = format!("; ---- the DUT ({tag}), as yosys wrote it\n");
-    for line in text.lines().filter(|l| !l.starts_with("(set-")) {
-        body += line;
-        body.push('\n');
-    }
+    push_script(&mut body, &text);
     let mut next_bits = Vec::new();
     if bits {
         // the transition relation's conjuncts: `(= NEXT(state) (|m#k| next_state)) ; cell \reg [bit]`
@@ -402,11 +396,12 @@ pub fn prove(
 
     // the inputs each row holds as read (rp_read(x) = x), proven step by step from the
     // previous row's (a DUT may read its inputs in stage 0 and rely on that later)
+    // (each step's model emitted once, for its invariant and its queries)
+    let models = steps.iter().map(|s| emit_stage_range(req, s.lo, s.hi)).collect::<Result<Vec<_>, _>>()?;
     let mut read_ok: Vec<Vec<String>> = Vec::new();
     for (i, s) in steps.iter().enumerate() {
         let prev_read: &[String] = if i == 0 { &[] } else { &read_ok[i - 1] };
-        let m = emit_stage_range(req, s.lo, s.hi)?;
-        read_ok.push(invariant(&m, &full, s, &duts[i], prev_read, lay, phases, solver, timeout_s)?);
+        read_ok.push(invariant(&models[i], &full, s, &duts[i], prev_read, lay, phases, solver, timeout_s)?);
     }
 
     // one query per signal of each step, one for its carried fields, one for the ports
@@ -446,10 +441,8 @@ pub fn prove(
                     Some(i) => {
                         let s = &steps[i];
                         let prev_read: &[String] = if i == 0 { &[] } else { &read_ok[i - 1] };
-                        emit_stage_range(req, s.lo, s.hi).and_then(|m| {
-                            let q = Query::new(&m, &full, s, &duts[i], prev_read, lay, phases);
-                            q.run(&job.goal, solver, timeout_s)
-                        })
+                        Query::new(&models[i], &full, s, &duts[i], prev_read, lay, phases)
+                            .run(&job.goal, solver, timeout_s)
                     }
                     None => run_ports(last, &ports_dut, lay, solver, timeout_s),
                 };
