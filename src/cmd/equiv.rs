@@ -59,6 +59,16 @@ pub struct Args {
     /// cycle 1..=P after reset (default: the stage's edges - 1).
     #[arg(long)]
     pub phases: Option<u32>,
+    /// With --stage-row: replace every instance of MODULE (ports a, b, y; every other port tied
+    /// to a constant) by its operation OP (mul: a × b; add: a + b, or a − b with `sub` tied to
+    /// 1), rounded to nearest-even, after proving the module alone equal to it (repeat for
+    /// several modules; docs/proofs.md).
+    #[arg(long = "abstract")]
+    pub abstract_: Vec<String>,
+    /// With --abstract: also use an abstraction whose module-alone proof did not finish in
+    /// --timeout (never a refuted one); a proof is then PROVEN only IF those modules are (exit 3).
+    #[arg(long)]
+    pub trust_unfinished: bool,
     /// Queries run at once (default: the machine's cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -72,6 +82,9 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     check_solver(&a.solver, a.timeout)?;
     if !a.stage_row.is_empty() || a.set.is_some() {
         return run_stages(&a);
+    }
+    if !a.abstract_.is_empty() {
+        return Err("--abstract replaces modules in a stage-by-stage proof: give --set and --stage-row".into());
     }
     let params = a
         .param
@@ -280,34 +293,60 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
     let work = std::env::temp_dir().join(format!("raypipe-equiv-{}", std::process::id()));
     std::fs::create_dir_all(&work).map_err(|e| format!("{}: {e}", work.display()))?;
     let t0 = std::time::Instant::now();
-    let result = formal::equiv::stages::elaborate(&dut, &work).and_then(|n| {
-        formal::equiv::stages::prove(&req, &n, &rows, &lay, a.phases, &a.outputs, &a.solver, a.timeout, threads, &work)
+    let abs = a.abstract_.iter().map(|s| formal::equiv::abstraction::parse(s)).collect::<Result<Vec<_>, _>>()?;
+    let result = formal::equiv::stages::elaborate(&dut, &abs, &work).and_then(|n| {
+        let set = formal::equiv::stages::Settings {
+            phases: a.phases,
+            only: a.outputs.clone(),
+            solver: a.solver.clone(),
+            timeout_s: a.timeout,
+            threads,
+            trust_unfinished: a.trust_unfinished,
+        };
+        formal::equiv::stages::prove(&req, &n, &rows, &lay, &set, &work)
     });
     let _ = std::fs::remove_dir_all(&work);
-    let proofs = result?;
+    let formal::equiv::stages::Proof { steps: proofs, plan } = result?;
     let seconds = t0.elapsed().as_secs_f64();
+    use formal::equiv::stages::Goal;
+    // the DUT's verdict comes from the steps; a module proof only decides whether its
+    // abstraction was used (a refuted or unfinished module's instances stay concrete), except
+    // an unfinished one used under --trust-unfinished, which the verdict is conditional on
+    let is_module = |p: &&formal::equiv::stages::StepProof| matches!(p.goal, Goal::Module(..));
+    let trusted: Vec<String> = proofs
+        .iter()
+        .filter(|p| is_module(p) && p.verdict.result != "unsat")
+        .filter_map(|p| match &p.goal {
+            Goal::Module(g, s) if plan.instances.iter().any(|i| i.group == *g) => Some(s.clone()),
+            _ => None,
+        })
+        .collect();
+    let steps: Vec<&formal::equiv::stages::StepProof> = proofs.iter().filter(|p| !is_module(p)).collect();
     // a proof of some signals only (--outputs) proves the DUT equal on those
-    let status = if proofs.iter().all(|p| p.verdict.result == "unsat") {
-        if a.outputs.is_empty() {
+    let status = if steps.iter().all(|p| p.verdict.result == "unsat") {
+        if !trusted.is_empty() {
+            "PROVEN IF the modules trusted are their operations"
+        } else if a.outputs.is_empty() {
             "PROVEN"
         } else {
             "PROVEN (the signals named)"
         }
-    } else if proofs.iter().any(|p| p.verdict.result == "sat") {
+    } else if steps.iter().any(|p| p.verdict.result == "sat") {
         "COUNTEREXAMPLE"
     } else {
         "UNKNOWN"
     };
-    use formal::equiv::stages::Goal;
     let goal_name = |g: &Goal| match g {
         Goal::Signal(s) => s.clone(),
         Goal::Carried => "(carried fields)".to_string(),
         Goal::Ports => "(out_row, stg_row)".to_string(),
+        Goal::Module(_, s) => s.clone(),
     };
-    let stages_of = |p: &formal::equiv::stages::StepProof| match p.stages {
-        Some((lo, hi)) if lo == hi => format!("{lo}"),
-        Some((lo, hi)) => format!("{lo}..={hi}"),
-        None => "ports".into(),
+    let stages_of = |p: &formal::equiv::stages::StepProof| match (p.stages, &p.goal) {
+        (Some((lo, hi)), _) if lo == hi => format!("{lo}"),
+        (Some((lo, hi)), _) => format!("{lo}..={hi}"),
+        (None, Goal::Module(..)) => "module".into(),
+        (None, _) => "ports".into(),
     };
     let hex = |v: u64| format!("{v:#x}");
     let j = serde_json::json!({
@@ -318,6 +357,11 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
         "unit": m.unit,
         "format": m.format,
         "seconds": seconds,
+        "abstraction": {
+            "instances": plan.instances.iter().map(|i| &i.name).collect::<Vec<_>>(),
+            "concrete": plan.concrete.iter().map(|(n, why)| serde_json::json!({"instance": n, "why": why})).collect::<Vec<_>>(),
+            "trusted_unproven": trusted,
+        },
         "steps": proofs.iter().map(|p| serde_json::json!({
             "stages": stages_of(p),
             "method": p.method,
@@ -339,6 +383,16 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
             proofs.len(),
             seconds
         );
+        if !plan.instances.is_empty() {
+            let names: Vec<&str> = plan.instances.iter().map(|i| i.name.as_str()).collect();
+            s += &format!("  abstracted (each module proven alone below): {}\n", names.join(" "));
+        }
+        for (n, why) in &plan.concrete {
+            s += &format!("  left concrete: {n}: {why}\n");
+        }
+        for t in &trusted {
+            s += &format!("  TRUSTED, not proven (--trust-unfinished): {t}\n");
+        }
         for p in &proofs {
             s += &format!(
                 "  stage {:>5} {:<22} {}: {} ({} {:.1} s)\n",

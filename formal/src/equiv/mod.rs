@@ -15,6 +15,7 @@ use std::process::Command;
 use crate::smt::Model;
 use crate::solver::{check, Verdict};
 
+pub mod abstraction;
 pub mod stages;
 
 /// The DUT: sources, top module and how to elaborate it.
@@ -109,7 +110,8 @@ endmodule",
 
 /// The yosys script that reads the sources (and `extra` files) and elaborates `top`: flattened,
 /// processes and flip-flops in the forms `write_smt2` and `write_rtlil` take.
-pub(crate) fn read_script(d: &Dut, top: &str, extra: &[PathBuf]) -> Result<String, String> {
+/// `before_proc`: yosys lines run after `hierarchy`, before `proc`.
+pub(crate) fn read_script(d: &Dut, top: &str, extra: &[PathBuf], before_proc: &str) -> Result<String, String> {
     for f in &d.rtl {
         if !f.is_file() {
             return Err(format!("--rtl {}: no such file", f.display()));
@@ -153,7 +155,10 @@ pub(crate) fn read_script(d: &Dut, top: &str, extra: &[PathBuf]) -> Result<Strin
     // registers as plain flip-flops without reset or enable logic (what write_smt2 reads):
     // an asynchronous reset becomes synchronous (async2sync), enables and synchronous resets
     // become multiplexers (dffunmap)
-    let _ = writeln!(script, "{hier}\nproc\nflatten\nsetundef -undriven -zero\nopt -fast\nasync2sync\ndffunmap");
+    let _ = writeln!(
+        script,
+        "{hier}\n{before_proc}proc\nflatten\nsetundef -undriven -zero\nopt -fast\nasync2sync\ndffunmap"
+    );
     Ok(script)
 }
 
@@ -182,7 +187,7 @@ pub(crate) fn quote(p: &Path) -> String {
 
 /// One yosys run: the sources (and `extra` files) elaborated under `top`, written as SMT-LIB.
 fn yosys_smt(d: &Dut, top: &str, extra: &[PathBuf], work: &Path) -> Result<DutSmt, String> {
-    let mut script = read_script(d, top, extra)?;
+    let mut script = read_script(d, top, extra, "")?;
     let out = work.join("dut.smt2");
     let _ = writeln!(script, "write_smt2 -stbv {}", quote(&out));
     run_yosys(&script, work, "equiv")?;

@@ -31,6 +31,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use super::abstraction::{self, Abstraction, Plan};
 use super::{push_script, quote, read_script, run_yosys, Dut};
 use crate::smt::{emit_stage_range, Model, Request};
 use crate::solver::{check, Verdict};
@@ -116,6 +117,8 @@ pub enum Goal {
     Carried,
     /// `out_row` and `stg_row` from the last row.
     Ports,
+    /// An abstracted module alone equals its operation (the group's index, the statement).
+    Module(usize, String),
 }
 
 /// One query's verdict.
@@ -140,14 +143,21 @@ pub struct Netlist {
     pub rtlil: std::path::PathBuf,
     /// Wire widths by name.
     pub wires: Vec<(String, u32)>,
+    /// The DUT it was elaborated from.
+    pub dut: Dut,
+    /// The `--abstract` options.
+    pub abstractions: Vec<Abstraction>,
+    /// yosys's dump of the cells of the abstracted modules (before flattening).
+    pub cells: String,
 }
 
 /// Elaborates the DUT once (yosys), for the per-step queries.
-pub fn elaborate(d: &Dut, work: &Path) -> Result<Netlist, String> {
+pub fn elaborate(d: &Dut, abs: &[Abstraction], work: &Path) -> Result<Netlist, String> {
     if !d.params.is_empty() {
         return Err("a pipelined DUT takes its parameters from the set's package here (no --param)".into());
     }
-    let mut script = read_script(d, &d.top, &[])?;
+    let cells_file = work.join("cells.txt");
+    let mut script = read_script(d, &d.top, &[], &abstraction::list_cells(abs, &cells_file)?)?;
     let il = work.join("base.il");
     let _ = writeln!(script, "write_rtlil {}", quote(&il));
     run_yosys(&script, work, "base")?;
@@ -165,7 +175,12 @@ pub fn elaborate(d: &Dut, work: &Path) -> Result<Netlist, String> {
             }
         }
     }
-    Ok(Netlist { rtlil: il, wires })
+    let cells = if abs.is_empty() {
+        String::new()
+    } else {
+        std::fs::read_to_string(&cells_file).map_err(|e| format!("{}: {e}", cells_file.display()))?
+    };
+    Ok(Netlist { rtlil: il, wires, dut: d.clone(), abstractions: abs.to_vec(), cells })
 }
 
 impl Netlist {
@@ -264,15 +279,20 @@ struct StepDut {
     text: String,
     /// (register, bit) → name of a `define-fun` from the state to the bit's next value (Bool).
     next_bits: Vec<((String, u32), String)>,
+    /// The abstracted instances in the step (indices into the plan's instances).
+    present: Vec<usize>,
 }
 
 /// The yosys run for one step: the netlist with the previous row's registers cut and
 /// everything that does not feed the kept wires removed; for a one-edge step the flip-flops
 /// are split into single bits, and the next value of each is read from the transition
 /// relation (so a query on one field does not carry the logic of the others).
+#[allow(clippy::too_many_arguments)]
 fn step_smt(
     n: &Netlist,
+    plan: &Plan,
     cut: &[&str],
+    next: &[&str],
     keep: &[&str],
     ports: bool,
     bits: bool,
@@ -283,6 +303,17 @@ fn step_smt(
     let mut s = format!("read_rtlil {}\n", quote(&n.rtlil));
     for c in cut {
         let _ = writeln!(s, "cutpoint w:{c}");
+    }
+    if !plan.instances.is_empty() && !next.is_empty() {
+        // which abstracted instances feed the next row (one yosys run to list the cone)
+        let list = work.join(format!("{tag}-cone.txt"));
+        let f = list.display().to_string();
+        if f.contains(|c: char| c.is_whitespace() || c == '"') {
+            return Err(format!("the scratch directory {f} has a space or a quote in its path: set TMPDIR"));
+        }
+        run_yosys(&(s.clone() + &Plan::cone_script(next, &f)), work, &format!("{tag}-cone"))?;
+        let listing = std::fs::read_to_string(&list).map_err(|e| format!("{f}: {e}"))?;
+        s += &plan.step_script(&plan.in_cone(&listing));
     }
     let _ = writeln!(s, "setattr -set keep 1 {}", keep.iter().map(|k| format!("w:{k}")).collect::<Vec<_>>().join(" "));
     if !ports {
@@ -338,28 +369,56 @@ fn step_smt(
             next_bits.push(((reg.to_string(), bit), name));
         }
     }
-    Ok(StepDut { module, text: body, next_bits })
+    let present = plan.present(&module, &body);
+    Ok(StepDut { module, text: body, next_bits, present })
 }
 
-/// Proves the DUT's rows stage by stage. `threads` queries run at once.
-#[allow(clippy::too_many_arguments)]
+/// The verdicts of a stage-by-stage proof and the abstraction it used.
+pub struct Proof {
+    /// The module-alone proofs of the abstractions, then every step's queries and the ports'.
+    pub steps: Vec<StepProof>,
+    /// The instances abstracted and those left concrete.
+    pub plan: Plan,
+}
+
+/// How a stage-by-stage proof runs.
+#[derive(Clone, Debug, Default)]
+pub struct Settings {
+    /// Entry cycles of a several-edge step (default: its edges − 1).
+    pub phases: Option<u32>,
+    /// Prove only these signals (empty: every signal, the carried fields, the ports).
+    pub only: Vec<String>,
+    /// Solver (`auto`, `bitwuzla`, `cvc5`, `z3`).
+    pub solver: String,
+    /// Seconds per query (0: no limit).
+    pub timeout_s: f64,
+    /// Queries at once.
+    pub threads: usize,
+    /// Use an abstraction whose module-alone proof did not finish (never a refuted one): the
+    /// result is then conditional on those modules.
+    pub trust_unfinished: bool,
+}
+
+/// Proves the DUT's rows stage by stage.
 pub fn prove(
     req: &Request,
     n: &Netlist,
     rows: &[Row],
     lay: &Layout,
-    phases: Option<u32>,
-    only: &[String],
-    solver: &str,
-    timeout_s: f64,
-    threads: usize,
+    set: &Settings,
     work: &Path,
-) -> Result<Vec<StepProof>, String> {
+) -> Result<Proof, String> {
+    let (phases, only, solver, timeout_s, threads) =
+        (set.phases, set.only.as_slice(), set.solver.as_str(), set.timeout_s, set.threads);
     let full = crate::smt::emit(req)?;
     if let Some(o) = only.iter().find(|o| !full.signals.iter().any(|s| &s.0 == *o)) {
         return Err(format!("--outputs {o}: not a stage signal of the {:?} model", req.unit));
     }
     let rows = check_rows(rows, n, lay, &full)?;
+    // operator abstraction: each group's module proven alone first (a group not proven stays
+    // concrete), then cut out of the steps
+    let mut plan = abstraction::plan(&n.abstractions, &n.cells, &|w| n.width(w), full.float.width());
+    let module_proofs = justify(&mut plan, n, &full, set, work)?;
     let first_stage = *full.stages.iter().min().unwrap_or(&0);
     // the steps: each row from the previous one
     let mut steps = Vec::new();
@@ -381,18 +440,19 @@ pub fn prove(
     for (i, s) in steps.iter().enumerate() {
         let cut: Vec<&str> =
             s.prev.map(|p| p.inputs.iter().chain(&p.stages).map(String::as_str).collect()).unwrap_or_default();
+        let next: Vec<&str> = s.next.inputs.iter().chain(&s.next.stages).map(String::as_str).collect();
         let mut keep = cut.clone();
-        keep.extend(s.next.inputs.iter().chain(&s.next.stages).map(String::as_str));
+        keep.extend(&next);
         if s.bmc() || s.prev.is_none() {
             keep.extend(["rst_n", "in_valid", "in_row"]);
         }
-        duts.push(step_smt(n, &cut, &keep, false, !s.bmc(), work, &format!("step{i}"))?);
+        duts.push(step_smt(n, &plan, &cut, &next, &keep, false, !s.bmc(), work, &format!("step{i}"))?);
     }
     let last = rows.last().expect("checked: a last row");
     let cut_last: Vec<&str> = last.inputs.iter().chain(&last.stages).map(String::as_str).collect();
     let mut keep_last = cut_last.clone();
     keep_last.extend(["out_row", "stg_row"]);
-    let ports_dut = step_smt(n, &cut_last, &keep_last, true, false, work, "ports")?;
+    let ports_dut = step_smt(n, &Plan::default(), &cut_last, &[], &keep_last, true, false, work, "ports")?;
 
     // the inputs each row holds as read (rp_read(x) = x), proven step by step from the
     // previous row's (a DUT may read its inputs in stage 0 and rely on that later)
@@ -401,7 +461,8 @@ pub fn prove(
     let mut read_ok: Vec<Vec<String>> = Vec::new();
     for (i, s) in steps.iter().enumerate() {
         let prev_read: &[String] = if i == 0 { &[] } else { &read_ok[i - 1] };
-        read_ok.push(invariant(&models[i], &full, s, &duts[i], prev_read, lay, phases, solver, timeout_s)?);
+        let q = Query::new(&models[i], &full, s, &duts[i], &plan, prev_read, lay, phases);
+        read_ok.push(invariant(&q, s, solver, timeout_s)?);
     }
 
     // one query per signal of each step, one for its carried fields, one for the ports
@@ -423,10 +484,41 @@ pub fn prove(
     if only.is_empty() {
         jobs.push(Job { step: None, goal: Goal::Ports });
     }
-    let queue = std::sync::Mutex::new(0usize);
-    let results: std::sync::Mutex<Vec<Option<Result<StepProof, String>>>> =
-        std::sync::Mutex::new((0..jobs.len()).map(|_| None).collect());
     let progress = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let results = par_map(&jobs, threads, |job| {
+        let r = match job.step {
+            Some(i) => {
+                let s = &steps[i];
+                let prev_read: &[String] = if i == 0 { &[] } else { &read_ok[i - 1] };
+                Query::new(&models[i], &full, s, &duts[i], &plan, prev_read, lay, phases)
+                    .run(&job.goal, solver, timeout_s)
+            }
+            None => run_ports(last, &ports_dut, lay, solver, timeout_s),
+        };
+        if progress {
+            if let Ok(p) = &r {
+                eprintln!(
+                    "equiv: {} {}: {} ({:.1} s)",
+                    job.step.map_or("ports".into(), |i| format!("stage {}", steps[i].lo)),
+                    goal_file(&job.goal),
+                    p.verdict.result,
+                    p.verdict.seconds
+                );
+            }
+        }
+        r
+    });
+    let mut all = module_proofs;
+    for r in results {
+        all.push(r?);
+    }
+    Ok(Proof { steps: all, plan })
+}
+
+/// `f` over `items` on `threads` threads; the results in order.
+fn par_map<T: Sync, R: Send>(items: &[T], threads: usize, f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    let queue = std::sync::Mutex::new(0usize);
+    let results: std::sync::Mutex<Vec<Option<R>>> = std::sync::Mutex::new((0..items.len()).map(|_| None).collect());
     std::thread::scope(|sc| {
         for _ in 0..threads.max(1) {
             sc.spawn(|| loop {
@@ -436,51 +528,62 @@ pub fn prove(
                     *q += 1;
                     j
                 };
-                let Some(job) = jobs.get(j) else { break };
-                let r = match job.step {
-                    Some(i) => {
-                        let s = &steps[i];
-                        let prev_read: &[String] = if i == 0 { &[] } else { &read_ok[i - 1] };
-                        Query::new(&models[i], &full, s, &duts[i], prev_read, lay, phases)
-                            .run(&job.goal, solver, timeout_s)
-                    }
-                    None => run_ports(last, &ports_dut, lay, solver, timeout_s),
-                };
-                if progress {
-                    if let Ok(p) = &r {
-                        eprintln!(
-                            "equiv: {} {}: {} ({:.1} s)",
-                            job.step.map_or("ports".into(), |i| format!("stage {}", steps[i].lo)),
-                            goal_file(&job.goal),
-                            p.verdict.result,
-                            p.verdict.seconds
-                        );
-                    }
-                }
+                let Some(item) = items.get(j) else { break };
+                let r = f(item);
                 results.lock().expect("results")[j] = Some(r);
             });
         }
     });
-    results.into_inner().expect("results").into_iter().map(|r| r.expect("every job ran")).collect()
+    results.into_inner().expect("results").into_iter().map(|r| r.expect("every item ran")).collect()
+}
+
+/// Proves each abstraction group's module alone; a group not proven (a counterexample, a
+/// timeout) leaves its instances concrete.
+fn justify(plan: &mut Plan, n: &Netlist, m: &Model, set: &Settings, work: &Path) -> Result<Vec<StepProof>, String> {
+    let (solver, timeout_s, threads) = (set.solver.as_str(), set.timeout_s, set.threads);
+    let groups: Vec<usize> = (0..plan.groups.len()).collect();
+    let p: &Plan = plan;
+    let proofs = par_map(&groups, threads, |&g| -> Result<StepProof, String> {
+        let group = &p.groups[g];
+        let (q, values) = abstraction::justification(p, group, &n.dut, m, work, &format!("module{g}"))?;
+        let terms: Vec<String> = values.iter().map(|v| v.1.clone()).collect();
+        let v = check_kept(&q, solver, timeout_s, &terms, &format!("module{g}"))?;
+        let witness = if v.result == "sat" {
+            values.iter().map(|(label, t)| (label.clone(), v.value(t))).collect()
+        } else {
+            Vec::new()
+        };
+        Ok(StepProof {
+            stages: None,
+            method: format!("the module alone, every a and b ({} instances)", group.instances.len()),
+            goal: Goal::Module(g, p.statement(group)),
+            verdict: v,
+            witness,
+        })
+    })
+    .into_iter()
+    .collect::<Result<Vec<_>, _>>()?;
+    for pr in &proofs {
+        let Goal::Module(g, _) = &pr.goal else { continue };
+        if pr.verdict.result != "unsat" && !(set.trust_unfinished && pr.verdict.result == "unknown") {
+            let why = if pr.verdict.result == "sat" {
+                let w: Vec<String> = pr.witness.iter().map(|(k, v)| format!("{k}={v:#x}")).collect();
+                format!("its module alone is not the operation ({})", w.join(" "))
+            } else {
+                format!("its module alone was not proven the operation ({})", pr.verdict.result)
+            };
+            plan.drop_group(*g, &why);
+        }
+    }
+    Ok(proofs)
 }
 
 /// The inputs of `s`'s next row that hold read values in every state the step reaches from
 /// a previous row whose `prev_read` inputs do (a Houdini-style fixpoint: drop the fields a
 /// counterexample violates and ask again).
-#[allow(clippy::too_many_arguments)]
-fn invariant(
-    m: &Model,
-    full: &Model,
-    s: &Step,
-    dut: &StepDut,
-    prev_read: &[String],
-    lay: &Layout,
-    phases: Option<u32>,
-    solver: &str,
-    timeout_s: f64,
-) -> Result<Vec<String>, String> {
+fn invariant(q: &Query, s: &Step, solver: &str, timeout_s: f64) -> Result<Vec<String>, String> {
     let Some(reg) = &s.next.inputs else { return Ok(Vec::new()) };
-    let q = Query::new(m, full, s, dut, prev_read, lay, phases);
+    let (full, lay) = (q.full, q.lay);
     let mut cand: Vec<String> =
         full.inputs.iter().filter(|x| lay.inputs.iter().any(|f| &f.name == *x)).cloned().collect();
     while !cand.is_empty() {
@@ -516,23 +619,26 @@ struct Query<'a> {
     full: &'a Model,
     s: &'a Step<'a>,
     dut: &'a StepDut,
+    plan: &'a Plan,
     lay: &'a Layout,
     prev_read: &'a [String],
     p: u32,
 }
 
 impl<'a> Query<'a> {
+    #[allow(clippy::too_many_arguments)]
     fn new(
         m: &'a Model,
         full: &'a Model,
         s: &'a Step<'a>,
         dut: &'a StepDut,
+        plan: &'a Plan,
         prev_read: &'a [String],
         lay: &'a Layout,
         phases: Option<u32>,
     ) -> Self {
         let p = phases.unwrap_or(s.next.edges.saturating_sub(1)).max(1);
-        Query { m, full, s, dut, lay, prev_read, p }
+        Query { m, full, s, dut, plan, lay, prev_read, p }
     }
 
     fn nx(&self, reg: &str, st: &str) -> String {
@@ -618,6 +724,8 @@ impl<'a> Query<'a> {
                 let _ = writeln!(q, "(assert (|{md}_t| rp_s{} rp_s{t}))", t - 1);
             }
         }
+        let sts: Vec<String> = (0..=states).map(|t| format!("rp_s{t}")).collect();
+        q += &self.plan.assumptions(md, &self.dut.present, &sts);
         if s.bmc() {
             let p = self.p;
             let _ = writeln!(q, "(declare-const rp_c (_ BitVec 16))");
@@ -699,7 +807,7 @@ impl<'a> Query<'a> {
                     format!("(or {})", ors.join(" "))
                 }
             }
-            Goal::Ports => unreachable!("ports are run_ports'"),
+            Goal::Ports | Goal::Module(..) => unreachable!("ports are run_ports', modules justify's"),
         };
         if s.bmc() {
             values.push("rp_c".into());
@@ -736,6 +844,7 @@ fn goal_file(g: &Goal) -> String {
         Goal::Signal(s) => s.clone(),
         Goal::Carried => "carried".into(),
         Goal::Ports => "ports".into(),
+        Goal::Module(g, _) => format!("module{g}"),
     }
 }
 

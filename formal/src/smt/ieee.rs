@@ -157,11 +157,17 @@ impl IeeeSmt {
     }
 
     /// Declares `name` as the result of one rounded operation `op` (`fp.add`, `fp.sub`,
-    /// `fp.mul`, `fp.div`) of encodings `a` and `b`, with its tying assertion.
-    pub fn result(&self, out: &mut String, name: &str, op: &str, a: &str, b: &str) {
+    /// `fp.mul`, `fp.div`) of encodings `a` and `b`, with its tying assertion. `raw` maps an
+    /// operand that is an input's read (`rp_read in_x`) to the input as received (`in_x`): its
+    /// value is the same (a NaN read is still NaN, a flushed one flushes again to the same), and
+    /// a DUT that computes on the received encoding then meets the same term.
+    pub fn result(&self, out: &mut String, name: &str, op: &str, a: &str, b: &str, raw: &dyn Fn(&str) -> String) {
         let _ = writeln!(out, "(declare-const {name} {})", self.bv_sort());
-        let _ =
-            writeln!(out, "(assert (rp_res {name} ({op} RNE (rp_fp (rp_flush {a})) (rp_fp (rp_flush {b}))) {a} {b}))");
+        let (fa, fb) = (raw(a), raw(b));
+        let _ = writeln!(
+            out,
+            "(assert (rp_res {name} ({op} RNE (rp_fp (rp_flush {fa})) (rp_fp (rp_flush {fb}))) {a} {b}))"
+        );
     }
 
     /// The encoding of 1.
@@ -171,15 +177,15 @@ impl IeeeSmt {
 
     /// Declares the terms of `name = a ÷ b` per the division mode (`name!q` holds the
     /// reciprocal in `recip` mode) and returns the term of the quotient.
-    pub fn div(&self, out: &mut String, name: &str, a: &str, b: &str) -> String {
+    pub fn div(&self, out: &mut String, name: &str, a: &str, b: &str, raw: &dyn Fn(&str) -> String) -> String {
         match self.div {
             DivMode::Divide => {
-                self.result(out, &format!("{name}!r"), "fp.div", a, b);
+                self.result(out, &format!("{name}!r"), "fp.div", a, b, raw);
             }
             DivMode::RecipMul => {
                 let one = self.lit(self.one());
-                self.result(out, &format!("{name}!q"), "fp.div", &one, b);
-                self.result(out, &format!("{name}!r"), "fp.mul", a, &format!("{name}!q"));
+                self.result(out, &format!("{name}!q"), "fp.div", &one, b, raw);
+                self.result(out, &format!("{name}!r"), "fp.mul", a, &format!("{name}!q"), raw);
             }
         }
         format!("{name}!r")

@@ -114,7 +114,15 @@ fn float_of<F: Format>(f: &F) -> Result<IeeeSmt, String> {
 
 fn emit_in<F: Format>(req: &Request, f: &F, cut: Option<(u8, u8)>) -> Result<Model, String> {
     let x = float_of(f)?;
-    let mut e = Emitter { x, text: String::new(), signals: Vec::new(), flags: Vec::new(), stages: Vec::new(), cut };
+    let mut e = Emitter {
+        x,
+        text: String::new(),
+        signals: Vec::new(),
+        flags: Vec::new(),
+        stages: Vec::new(),
+        cut,
+        reads: Vec::new(),
+    };
     let _ = writeln!(
         e.text,
         "; raypipe {} SMT-LIB 2 model of the {:?} unit in {}",
@@ -181,6 +189,8 @@ struct Emitter {
     stages: Vec<u8>,
     /// Emitting stages `lo..=hi` only (see [`emit_stage_range`]).
     cut: Option<(u8, u8)>,
+    /// Signals defined as an input's read, with the input (`in_x`).
+    reads: Vec<(String, String)>,
 }
 
 impl Emitter {
@@ -192,6 +202,7 @@ impl Emitter {
         }
         for n in names.iter().filter(|n| !read_by_table.contains(n)) {
             let _ = writeln!(self.text, "(define-fun {n} () {b} (rp_read in_{n}))");
+            self.reads.push((n.to_string(), format!("in_{n}")));
         }
         let _ = writeln!(self.text, "(define-fun one () {b} {})", self.x.lit(self.x.one()));
         let _ = writeln!(self.text, "(define-fun zero () {b} {})", self.x.lit(0));
@@ -209,16 +220,29 @@ impl Emitter {
         self.flags.push(true);
     }
 
+    /// An operation's operand as its floating-point value is taken: an input's read as the
+    /// input received (see [`IeeeSmt::result`]).
+    fn raw(&self) -> impl Fn(&str) -> String + '_ {
+        |s: &str| self.reads.iter().find(|r| r.0 == s).map_or_else(|| s.to_string(), |r| r.1.clone())
+    }
+
     fn arith(&mut self, name: &str, op: Op, a: &str, b: &str) -> String {
         let x = self.x;
+        let mut text = std::mem::take(&mut self.text);
+        let r = self.arith_into(&mut text, x, name, op, a, b);
+        self.text = text;
+        r
+    }
+
+    fn arith_into(&self, text: &mut String, x: IeeeSmt, name: &str, op: Op, a: &str, b: &str) -> String {
         let fop = match op {
             Op::Add => "fp.add",
             Op::Sub => "fp.sub",
             Op::Mul => "fp.mul",
-            Op::Div => return x.div(&mut self.text, name, a, b),
+            Op::Div => return x.div(text, name, a, b, &self.raw()),
             Op::Logic => unreachable!("a logic row has no arithmetic"),
         };
-        x.result(&mut self.text, &format!("{name}!r"), fop, a, b);
+        x.result(text, &format!("{name}!r"), fop, a, b, &self.raw());
         format!("{name}!r")
     }
 
@@ -264,7 +288,10 @@ impl Emitter {
                 let t = if guard { format!("(ite (rp_gsub {} {} {r}) {cnan} {r})", d.a, d.b) } else { r };
                 self.value(d.name, &t);
             }
-            Rule::Read(i) => self.value(d.name, &format!("(rp_read {i})")),
+            Rule::Read(i) => {
+                self.value(d.name, &format!("(rp_read {i})"));
+                self.reads.push((d.name.to_string(), i.to_string()));
+            }
             Rule::Prep(v) => {
                 let cfg = env.slab.ok_or("Prep outside the slab unit")?;
                 match cfg.prep {
@@ -273,7 +300,7 @@ impl Emitter {
                         // |v| < δ ? (sign(v) ? 0 ⊖ δ : δ) : v
                         let delta = self.x.lit(env.delta);
                         let neg = format!("{}!negdelta", d.name);
-                        self.x.result(&mut self.text, &neg, "fp.sub", "zero", &delta);
+                        self.x.result(&mut self.text, &neg, "fp.sub", "zero", &delta, &|s: &str| s.to_string());
                         let t = format!("(ite (rp_lt (rp_abs {v}) {delta}) (ite (rp_neg {v}) {neg} {delta}) {v})");
                         self.value(d.name, &t);
                     }
