@@ -294,7 +294,11 @@ module raypipe_slab_hf
   assign o.t_far = rs7.t_far;
   assign out_row = o;
   assign stg_row = rs7;
+`ifdef RAYPIPE_HF_FAULT_VALID_EARLY
+  assign out_valid = v6;  // a fault: out_valid one edge before its row
+`else
   assign out_valid = v7;
+`endif
 `undef RAYPIPE_HF_IN_T
 `undef RAYPIPE_HF_STG_T
 endmodule

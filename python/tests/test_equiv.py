@@ -119,23 +119,29 @@ def test_pipelined_slab_fp16_is_equivalent(tmp_path):
         fields = [x["name"] for x in json.load(f)["stages"]]
     proven = [x["goal"] for x in steps if x["stages"] not in ("module", "ports") and not x["goal"].startswith("(")]
     assert sorted(proven) == sorted(fields), (proven, fields)
+    [lat] = [x for x in steps if x["stages"] == "valid"]
+    assert lat["goal"] == "(out_valid 21 edges after in_valid, entries 1..=1)", lat
     assert sorted(j["abstraction"]["instances"]) == sorted(
         ["u_ndelta"] + [f"u_{k}{a}" for k in ("lo", "hi", "tlo", "thi") for a in "xyz"])
     assert j["abstraction"]["concrete"] == []
 
 
 def test_pipelined_slab_fp16_faults(tmp_path):
-    """Three RTL faults: a swapped subtract (abstracted: the step finds it), a multiplier
+    """Four RTL faults: a swapped subtract (abstracted: the step finds it), a multiplier
     rounding up (its module with rm=011 is not the operation: left concrete, and the step
-    finds it) and a strict compare; the subtract's witness is checked by float arithmetic."""
+    finds it), a strict compare and out_valid one edge early; the subtract's witness is checked
+    by float arithmetic."""
     s = slab_set(tmp_path)
     rc, j = equiv("--define", "RAYPIPE_HF_FAULT_LOX_SWAP", "--define", "RAYPIPE_HF_FAULT_HIT_STRICT",
-                  "--define", "RAYPIPE_HF_FAULT_THIZ_RUP", s,
+                  "--define", "RAYPIPE_HF_FAULT_THIZ_RUP", "--define", "RAYPIPE_HF_FAULT_VALID_EARLY", s,
                   "--outputs", "lox,hix,thiz,hit", "--phases", "1", "--timeout", "300")
     assert (rc, j["status"]) == (1, "COUNTEREXAMPLE"), j
     res = {x["goal"]: x for x in j["steps"]}
     assert res["hix"]["result"] == "unsat"
     assert res["lox"]["result"] == "sat" and res["hit"]["result"] == "sat" and res["thiz"]["result"] == "sat"
+    # out_valid one edge early: the latency query (always run) finds it
+    [lat] = [x for x in j["steps"] if x["stages"] == "valid"]
+    assert lat["result"] == "sat", lat
     [rup] = [x for x in j["steps"] if x["stages"] == "module" and "rm=011" in x["goal"]]
     assert rup["result"] == "sat", rup
     assert [c["instance"] for c in j["abstraction"]["concrete"]] == ["u_thiz"], j["abstraction"]

@@ -341,11 +341,13 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
         Goal::Carried => "(carried fields)".to_string(),
         Goal::Ports => "(out_row, stg_row)".to_string(),
         Goal::Module(_, s) => s.clone(),
+        Goal::Latency(l, p) => format!("(out_valid {l} edges after in_valid, entries 1..={p})"),
     };
     let stages_of = |p: &formal::equiv::stages::StepProof| match (p.stages, &p.goal) {
         (Some((lo, hi)), _) if lo == hi => format!("{lo}"),
         (Some((lo, hi)), _) => format!("{lo}..={hi}"),
         (None, Goal::Module(..)) => "module".into(),
+        (None, Goal::Latency(..)) => "valid".into(),
         (None, _) => "ports".into(),
     };
     let hex = |v: u64| format!("{v:#x}");

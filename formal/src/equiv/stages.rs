@@ -119,6 +119,9 @@ pub enum Goal {
     Ports,
     /// An abstracted module alone equals its operation (the group's index, the statement).
     Module(usize, String),
+    /// `out_valid` rises exactly with the transactions' rows: the latency (edges) and the
+    /// entry cycles checked.
+    Latency(u32, u32),
 }
 
 /// One query's verdict.
@@ -481,9 +484,16 @@ pub fn prove(
             jobs.push(Job { step: Some(i), goal: Goal::Carried });
         }
     }
+    // the latency: the rows' edges from in_row (the last row's fields are on out_row)
+    let latency: u32 = rows.iter().map(|r| r.edges).sum();
+    let entries = phases.unwrap_or_else(|| rows.iter().map(|r| r.edges.saturating_sub(1)).max().unwrap_or(1)).max(1);
     if only.is_empty() {
         jobs.push(Job { step: None, goal: Goal::Ports });
     }
+    // (the latency always: a small circuit)
+    jobs.push(Job { step: None, goal: Goal::Latency(latency, entries) });
+    let valid_dut =
+        step_smt(n, &Plan::default(), &[], &[], &["rst_n", "in_valid", "out_valid"], false, false, work, "valid")?;
     let progress = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let results = par_map(&jobs, threads, |job| {
         let r = match job.step {
@@ -493,7 +503,10 @@ pub fn prove(
                 Query::new(&models[i], &full, s, &duts[i], &plan, prev_read, lay, phases)
                     .run(&job.goal, solver, timeout_s)
             }
-            None => run_ports(last, &ports_dut, lay, solver, timeout_s),
+            None => match &job.goal {
+                Goal::Latency(l, p) => run_latency(&valid_dut, *l, *p, solver, timeout_s),
+                _ => run_ports(last, &ports_dut, lay, solver, timeout_s),
+            },
         };
         if progress {
             if let Ok(p) = &r {
@@ -807,7 +820,9 @@ impl<'a> Query<'a> {
                     format!("(or {})", ors.join(" "))
                 }
             }
-            Goal::Ports | Goal::Module(..) => unreachable!("ports are run_ports', modules justify's"),
+            Goal::Ports | Goal::Module(..) | Goal::Latency(..) => {
+                unreachable!("ports are run_ports', modules justify's, the latency run_latency's")
+            }
         };
         if s.bmc() {
             values.push("rp_c".into());
@@ -844,6 +859,7 @@ fn goal_file(g: &Goal) -> String {
         Goal::Signal(s) => s.clone(),
         Goal::Carried => "carried".into(),
         Goal::Ports => "ports".into(),
+        Goal::Latency(..) => "latency".into(),
         Goal::Module(g, _) => format!("module{g}"),
     }
 }
@@ -866,6 +882,34 @@ fn check_kept(q: &str, solver: &str, timeout_s: f64, values: &[String], name: &s
         }),
         Err(e) => Err(e),
     }
+}
+
+/// `out_valid` against `in_valid` by bounded model checking from reset: cycle 0 has `rst_n`
+/// low, cycles 1..=P + L high, `in_valid` free in every cycle; `out_valid` is low in cycles
+/// 1..=L (nothing entered before reset was released) and in cycle c + L equals `in_valid` in
+/// cycle c, for c in 1..=P.
+fn run_latency(dut: &StepDut, l: u32, p: u32, solver: &str, timeout_s: f64) -> Result<StepProof, String> {
+    let md = &dut.module;
+    let nx = |w: &str, t: u32| format!("(|{md}_n {w}| rp_s{t})");
+    let mut q = format!("(set-logic QF_BV)\n{}", dut.text);
+    for t in 0..=p + l {
+        let _ = writeln!(q, "(declare-const rp_s{t} |{md}_s|)\n(assert (|{md}_h| rp_s{t}))");
+        if t > 0 {
+            let _ = writeln!(q, "(assert (|{md}_t| rp_s{} rp_s{t}))\n(assert {})", t - 1, nx("rst_n", t));
+        }
+    }
+    let _ = writeln!(q, "(assert (not {}))", nx("rst_n", 0));
+    let mut ors: Vec<String> = (1..=l).map(|t| nx("out_valid", t)).collect();
+    ors.extend((1..=p).map(|c| format!("(not (= {} {}))", nx("out_valid", c + l), nx("in_valid", c))));
+    let _ = writeln!(q, "(assert (or {}))", ors.join(" "));
+    let v = check_kept(&q, solver, timeout_s, &[], "latency")?;
+    Ok(StepProof {
+        stages: None,
+        method: format!("bmc from reset, {} cycles", p + l),
+        goal: Goal::Latency(l, p),
+        verdict: v,
+        witness: Vec::new(),
+    })
 }
 
 fn run_ports(last: &Row, dut: &StepDut, lay: &Layout, solver: &str, timeout_s: f64) -> Result<StepProof, String> {
