@@ -184,6 +184,19 @@ pub fn plan(abs: &[Abstraction], dump: &str, wire_width: &dyn Fn(&str) -> Option
     p
 }
 
+/// The `--abstract` modules no cell of the DUT instantiates (a misspelt name).
+pub fn unmatched(abs: &[Abstraction], dump: &str) -> Vec<String> {
+    abs.iter()
+        .filter(|a| {
+            !dump.lines().any(|l| {
+                let w: Vec<&str> = l.split_whitespace().collect();
+                matches!(w.as_slice(), ["cell", t, _] if is_module(t, &a.module))
+            })
+        })
+        .map(|a| a.module.clone())
+        .collect()
+}
+
 /// The IEEE operation an instance is assumed to compute: the value (a FloatingPoint term) of
 /// `a`, `b`.
 fn op_term(op: Op, sub: bool, a: &str, b: &str) -> String {
@@ -405,5 +418,7 @@ mod tests {
         assert!(p.concrete[0].1.contains("not tied to a constant"));
         assert!(p.concrete[1].1.contains("no 16-bit wire u_gone.a"));
         assert_eq!(p.statement(&p.groups[2]), "hf_add (sub=1): y = a − b, rounded to nearest-even");
+        let typo = [parse("hf_mul=mul").unwrap(), parse("hf_mull=mul").unwrap()];
+        assert_eq!(unmatched(&typo, dump), ["hf_mull"]);
     }
 }

@@ -420,6 +420,9 @@ pub fn prove(
     let rows = check_rows(rows, n, lay, &full)?;
     // operator abstraction: each group's module proven alone first (a group not proven stays
     // concrete), then cut out of the steps
+    if let Some(m) = abstraction::unmatched(&n.abstractions, &n.cells).first() {
+        return Err(format!("--abstract {m}: no cell of the DUT instantiates module {m}"));
+    }
     let mut plan = abstraction::plan(&n.abstractions, &n.cells, &|w| n.width(w), full.float.width());
     let module_proofs = justify(&mut plan, n, &full, set, work)?;
     let first_stage = *full.stages.iter().min().unwrap_or(&0);
