@@ -19,7 +19,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::{push_script, quote, read_script, run_yosys, Dut};
+use super::{bare_path, push_script, read_script, top_module, write_smt2, Dut};
 use crate::smt::Model;
 
 /// The operation an abstracted module computes.
@@ -99,11 +99,7 @@ pub fn list_cells(abs: &[Abstraction], file: &Path) -> Result<String, String> {
     if abs.is_empty() {
         return Ok(String::new());
     }
-    // (yosys's tee takes the file name as is: no quotes)
-    let f = file.display().to_string();
-    if f.contains(|c: char| c.is_whitespace() || c == '"') {
-        return Err(format!("the scratch directory {f} has a space or a quote in its path: set TMPDIR"));
-    }
+    let f = bare_path(file)?;
     let pats: Vec<String> = abs.iter().map(|a| format!("t:*{}*", a.module)).collect();
     Ok(format!("tee -q -o {f} dump {}\n", pats.join(" ")))
 }
@@ -125,21 +121,7 @@ fn const_bits(v: &str) -> Option<String> {
 /// instances are abstracted (`width`: the format's width).
 pub fn plan(abs: &[Abstraction], dump: &str, wire_width: &dyn Fn(&str) -> Option<u32>, width: u32) -> Plan {
     let mut p = Plan { abstractions: abs.to_vec(), ..Plan::default() };
-    // the cells: type, name, connections (port, value)
-    type Conns = Vec<(String, String)>;
-    let mut cells: Vec<(String, String, Conns)> = Vec::new();
-    for line in dump.lines() {
-        let w: Vec<&str> = line.split_whitespace().collect();
-        match w.as_slice() {
-            ["cell", t, n] => cells.push((t.to_string(), n.trim_start_matches('\\').to_string(), Vec::new())),
-            ["connect", port, value @ ..] => {
-                if let Some(c) = cells.last_mut() {
-                    c.2.push((port.trim_start_matches('\\').to_string(), value.join(" ")));
-                }
-            }
-            _ => {}
-        }
-    }
+    let cells = cells(dump);
     for (t, name, conns) in &cells {
         let Some(ai) = abs.iter().position(|a| is_module(t, &a.module)) else { continue };
         let mut why = None;
@@ -186,15 +168,29 @@ pub fn plan(abs: &[Abstraction], dump: &str, wire_width: &dyn Fn(&str) -> Option
 
 /// The `--abstract` modules no cell of the DUT instantiates (a misspelt name).
 pub fn unmatched(abs: &[Abstraction], dump: &str) -> Vec<String> {
-    abs.iter()
-        .filter(|a| {
-            !dump.lines().any(|l| {
-                let w: Vec<&str> = l.split_whitespace().collect();
-                matches!(w.as_slice(), ["cell", t, _] if is_module(t, &a.module))
-            })
-        })
-        .map(|a| a.module.clone())
-        .collect()
+    let cells = cells(dump);
+    abs.iter().filter(|a| !cells.iter().any(|c| is_module(&c.0, &a.module))).map(|a| a.module.clone()).collect()
+}
+
+/// A dumped cell: type, name, connections (port, value).
+type Cell = (String, String, Vec<(String, String)>);
+
+/// The cells of yosys's `dump`.
+fn cells(dump: &str) -> Vec<Cell> {
+    let mut cells: Vec<Cell> = Vec::new();
+    for line in dump.lines() {
+        let w: Vec<&str> = line.split_whitespace().collect();
+        match w.as_slice() {
+            ["cell", t, n] => cells.push((t.to_string(), n.trim_start_matches('\\').to_string(), Vec::new())),
+            ["connect", port, value @ ..] => {
+                if let Some(c) = cells.last_mut() {
+                    c.2.push((port.trim_start_matches('\\').to_string(), value.join(" ")));
+                }
+            }
+            _ => {}
+        }
+    }
+    cells
 }
 
 /// The IEEE operation an instance is assumed to compute: the value (a FloatingPoint term) of
@@ -313,19 +309,9 @@ pub fn justification(
     work: &Path,
     tag: &str,
 ) -> Result<(String, Vec<(String, String)>), String> {
-    let out = work.join(format!("{tag}.smt2"));
-    let mut s = read_script(d, &d.top, &[], &format!("hierarchy -top {}\n", g.cell_type))?;
-    let _ = writeln!(s, "write_smt2 -stbv {}", quote(&out));
-    run_yosys(&s, work, tag)?;
-    let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-    let module = text
-        .lines()
-        .find_map(|l| l.strip_prefix("; yosys-smt2-topmod "))
-        .ok_or("yosys wrote no top module")?
-        .split_whitespace()
-        .next()
-        .unwrap_or_default()
-        .to_string();
+    let s = read_script(d, &d.top, &[], &format!("hierarchy -top {}\n", g.cell_type))?;
+    let text = write_smt2(s, work, tag, tag)?;
+    let module = top_module(&text)?;
     let n = |p: &str| format!("(|{module}_n {p}| rp_s0)");
     let mut q = String::new();
     let _ = writeln!(q, "(set-logic QF_BVFP)");

@@ -187,12 +187,38 @@ pub(crate) fn quote(p: &Path) -> String {
 
 /// One yosys run: the sources (and `extra` files) elaborated under `top`, written as SMT-LIB.
 fn yosys_smt(d: &Dut, top: &str, extra: &[PathBuf], work: &Path) -> Result<DutSmt, String> {
-    let mut script = read_script(d, top, extra, "")?;
-    let out = work.join("dut.smt2");
-    let _ = writeln!(script, "write_smt2 -stbv {}", quote(&out));
-    run_yosys(&script, work, "equiv")?;
-    let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let text = write_smt2(read_script(d, top, extra, "")?, work, "equiv", "dut")?;
     parse(&text, top)
+}
+
+/// Runs `script` with `write_smt2 -stbv` appended (to `work/out.smt2`; the script as
+/// `work/tag.ys`) and returns what yosys wrote.
+pub(crate) fn write_smt2(mut script: String, work: &Path, tag: &str, out: &str) -> Result<String, String> {
+    let out = work.join(format!("{out}.smt2"));
+    let _ = writeln!(script, "write_smt2 -stbv {}", quote(&out));
+    run_yosys(&script, work, tag)?;
+    std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))
+}
+
+/// The top module's name in yosys's SMT-LIB output.
+pub(crate) fn top_module(text: &str) -> Result<String, String> {
+    Ok(text
+        .lines()
+        .find_map(|l| l.strip_prefix("; yosys-smt2-topmod "))
+        .ok_or("yosys wrote no top module")?
+        .split_whitespace()
+        .next()
+        .unwrap_or_default()
+        .to_string())
+}
+
+/// A scratch file's path as yosys's `tee -o` takes it (as is: no quotes, so no space).
+pub(crate) fn bare_path(p: &Path) -> Result<String, String> {
+    let f = p.display().to_string();
+    if f.contains(|c: char| c.is_whitespace() || c == '"') {
+        return Err(format!("the scratch directory {f} has a space or a quote in its path: set TMPDIR"));
+    }
+    Ok(f)
 }
 
 /// Reads the ports and registers of `top` from yosys's comments in `text`.

@@ -32,7 +32,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::abstraction::{self, Abstraction, Plan};
-use super::{push_script, quote, read_script, run_yosys, Dut};
+use super::{bare_path, push_script, quote, read_script, run_yosys, top_module, write_smt2, Dut};
 use crate::smt::{emit_stage_range, Model, Request};
 use crate::solver::{check, Verdict};
 
@@ -302,7 +302,6 @@ fn step_smt(
     work: &Path,
     tag: &str,
 ) -> Result<StepDut, String> {
-    let out = work.join(format!("{tag}.smt2"));
     let mut s = format!("read_rtlil {}\n", quote(&n.rtlil));
     for c in cut {
         let _ = writeln!(s, "cutpoint w:{c}");
@@ -310,10 +309,7 @@ fn step_smt(
     if !plan.instances.is_empty() && !next.is_empty() {
         // which abstracted instances feed the next row (one yosys run to list the cone)
         let list = work.join(format!("{tag}-cone.txt"));
-        let f = list.display().to_string();
-        if f.contains(|c: char| c.is_whitespace() || c == '"') {
-            return Err(format!("the scratch directory {f} has a space or a quote in its path: set TMPDIR"));
-        }
+        let f = bare_path(&list)?;
         run_yosys(&(s.clone() + &Plan::cone_script(next, &f)), work, &format!("{tag}-cone"))?;
         let listing = std::fs::read_to_string(&list).map_err(|e| format!("{f}: {e}"))?;
         s += &plan.step_script(&plan.in_cone(&listing));
@@ -326,17 +322,8 @@ fn step_smt(
     if bits {
         s += "simplemap t:$dff\nopt_clean\n";
     }
-    let _ = writeln!(s, "write_smt2 -stbv {}", quote(&out));
-    run_yosys(&s, work, tag)?;
-    let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-    let module = text
-        .lines()
-        .find_map(|l| l.strip_prefix("; yosys-smt2-topmod "))
-        .ok_or("yosys wrote no top module")?
-        .split_whitespace()
-        .next()
-        .unwrap_or_default()
-        .to_string();
+    let text = write_smt2(s, work, tag, tag)?;
+    let module = top_module(&text)?;
     let mut body = format!("; ---- the DUT ({tag}), as yosys wrote it\n");
     push_script(&mut body, &text);
     let mut next_bits = Vec::new();

@@ -157,13 +157,13 @@ impl IeeeSmt {
     }
 
     /// Declares `name` as the result of one rounded operation `op` (`fp.add`, `fp.sub`,
-    /// `fp.mul`, `fp.div`) of encodings `a` and `b`, with its tying assertion. `raw` maps an
-    /// operand that is an input's read (`rp_read in_x`) to the input as received (`in_x`): its
-    /// value is the same (a NaN read is still NaN, a flushed one flushes again to the same), and
-    /// a DUT that computes on the received encoding then meets the same term.
-    pub fn result(&self, out: &mut String, name: &str, op: &str, a: &str, b: &str, raw: &dyn Fn(&str) -> String) {
+    /// `fp.mul`, `fp.div`) of encodings `a` and `b`, with its tying assertion. Each operand is
+    /// (encoding, term taken as its value): an input's read (`rp_read in_x`) is taken as the
+    /// input received (`in_x`) — the same value (a NaN read is still NaN, a flushed one flushes
+    /// again to the same) — so a DUT that computes on the received encoding meets the same term.
+    pub fn result(&self, out: &mut String, name: &str, op: &str, a: (&str, &str), b: (&str, &str)) {
         let _ = writeln!(out, "(declare-const {name} {})", self.bv_sort());
-        let (fa, fb) = (raw(a), raw(b));
+        let ((a, fa), (b, fb)) = (a, b);
         let _ = writeln!(
             out,
             "(assert (rp_res {name} ({op} RNE (rp_fp (rp_flush {fa})) (rp_fp (rp_flush {fb}))) {a} {b}))"
@@ -177,15 +177,17 @@ impl IeeeSmt {
 
     /// Declares the terms of `name = a ÷ b` per the division mode (`name!q` holds the
     /// reciprocal in `recip` mode) and returns the term of the quotient.
-    pub fn div(&self, out: &mut String, name: &str, a: &str, b: &str, raw: &dyn Fn(&str) -> String) -> String {
+    /// Operands as in [`IeeeSmt::result`].
+    pub fn div(&self, out: &mut String, name: &str, a: (&str, &str), b: (&str, &str)) -> String {
         match self.div {
             DivMode::Divide => {
-                self.result(out, &format!("{name}!r"), "fp.div", a, b, raw);
+                self.result(out, &format!("{name}!r"), "fp.div", a, b);
             }
             DivMode::RecipMul => {
                 let one = self.lit(self.one());
-                self.result(out, &format!("{name}!q"), "fp.div", &one, b, raw);
-                self.result(out, &format!("{name}!r"), "fp.mul", a, &format!("{name}!q"), raw);
+                let q = format!("{name}!q");
+                self.result(out, &q, "fp.div", (&one, &one), b);
+                self.result(out, &format!("{name}!r"), "fp.mul", a, (&q, &q));
             }
         }
         format!("{name}!r")

@@ -220,30 +220,30 @@ impl Emitter {
         self.flags.push(true);
     }
 
-    /// An operation's operand as its floating-point value is taken: an input's read as the
-    /// input received (see [`IeeeSmt::result`]).
-    fn raw(&self) -> impl Fn(&str) -> String + '_ {
-        |s: &str| self.reads.iter().find(|r| r.0 == s).map_or_else(|| s.to_string(), |r| r.1.clone())
+    /// An operand as (encoding, term taken as its value): an input's read as the input
+    /// received (see [`IeeeSmt::result`]).
+    fn operand<'a>(&'a self, s: &'a str) -> (&'a str, &'a str) {
+        (s, self.reads.iter().find(|r| r.0 == s).map_or(s, |r| r.1.as_str()))
     }
 
     fn arith(&mut self, name: &str, op: Op, a: &str, b: &str) -> String {
-        let x = self.x;
-        let mut text = std::mem::take(&mut self.text);
-        let r = self.arith_into(&mut text, x, name, op, a, b);
-        self.text = text;
-        r
-    }
-
-    fn arith_into(&self, text: &mut String, x: IeeeSmt, name: &str, op: Op, a: &str, b: &str) -> String {
-        let fop = match op {
-            Op::Add => "fp.add",
-            Op::Sub => "fp.sub",
-            Op::Mul => "fp.mul",
-            Op::Div => return x.div(text, name, a, b, &self.raw()),
+        let (x, mut text) = (self.x, String::new());
+        let (a, b) = (self.operand(a), self.operand(b));
+        let r = match op {
+            Op::Div => x.div(&mut text, name, a, b),
+            Op::Add | Op::Sub | Op::Mul => {
+                let fop = match op {
+                    Op::Add => "fp.add",
+                    Op::Sub => "fp.sub",
+                    _ => "fp.mul",
+                };
+                x.result(&mut text, &format!("{name}!r"), fop, a, b);
+                format!("{name}!r")
+            }
             Op::Logic => unreachable!("a logic row has no arithmetic"),
         };
-        x.result(text, &format!("{name}!r"), fop, a, b, &self.raw());
-        format!("{name}!r")
+        self.text += &text;
+        r
     }
 
     fn row(&mut self, d: &SigDef, env: &Env) -> Result<(), String> {
@@ -300,7 +300,7 @@ impl Emitter {
                         // |v| < δ ? (sign(v) ? 0 ⊖ δ : δ) : v
                         let delta = self.x.lit(env.delta);
                         let neg = format!("{}!negdelta", d.name);
-                        self.x.result(&mut self.text, &neg, "fp.sub", "zero", &delta, &|s: &str| s.to_string());
+                        self.x.result(&mut self.text, &neg, "fp.sub", ("zero", "zero"), (&delta, &delta));
                         let t = format!("(ite (rp_lt (rp_abs {v}) {delta}) (ite (rp_neg {v}) {neg} {delta}) {v})");
                         self.value(d.name, &t);
                     }
