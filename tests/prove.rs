@@ -1,6 +1,7 @@
-//! `raypipe prove history-equals-stack` from the command line: PROVEN exits 0 with its theorem,
-//! a mutant's counterexample exits 1 and shows the two traversals' different leaves, and a
-//! request that does not apply exits 2. (The solver-backed properties are tested in
+//! `raypipe prove history-equals-stack` and `rti-bound` from the command line: PROVEN exits 0
+//! with its theorem, a mutant's counterexample exits 1 and shows the two traversals' different
+//! leaves (history) or a whole RTI input outside the mutated bound that `raypipe explain`
+//! replays (rti-bound), and a request that does not apply exits 2. (The solver-backed properties are tested in
 //! python/tests/test_prove.py, where the solvers are installed.)
 
 mod common;
@@ -80,5 +81,67 @@ fn the_directed_slab_never_misses_in_small_formats_without_a_solver() {
     ] {
         let o = raypipe(args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    }
+}
+
+#[test]
+fn rti_bound_is_proven_for_a_small_format_and_its_mutants_are_refuted() {
+    let o = raypipe(&["prove", "rti-bound", "--format", "e5m6", "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["status"], "PROVEN");
+    let ops: Vec<&str> = j["lemmas"].as_array().unwrap().iter().map(|l| l["op"].as_str().unwrap()).collect();
+    assert_eq!(ops, ["add", "sub", "mul", "recip"]);
+    // every finite pair: (2^12 − 2·2^6)² = 3968² pairs of e5m6, split into finite and not
+    for l in &j["lemmas"].as_array().unwrap()[..3] {
+        let n = l["pairs"].as_u64().unwrap() + l["not_finite"].as_u64().unwrap();
+        assert_eq!(n, 3968 * 3968, "{l}");
+        assert!(l["worst_ratio"].as_f64().unwrap() < 1.0);
+    }
+    let o = raypipe(&["prove", "rti-bound", "--format", "e5m6:divide", "--json", "--threads", "1"]);
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!((o.status.code(), j["lemmas"][3]["op"].as_str()), (Some(0), Some("div")));
+    for (m, format) in [("no-eta", "e5m6"), ("u-sixteenth", "fp16")] {
+        let o = raypipe(&["prove", "rti-bound", "--format", format, "--mutant", m, "--json"]);
+        assert_eq!(o.status.code(), Some(1), "{m}: {}", String::from_utf8_lossy(&o.stderr));
+        let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(j["status"], "COUNTEREXAMPLE");
+        let bad: Vec<&serde_json::Value> =
+            j["witness"].as_array().unwrap().iter().filter(|c| c["holds"] == false).collect();
+        assert!(!bad.is_empty(), "{m}: {j}");
+        // the printed command replays the input: the model's t' is the witness's, and the
+        // exact t' (the binary64 twin is exact here: one product of two fp16 values) differs
+        // from it by more than the mutated bound
+        let cmd = j["explain"].as_str().unwrap();
+        let args: Vec<&str> = cmd.split_whitespace().skip(1).chain(["--json"]).collect();
+        let e = raypipe(&args);
+        assert_eq!(e.status.code(), Some(0), "{cmd}");
+        let ej: serde_json::Value = serde_json::from_slice(&e.stdout).unwrap();
+        let tp = ej["signals"].as_array().unwrap().iter().find(|s| s["name"] == "tp").unwrap();
+        let w = bad.iter().find(|c| c["quantity"] == "tp").expect("t' outside");
+        let bits = |s: &str| u64::from_str_radix(s.trim_start_matches("0x"), 16).unwrap();
+        assert_eq!(bits(tp["bits"].as_str().unwrap()), bits(w["model_bits"].as_str().unwrap()), "{m}: {tp}");
+        let model: f64 = tp["value"].as_str().unwrap().parse().unwrap();
+        assert!((model - w["exact"].as_f64().unwrap()).abs() > w["bound"].as_f64().unwrap());
+    }
+}
+
+#[test]
+fn rti_bound_requests_that_do_not_apply_exit_2() {
+    for args in [
+        &["prove", "rti-bound", "--format", "bf16"][..],
+        &["prove", "rti-bound", "--format", "f32"],
+        &["prove", "rti-bound", "--format", "fp16:ftz"],
+        &["prove", "rti-bound", "--format", "q8.8"],
+        &["prove", "rti-bound", "--format", "nope"],
+        &["prove", "rti-bound", "--variant", "conservative"],
+        &["prove", "rti-bound", "--no-guard"],
+        &["prove", "rti-bound", "--mutant", "ties-right"],
+        &["prove", "rti-bound", "--out", "target/never-written"],
+    ] {
+        let o = raypipe(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
 }

@@ -1,5 +1,6 @@
 //! `raypipe prove`: prove one of raypipe's guarantees (docs/proofs.md): by SMT solver and
-//! enumeration (slab-never-misses) or explicit-state search (history-equals-stack).
+//! enumeration (slab-never-misses), enumeration and a written composition (rti-bound) or
+//! explicit-state search (history-equals-stack).
 //! Exit 0 PROVEN, 1 counterexample, 3 unknown (timeout: nothing proven).
 
 use super::prelude::*;
@@ -8,10 +9,11 @@ use datapath::Format;
 /// The options of `raypipe prove`.
 #[derive(clap::Args, Clone)]
 pub struct Args {
-    /// Property: slab-never-misses, history-equals-stack.
+    /// Property: slab-never-misses, rti-bound, history-equals-stack.
     pub property: String,
-    /// Format of slab-never-misses (default fp16): floats of at most 16 bits (fp16, bf16, eEmM);
+    /// Format (default fp16). slab-never-misses: floats of at most 16 bits (fp16, bf16, eEmM);
     /// with --variant directed also saturating fixed point of at most 16 bits (q8.8, ...).
+    /// rti-bound: fp16 and small eEmM without FTZ, recip-mul or :divide.
     #[arg(long)]
     pub format: Option<String>,
     /// Slab variant of slab-never-misses: conservative (default) or directed.
@@ -26,8 +28,9 @@ pub struct Args {
     /// history-equals-stack: also offer NaN entry distances (checks that NaN orders as a tie).
     #[arg(long)]
     pub nan: bool,
-    /// history-equals-stack: a mutant of the control logic the proof must refute
-    /// (resume-shallowest, no-reset-deeper, no-mark-split, one-pass, ties-right, no-mark-pass).
+    /// A mutant the proof must refute. history-equals-stack: of the control logic
+    /// (resume-shallowest, no-reset-deeper, no-mark-split, one-pass, ties-right, no-mark-pass);
+    /// rti-bound: of the error model (no-eta, u-sixteenth).
     #[arg(long)]
     pub mutant: Option<String>,
     /// Slab variant changes (a mutant the proof must refute).
@@ -56,8 +59,11 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     if a.property == "history-equals-stack" {
         return history(&a);
     }
+    if a.property == "rti-bound" {
+        return rti_bound(&a);
+    }
     if a.mutant.is_some() || a.nan {
-        return Err("--mutant and --nan belong to history-equals-stack".into());
+        return Err("--mutant belongs to history-equals-stack and rti-bound, --nan to history-equals-stack".into());
     }
     if let Some(out) = &a.out {
         // before the work: never overwrite what raypipe did not write
@@ -71,7 +77,9 @@ pub fn run(a: Args) -> Result<Outcome, String> {
             formal::prove::slab::prove(&req, &a.solver, a.timeout, threads(a.threads))?
         }
         other => {
-            return Err(format!("unknown property '{other}'; properties: slab-never-misses, history-equals-stack"))
+            return Err(format!(
+                "unknown property '{other}'; properties: slab-never-misses, rti-bound, history-equals-stack"
+            ))
         }
     };
     let explain = (p.verdict.result == "sat").then(|| explain_command(&format, &variant, &a.mutation, &p));
@@ -181,6 +189,100 @@ fn history(a: &Args) -> Result<Outcome, String> {
         "COUNTEREXAMPLE" => Outcome::Fail,
         _ => Outcome::Inconclusive,
     })
+}
+
+/// `raypipe prove rti-bound`: every operation's lemma by enumeration; the composition written.
+fn rti_bound(a: &Args) -> Result<Outcome, String> {
+    use formal::prove::rti_bound::{prove, Mutant, MARGIN_BITS};
+    if a.out.is_some() {
+        return Err("rti-bound's counterexamples are of the error bound, not of the datapath's outputs: there is no vector set to write (--out); the witness prints as a raypipe explain command".into());
+    }
+    if a.variant.is_some() || !a.mutation.flags().is_empty() || a.nan {
+        return Err("rti-bound is about the RTI unit: --variant, --widen, --no-guard and --nan do not apply".into());
+    }
+    let format = a.format.clone().unwrap_or_else(|| "fp16".into());
+    let f = parse_format(&format)?;
+    let mutant = a.mutant.as_deref().map_or(Ok(Mutant::None), Mutant::parse)?;
+    let p = with_format!(&f, |f| prove(f, mutant, threads(a.threads)))?;
+    let (em, div) = with_format!(&f, |f| (mutant.apply(f.error_model()), f.div_mode()));
+    let list = |xs: &[f64]| xs.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(",");
+    let explain = p.witness.as_ref().map(|((o, d, v), _)| {
+        format!(
+            "raypipe explain --unit rti --format {format} --ray {},{} --tri {}",
+            list(o),
+            list(d),
+            list(&v.iter().flatten().copied().collect::<Vec<_>>())
+        )
+    });
+    let lemma_json = |l: &formal::prove::rti_bound::OpLemma| {
+        serde_json::json!({
+            "op": l.op,
+            "statement": l.statement,
+            "pairs": l.cases,
+            "not_finite": l.overflowed,
+            "worst_ratio": l.worst.map(|w| w.0),
+            "worst_operands": l.worst.map(|w| [format!("{:#x}", w.1), format!("{:#x}", w.2)]),
+            "violation": l.violation.map(|v| v.map(|x| format!("{x:#x}"))),
+        })
+    };
+    let j = serde_json::json!({
+        "command": command_as_typed(),
+        "property": "rti-bound",
+        "format": f.name(),
+        "division": format!("{div:?}"),
+        "mutant": a.mutant,
+        "error_model": {"u": em.u, "eta": em.eta, "add_eta": em.add_eta, "max": em.max},
+        "margin": format!("1 - 2^-{MARGIN_BITS}"),
+        "status": p.status,
+        "statement": p.statement,
+        "method": "every operand pair of each operation of the model, checked exactly in 128-bit integers; the composition over the stage table's rows is written in docs/proofs.md",
+        "seconds": p.seconds,
+        "lemmas": p.lemmas.iter().map(lemma_json).collect::<Vec<_>>(),
+        "witness": p.witness.as_ref().map(|(_, cs)| cs.iter().map(|c| serde_json::json!({
+            "quantity": c.name,
+            "model": c.model,
+            "model_bits": format!("{:#x}", with_format!(&f, |f| f.to_bits(f.from_f64(c.model)))),
+            "exact": c.exact,
+            "bound": c.bound,
+            "holds": c.holds,
+        })).collect::<Vec<_>>()),
+        "explain": explain,
+    });
+    emit(a.json, &j, |_| {
+        let mut s = format!(
+            "rti-bound: {} for {}{} — enumeration of every operand pair in {:.1} s\n",
+            p.status,
+            f.name(),
+            a.mutant.as_ref().map_or(String::new(), |m| format!(", mutant {m}")),
+            p.seconds
+        );
+        for l in &p.lemmas {
+            s += &match (l.violation, l.cases) {
+                (Some([x, y, r]), _) => {
+                    format!("  {}: {} FAILS at {x:#x}, {y:#x} (result {r:#x})\n", l.op, l.statement)
+                }
+                (None, Some(n)) => format!(
+                    "  {}: {} holds on {n} pairs (worst ratio {:.6}){}\n",
+                    l.op,
+                    l.statement,
+                    l.worst.map_or(0.0, |w| w.0),
+                    l.overflowed
+                        .filter(|&o| o > 0)
+                        .map_or(String::new(), |o| format!("; {o} with a result not finite (no claim)"))
+                ),
+                _ => String::new(),
+            };
+        }
+        s += &format!("{}: {}\n", if p.status == "PROVEN" { "theorem" } else { "refuted" }, p.statement);
+        if let Some((_, cs)) = &p.witness {
+            for c in cs.iter().filter(|c| !c.holds) {
+                s += &format!("  {}: model {:?}, exact {:?}, bound {:e}: outside\n", c.name, c.model, c.exact, c.bound);
+            }
+            s += &format!("reproduce: {}\n", explain.clone().unwrap_or_default());
+        }
+        s
+    })?;
+    Ok(if p.status == "PROVEN" { Outcome::Pass } else { Outcome::Fail })
 }
 
 /// Writes a slab counterexample as a one-vector set of class `smt` whose expected outputs are

@@ -4,6 +4,7 @@
 //! gives a counterexample; `unknown` (a timeout) proves nothing.
 
 pub mod history;
+pub mod rti_bound;
 pub mod slab;
 pub mod slab_directed;
 pub mod slab_planes;
