@@ -215,7 +215,17 @@ pub fn covers<F: Format>(f: &F, em: ErrorModel) -> Result<Scale, String> {
             f.name()
         ));
     }
-    let _ = em.max;
+    // a non-finite model value raises the judge's overflow flag (docs/proofs.md, step 1):
+    // 224·2^-53·max² < u (the format's own u: a mutant changes only the lemma)
+    let u0 = f.error_model().u;
+    if 224.0 * (-53f64).exp2() * l.max_finite() * l.max_finite() >= u0 {
+        return Err(format!(
+            "{}: the overflow argument needs 224·2^-53·max² < u (max {:e}, u {:e})",
+            f.name(),
+            l.max_finite(),
+            u0
+        ));
+    }
     Ok(sc)
 }
 
