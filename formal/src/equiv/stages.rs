@@ -410,6 +410,12 @@ pub fn prove(
     if let Some(m) = abstraction::unmatched(&n.abstractions, &n.cells).first() {
         return Err(format!("--abstract {m}: no cell of the DUT instantiates module {m}"));
     }
+    if !n.abstractions.is_empty() && full.float.ieee().is_none() {
+        return Err(
+            "--abstract states a module equal to an IEEE operation rounded to nearest-even; the format is fixed point"
+                .into(),
+        );
+    }
     let mut plan = abstraction::plan(&n.abstractions, &n.cells, &|w| n.width(w), full.float.width());
     let module_proofs = justify(&mut plan, n, &full, set, work)?;
     let first_stage = *full.stages.iter().min().unwrap_or(&0);

@@ -1,13 +1,16 @@
 //! The stage models as SMT-LIB 2, generated from the stage tables ([`datapath::rti::stage_table`],
-//! [`datapath::slab::SLAB_TABLE`]) and the format's contract ([`ieee::IeeeSmt`]).
+//! [`datapath::slab::SLAB_TABLE`]) and the format's contract ([`ieee::IeeeSmt`] for IEEE-like
+//! floats, [`fixed::FixedSmt`] for fixed point).
 //!
 //! Naming: each unit input `x` is a declared constant `in_x` (its encoding as received) and
 //! `x` is its stage-0 read; each stage signal is a nullary `define-fun` named as in the stage
 //! table (values: bit-vectors of the format's width; flags: `Bool`). An arithmetic row's value
-//! is the declared constant `NAME!r` (and `NAME!q`, the reciprocal in `recip` division mode)
-//! tied to its operands by an assertion (see [`ieee`]). Nothing else is asserted: every model
+//! is `NAME!r` (and `NAME!q`, the reciprocal in `recip` division mode): for floats a declared
+//! constant tied to its operands by an assertion (see [`ieee`]), for fixed point a defined
+//! bit-vector function of them (see [`fixed`]). Nothing else is asserted: every model
 //! of the declared inputs extends to exactly one model of the whole script, the datapath's.
 
+pub mod fixed;
 pub mod ieee;
 
 use datapath::format::FormatKind;
@@ -15,8 +18,99 @@ use datapath::rti::{stage_table, Cull, Rti, RtiConfig, RTI_INPUTS};
 use datapath::slab::{DirPrep, Slab, SlabConfig, SlabNan, SLAB_INPUTS, SLAB_TABLE};
 use datapath::stage::{Op, Rule, SigDef};
 use datapath::{AnyFormat, Format};
+use fixed::FixedSmt;
 use ieee::IeeeSmt;
 use std::fmt::Write;
+
+/// A format as SMT-LIB 2: an IEEE-like float or a fixed-point format.
+#[derive(Clone, Copy, Debug)]
+pub enum FormatSmt {
+    /// IEEE-like float (`FloatingPoint` terms).
+    Ieee(IeeeSmt),
+    /// Signed fixed point (bit-vector functions).
+    Fixed(FixedSmt),
+}
+
+impl FormatSmt {
+    /// Width of an encoding in bits.
+    pub fn width(&self) -> u32 {
+        match self {
+            Self::Ieee(x) => x.width(),
+            Self::Fixed(x) => x.width(),
+        }
+    }
+    /// A literal encoding.
+    pub fn lit(&self, v: u64) -> String {
+        match self {
+            Self::Ieee(x) => x.lit(v),
+            Self::Fixed(x) => x.lit(v),
+        }
+    }
+    /// The bit-vector sort of one encoding.
+    pub fn bv_sort(&self) -> String {
+        match self {
+            Self::Ieee(x) => x.bv_sort(),
+            Self::Fixed(x) => x.bv_sort(),
+        }
+    }
+    /// The helper functions (`rp_` prefix) every term of this format uses.
+    pub fn prelude(&self) -> String {
+        match self {
+            Self::Ieee(x) => x.prelude(),
+            Self::Fixed(x) => x.prelude(),
+        }
+    }
+    /// The encoding of the datapath's 1.
+    pub fn one(&self) -> u64 {
+        match self {
+            Self::Ieee(x) => x.one(),
+            Self::Fixed(x) => x.one,
+        }
+    }
+    /// The SMT-LIB logic of the emitted script.
+    pub fn logic(&self) -> &'static str {
+        match self {
+            Self::Ieee(_) => "QF_BVFP",
+            Self::Fixed(_) => "QF_BV",
+        }
+    }
+    /// The IEEE form, if the format is a float.
+    pub fn ieee(&self) -> Option<IeeeSmt> {
+        match self {
+            Self::Ieee(x) => Some(*x),
+            Self::Fixed(_) => None,
+        }
+    }
+    /// Emits `name` as the result of `op` (add, sub, mul) on operands given as (encoding, term
+    /// taken as its value), see [`IeeeSmt::result`] and [`FixedSmt::result`].
+    pub fn result(&self, out: &mut String, name: &str, op: Op, a: (&str, &str), b: (&str, &str)) {
+        match self {
+            Self::Ieee(x) => {
+                let fop = match op {
+                    Op::Add => "fp.add",
+                    Op::Sub => "fp.sub",
+                    _ => "fp.mul",
+                };
+                x.result(out, name, fop, a, b)
+            }
+            Self::Fixed(x) => {
+                let fop = match op {
+                    Op::Add => "rp_add",
+                    Op::Sub => "rp_sub",
+                    _ => "rp_mul",
+                };
+                x.result(out, name, fop, a.1, b.1)
+            }
+        }
+    }
+    /// Emits the terms of `name = a ÷ b` per the division mode; returns the quotient's term.
+    pub fn div(&self, out: &mut String, name: &str, a: (&str, &str), b: (&str, &str)) -> String {
+        match self {
+            Self::Ieee(x) => x.div(out, name, a, b),
+            Self::Fixed(x) => x.div(out, name, a.1, b.1),
+        }
+    }
+}
 
 /// The units `raypipe smt` emits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,7 +180,7 @@ pub struct Model {
     /// Encoding width of a value.
     pub width: u32,
     /// The format as SMT.
-    pub float: IeeeSmt,
+    pub float: FormatSmt,
 }
 
 /// The SMT-LIB 2 model of a unit in a format, or why it cannot be emitted.
@@ -102,14 +196,25 @@ pub fn emit_stage_range(req: &Request, lo: u8, hi: u8) -> Result<Model, String> 
     datapath::with_format!(&req.format, |f| emit_in(req, f, Some((lo, hi))))
 }
 
-fn float_of<F: Format>(f: &F) -> Result<IeeeSmt, String> {
-    match f.kind() {
-        FormatKind::Float(lay) => Ok(IeeeSmt { lay, ftz: f.flushes(), propagate: f.nan_propagates(), div: f.div_mode() }),
-        FormatKind::Fixed { .. } => Err(format!(
-            "SMT emission covers the IEEE-like float formats (f32, fp16, bf16, eEmM); {} is fixed point and is not emitted yet",
-            f.name()
-        )),
-    }
+fn float_of<F: Format>(f: &F) -> Result<FormatSmt, String> {
+    Ok(match f.kind() {
+        FormatKind::Float(lay) => {
+            FormatSmt::Ieee(IeeeSmt { lay, ftz: f.flushes(), propagate: f.nan_propagates(), div: f.div_mode() })
+        }
+        FormatKind::Fixed { int_bits, frac_bits } => {
+            let datapath::AnyFormat::Fixed(x) = f.name().parse::<datapath::AnyFormat>()? else {
+                return Err(format!("{}: not a fixed-point format name", f.name()));
+            };
+            FormatSmt::Fixed(FixedSmt {
+                int_bits,
+                frac_bits,
+                round: x.round,
+                overflow: x.overflow,
+                div: f.div_mode(),
+                one: f.to_bits(f.one()),
+            })
+        }
+    })
 }
 
 fn emit_in<F: Format>(req: &Request, f: &F, cut: Option<(u8, u8)>) -> Result<Model, String> {
@@ -130,7 +235,7 @@ fn emit_in<F: Format>(req: &Request, f: &F, cut: Option<(u8, u8)>) -> Result<Mod
         req.unit,
         f.name()
     );
-    let _ = writeln!(e.text, "(set-logic QF_BVFP)");
+    let _ = writeln!(e.text, "(set-logic {})", x.logic());
     e.text.push_str(&x.prelude());
     let inputs: Vec<String> = match req.unit {
         Unit::Rti => {
@@ -181,7 +286,7 @@ struct Env {
 }
 
 struct Emitter {
-    x: IeeeSmt,
+    x: FormatSmt,
     text: String,
     signals: Vec<String>,
     flags: Vec<bool>,
@@ -232,12 +337,7 @@ impl Emitter {
         let r = match op {
             Op::Div => x.div(&mut text, name, a, b),
             Op::Add | Op::Sub | Op::Mul => {
-                let fop = match op {
-                    Op::Add => "fp.add",
-                    Op::Sub => "fp.sub",
-                    _ => "fp.mul",
-                };
-                x.result(&mut text, &format!("{name}!r"), fop, a, b);
+                x.result(&mut text, &format!("{name}!r"), op, a, b);
                 format!("{name}!r")
             }
             Op::Logic => unreachable!("a logic row has no arithmetic"),
@@ -270,8 +370,12 @@ impl Emitter {
     }
 
     fn row_def(&mut self, d: &SigDef, env: &Env) -> Result<(), String> {
-        let cnan = self.x.lit(self.x.lay.canonical_nan());
         let guard = env.slab.is_some_and(|c| c.guard);
+        let cnan = match self.x.ieee() {
+            Some(x) => x.lit(x.lay.canonical_nan()),
+            None if guard => return Err("the slab guard is a float rule; fixed point has none".into()),
+            None => String::new(),
+        };
         let _ = writeln!(self.text, "; stage {} {}", d.stage, d.name);
         match d.rule {
             Rule::Arith => {
@@ -300,7 +404,7 @@ impl Emitter {
                         // |v| < δ ? (sign(v) ? 0 ⊖ δ : δ) : v
                         let delta = self.x.lit(env.delta);
                         let neg = format!("{}!negdelta", d.name);
-                        self.x.result(&mut self.text, &neg, "fp.sub", ("zero", "zero"), (&delta, &delta));
+                        self.x.result(&mut self.text, &neg, Op::Sub, ("zero", "zero"), (&delta, &delta));
                         let t = format!("(ite (rp_lt (rp_abs {v}) {delta}) (ite (rp_neg {v}) {neg} {delta}) {v})");
                         self.value(d.name, &t);
                     }
