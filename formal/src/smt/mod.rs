@@ -10,6 +10,7 @@
 //! bit-vector function of them (see [`fixed`]). Nothing else is asserted: every model
 //! of the declared inputs extends to exactly one model of the whole script, the datapath's.
 
+mod directed;
 pub mod fixed;
 pub mod ieee;
 
@@ -251,7 +252,30 @@ fn emit_in<F: Format>(req: &Request, f: &F, cut: Option<(u8, u8)>) -> Result<Mod
         Unit::Slab => {
             let cfg = req.slab_config(f)?;
             if cfg.directed {
-                return Err("the directed slab variant has no stage table of fixed shape (its signals depend on the data); SMT emission covers plain, conservative, take-on-false, embree".into());
+                if cut.is_some() {
+                    return Err(
+                        "the directed slab variant has no stage table of fixed shape: no stage range to cut".into()
+                    );
+                }
+                let _ = writeln!(e.text, "; slab variant directed: {cfg:?}");
+                let env = Env { thr: 0, cull: Cull::TwoSided, slab: Some(cfg), delta: 0 };
+                e.inputs(&SLAB_INPUTS, &["dx", "dy", "dz"]);
+                let ends = directed::Ends {
+                    top: e.x.lit(f.to_bits(f.from_f64(f64::INFINITY))),
+                    bottom: e.x.lit(f.to_bits(f.from_f64(f64::NEG_INFINITY))),
+                    no_one: f.to_f64(f.one()) != 1.0,
+                };
+                e.slab_directed(&env, &ends)?;
+                let n = e.signals.len();
+                e.stages.resize(n, 1);
+                return Ok(Model {
+                    text: e.text,
+                    inputs: SLAB_INPUTS.iter().map(|s| s.to_string()).collect(),
+                    signals: e.signals.into_iter().zip(e.flags).collect(),
+                    stages: e.stages,
+                    width: x.width(),
+                    float: x,
+                });
             }
             let delta = f.to_bits(Slab::new(*f, cfg).delta());
             let _ = writeln!(e.text, "; slab variant {}: {cfg:?}", req.variant);
