@@ -78,9 +78,19 @@ def test_bad_requests_exit_2(tmp_path):
     # --abstract belongs to a stage-by-stage proof, and takes MODULE=mul|add
     p = subprocess.run([e, "equiv", "--rtl", str(seq), "--top", "seq", "--abstract", "m=mul"], capture_output=True, text=True)
     assert p.returncode == 2 and "--stage-row" in p.stderr, p.stderr
+    # --out writes a pipelined DUT's whole-input counterexample: it needs --set and --stage-row
+    p = subprocess.run([e, "equiv", "--rtl", str(seq), "--top", "seq", "--out", str(tmp_path / "cx")],
+                       capture_output=True, text=True)
+    assert p.returncode == 2 and "--stage-row" in p.stderr, p.stderr
     s = slab_set(tmp_path)
     rc, j = equiv_raw(s, "--abstract", "raypipe_hf_mul=div")
     assert rc == 2 and "mul or add" in j, j
+    # an --out directory holding files raypipe did not write is refused before any work
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("mine")
+    rc, j = equiv_raw(s, "--out", str(foreign))
+    assert rc == 2 and (foreign / "notes.txt").read_text() == "mine", j
 
 
 # ---- the pipelined slab datapath (hdl/hardfloat/raypipe_slab_hf.sv), stage by stage
@@ -130,12 +140,25 @@ def test_pipelined_slab_fp16_faults(tmp_path):
     """Four RTL faults: a swapped subtract (abstracted: the step finds it), a multiplier
     rounding up (its module with rm=011 is not the operation: left concrete, and the step
     finds it), a strict compare and out_valid one edge early; the subtract's witness is checked
-    by float arithmetic."""
+    by float arithmetic, and the first differing signal's whole-input counterexample is replayed
+    in Icarus through the kit."""
     s = slab_set(tmp_path)
-    rc, j = equiv("--define", "RAYPIPE_HF_FAULT_LOX_SWAP", "--define", "RAYPIPE_HF_FAULT_HIT_STRICT",
-                  "--define", "RAYPIPE_HF_FAULT_THIZ_RUP", "--define", "RAYPIPE_HF_FAULT_VALID_EARLY", s,
-                  "--outputs", "lox,hix,thiz,hit", "--phases", "1", "--timeout", "300")
+    faults = ["RAYPIPE_HF_FAULT_LOX_SWAP", "RAYPIPE_HF_FAULT_HIT_STRICT", "RAYPIPE_HF_FAULT_THIZ_RUP",
+              "RAYPIPE_HF_FAULT_VALID_EARLY"]
+    defines = [x for f in faults for x in ("--define", f)]
+    cx_set = str(tmp_path / "whole")
+    rc, j = equiv(*defines, s, "--outputs", "lox,hix,thiz,hit", "--phases", "1", "--timeout", "300", "--out", cx_set)
     assert (rc, j["status"]) == (1, "COUNTEREXAMPLE"), j
+    # the first differing signal (lox) again from the in_row port: a whole input row, written
+    # as a vector set that the faulty DUT fails in Icarus on that signal and the clean one passes
+    w = j["whole_input"]
+    assert (w["goal"], w["result"], w["vectors"]) == ("lox", "sat", cx_set), w
+    run = os.path.join(os.path.dirname(EQUIV), "run")
+    # (with the subtract's fault alone: the early out_valid would fail the run on the protocol first)
+    bad = subprocess.run([run, "--no-waves", "--define", faults[0], cx_set], capture_output=True, text=True)
+    assert bad.returncode != 0 and "first stage signal to differ: lox (stage 1)" in bad.stdout, bad.stdout[-2000:]
+    good = subprocess.run([run, "--no-waves", cx_set], capture_output=True, text=True)
+    assert good.returncode == 0 and "1 passed, 0 failed" in good.stdout, good.stdout[-2000:]
     res = {x["goal"]: x for x in j["steps"]}
     assert res["hix"]["result"] == "unsat"
     assert res["lox"]["result"] == "sat" and res["hit"]["result"] == "sat" and res["thiz"]["result"] == "sat"

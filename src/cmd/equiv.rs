@@ -69,6 +69,11 @@ pub struct Args {
     /// --timeout (never a refuted one); a proof is then PROVEN only IF those modules are (exit 3).
     #[arg(long)]
     pub trust_unfinished: bool,
+    /// With --stage-row: search a whole-input counterexample for the first stage signal that
+    /// differs (bounded model checking from reset through every earlier stage, one transaction)
+    /// and write it to DIR as a vector set (class smt) the kit's runner replays in a simulator.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
     /// Queries run at once (default: the machine's cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -85,6 +90,9 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     }
     if !a.abstract_.is_empty() {
         return Err("--abstract replaces modules in a stage-by-stage proof: give --set and --stage-row".into());
+    }
+    if a.out.is_some() {
+        return Err("--out writes a pipelined DUT's whole-input counterexample: give --set and --stage-row (a combinational counterexample is replayed in Icarus directly)".into());
     }
     let params = a
         .param
@@ -228,6 +236,56 @@ fn prove_in(
     })
 }
 
+/// Writes a pipelined DUT's whole-input counterexample (the witness's `in_*` values) as a
+/// one-vector set of class `smt` with the model's expected outputs and stage signals; returns
+/// the set's directory.
+fn write_whole(
+    out: &std::path::Path,
+    m: &vectors::manifest::Manifest,
+    req: &formal::smt::Request,
+    witness: &[(String, u64)],
+) -> Result<PathBuf, String> {
+    let names: &[&str] = match req.unit {
+        formal::smt::Unit::Rti => &datapath::rti::RTI_INPUTS,
+        _ => &datapath::slab::SLAB_INPUTS,
+    };
+    let row: Vec<u64> = names
+        .iter()
+        .map(|n| {
+            witness
+                .iter()
+                .find(|(k, _)| *k == format!("in_{n}"))
+                .map(|(_, v)| *v)
+                .ok_or(format!("the witness has no {n}"))
+        })
+        .collect::<Result<_, _>>()?;
+    let gen = vectors::gen::Request {
+        unit: if req.unit == formal::smt::Unit::Rti { vectors::gen::Unit::Rti } else { vectors::gen::Unit::Slab },
+        format: req.format,
+        count: 1,
+        seed: 0,
+        level: 1,
+        threads: 1,
+        command: command_as_typed(),
+        rti: req.rti,
+        slab_variant: req.variant.clone(),
+        tree: None,
+        leaves: 8,
+        max_levels: 64,
+        explicit: Some(vectors::gen::Explicit {
+            class: "smt".into(),
+            covers: format!(
+                "a counterexample of raypipe equiv: an input row on which the DUT's stage registers differ from the {} model ({} in {})",
+                m.unit, m.unit, m.format
+            ),
+            origin: command_as_typed(),
+            rows: vec![row],
+        }),
+    };
+    let set = vectors::gen::generate(&gen)?;
+    vectors::write::write_set(&set, out)
+}
+
 /// The set's row layouts, from its manifest.
 fn layout(m: &vectors::manifest::Manifest) -> Result<formal::equiv::stages::Layout, String> {
     use formal::equiv::stages::{FieldPos, Layout};
@@ -274,6 +332,10 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
         widen: None,
         no_guard: false,
     };
+    if let Some(out) = &a.out {
+        // before the work: never overwrite what raypipe did not write
+        vectors::write::check_out(out)?;
+    }
     let lay = layout(&m)?;
     let rows = a.stage_row.iter().map(|s| formal::equiv::stages::parse_row(s)).collect::<Result<Vec<_>, _>>()?;
     let pkg = set.join("raypipe_pkg.sv");
@@ -302,11 +364,18 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
             timeout_s: a.timeout,
             threads,
             trust_unfinished: a.trust_unfinished,
+            whole_input: a.out.is_some(),
         };
         formal::equiv::stages::prove(&req, &n, &rows, &lay, &set, &work)
     });
     let _ = std::fs::remove_dir_all(&work);
-    let formal::equiv::stages::Proof { steps: proofs, plan } = result?;
+    let formal::equiv::stages::Proof { steps: proofs, plan, whole } = result?;
+    // the whole-input counterexample as a vector set: the witness row with the model's expected
+    // outputs and stage signals, which the DUT fails
+    let written = match (&a.out, &whole) {
+        (Some(out), Some(w)) if w.verdict.result == "sat" => Some(write_whole(out, &m, &req, &w.witness)?),
+        _ => None,
+    };
     let seconds = t0.elapsed().as_secs_f64();
     use formal::equiv::stages::Goal;
     // the DUT's verdict comes from the steps; a module proof only decides whether its
@@ -364,6 +433,14 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
             "concrete": plan.concrete.iter().map(|(n, why)| serde_json::json!({"instance": n, "why": why})).collect::<Vec<_>>(),
             "trusted_unproven": trusted,
         },
+        "whole_input": whole.as_ref().map(|p| serde_json::json!({
+            "goal": goal_name(&p.goal),
+            "method": p.method,
+            "result": p.verdict.result,
+            "seconds": p.verdict.seconds,
+            "counterexample": (!p.witness.is_empty()).then(|| p.witness.iter().map(|(k, v)| (k.clone(), serde_json::json!(hex(*v)))).collect::<serde_json::Map<_, _>>()),
+            "vectors": written.as_ref().map(|d| d.display().to_string()),
+        })),
         "steps": proofs.iter().map(|p| serde_json::json!({
             "stages": stages_of(p),
             "method": p.method,
@@ -412,6 +489,22 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
             if !p.witness.is_empty() {
                 let w: Vec<String> = p.witness.iter().map(|(k, v)| format!("{k}={}", hex(*v))).collect();
                 s += &format!("      {}\n", w.join(" "));
+            }
+        }
+        if let Some(p) = &whole {
+            s += &format!(
+                "  whole input, {}: {} ({}, {:.1} s)\n",
+                goal_name(&p.goal),
+                match p.verdict.result.as_str() {
+                    "sat" => "a whole input row differs",
+                    "unsat" => "no single transaction from reset reaches the difference",
+                    _ => "unknown",
+                },
+                p.method,
+                p.verdict.seconds
+            );
+            if let Some(d) = &written {
+                s += &format!("  vector set (class smt): {} — replay it with your kit runner (hdl/run)\n", d.display());
             }
         }
         s

@@ -369,6 +369,10 @@ pub struct Proof {
     pub steps: Vec<StepProof>,
     /// The instances abstracted and those left concrete.
     pub plan: Plan,
+    /// With [`Settings::whole_input`]: the first differing stage signal's query again, from the
+    /// `in_row` port through every earlier stage (one transaction, entering at cycle 1 after
+    /// reset), so that a witness is a whole input row.
+    pub whole: Option<StepProof>,
 }
 
 /// How a stage-by-stage proof runs.
@@ -387,6 +391,9 @@ pub struct Settings {
     /// Use an abstraction whose module-alone proof did not finish (never a refuted one): the
     /// result is then conditional on those modules.
     pub trust_unfinished: bool,
+    /// Search a whole-input counterexample for the first stage signal found to differ
+    /// ([`Proof::whole`]).
+    pub whole_input: bool,
 }
 
 /// Proves the DUT's rows stage by stage.
@@ -521,7 +528,28 @@ pub fn prove(
     for r in results {
         all.push(r?);
     }
-    Ok(Proof { steps: all, plan })
+    // a whole-input counterexample for the first signal that differs (jobs are in table order)
+    let mut whole = None;
+    if set.whole_input {
+        let first = jobs.iter().zip(&all[all.len() - jobs.len()..]).find_map(|(job, p)| match (&job.goal, job.step) {
+            (Goal::Signal(name), Some(i)) if p.verdict.result == "sat" => Some((i, name.clone())),
+            _ => None,
+        });
+        if let Some((i, name)) = first {
+            let s = &steps[i];
+            let row = Row { edges: s.arrive + s.next.edges, ..s.next.clone() };
+            let step = Step { prev: None, next: &row, lo: first_stage, hi: s.hi, arrive: 0 };
+            let next: Vec<&str> = row.inputs.iter().chain(&row.stages).map(String::as_str).collect();
+            let mut keep = next.clone();
+            keep.extend(["rst_n", "in_valid", "in_row"]);
+            let dut = step_smt(n, &plan, &[], &next, &keep, false, !step.bmc(), work, "whole")?;
+            let model = emit_stage_range(req, first_stage, s.hi)?;
+            let mut q = Query::new(&model, &full, &step, &dut, &plan, &[], lay, Some(1));
+            q.single = true;
+            whole = Some(q.run(&Goal::Signal(name), solver, timeout_s)?);
+        }
+    }
+    Ok(Proof { steps: all, plan, whole })
 }
 
 /// `f` over `items` on `threads` threads; the results in order.
@@ -632,6 +660,8 @@ struct Query<'a> {
     lay: &'a Layout,
     prev_read: &'a [String],
     p: u32,
+    /// One transaction only: `in_valid` low in every cycle but the entry cycle.
+    single: bool,
 }
 
 impl<'a> Query<'a> {
@@ -647,7 +677,7 @@ impl<'a> Query<'a> {
         phases: Option<u32>,
     ) -> Self {
         let p = phases.unwrap_or(s.next.edges.saturating_sub(1)).max(1);
-        Query { m, full, s, dut, plan, lay, prev_read, p }
+        Query { m, full, s, dut, plan, lay, prev_read, p, single: false }
     }
 
     fn nx(&self, reg: &str, st: &str) -> String {
@@ -746,6 +776,10 @@ impl<'a> Query<'a> {
                 if t <= p {
                     let _ =
                         writeln!(q, "(assert (=> (= rp_c (_ bv{t} 16)) {}))", self.nx("in_valid", &format!("rp_s{t}")));
+                }
+                if self.single {
+                    let v = self.nx("in_valid", &format!("rp_s{t}"));
+                    let _ = writeln!(q, "(assert (=> (not (= rp_c (_ bv{t} 16))) (not {v})))");
                 }
             }
         }
