@@ -201,12 +201,12 @@ def test_unfinished_module_proofs_are_trusted_only_when_asked(tmp_path):
 # ---- the pipelined RTI datapath (hdl/hardfloat/raypipe_rti_hf.sv): its injected faults
 
 
-@pytest.mark.skipif(not os.environ.get("RAYPIPE_SLOW_PROOFS"), reason="~3.5 min: set RAYPIPE_SLOW_PROOFS=1")
+@pytest.mark.skipif(not os.environ.get("RAYPIPE_SLOW_PROOFS"), reason="~3 min: set RAYPIPE_SLOW_PROOFS=1")
 def test_pipelined_rti_fp16_faults(tmp_path):
     """Each injected fault of the HardFloat RTI datapath is a counterexample of its stage
     signal: a swapped subtract (e1x), a flush-to-zero wrapper on q.x (qx), a multiplier rounding
     to nearest-away (detx: its group refuted alone, so that instance stays concrete) and a strict
-    compare (uv_ok); dety, built beside them, is proven. ~3.5 min on 2 cores: outside CI's budget,
+    compare (uv_ok); dety, built beside them, is proven. ~3 min on 2 cores: outside CI's budget,
     run with RAYPIPE_SLOW_PROOFS=1 (docs/proofs.md)."""
     d = tmp_path / "rti_fp16"
     subprocess.run([exe(), "vectors", "--unit", "rti", "--format", "fp16", "--count", "1", "--out", str(d)],
