@@ -235,3 +235,34 @@ pub fn traverse_tree(
     let b = raypipe::bvh::build(&scene, leaf_size);
     Ok(Some(vectors::traverse::TreeInput { name: scene.name.clone(), nodes: b.nodes, root: 0 }))
 }
+
+/// Writes a one-class vector set of explicit input rows (class `smt`: a proof's counterexample)
+/// of the rti or slab unit to `out`, with the model's expected outputs and stage signals;
+/// returns the set's directory.
+pub fn write_smt_set(
+    out: &std::path::Path,
+    unit: vectors::gen::Unit,
+    format: AnyFormat,
+    rti: datapath::rti::RtiConfig,
+    variant: &str,
+    covers: String,
+    rows: Vec<Vec<u64>>,
+) -> Result<std::path::PathBuf, String> {
+    let req = vectors::gen::Request {
+        unit,
+        format,
+        count: rows.len(),
+        seed: 0,
+        level: 1,
+        threads: 1,
+        command: command_as_typed(),
+        rti,
+        slab_variant: variant.to_string(),
+        tree: None,
+        leaves: 8,
+        max_levels: 64,
+        explicit: Some(vectors::gen::Explicit { class: "smt".into(), covers, origin: command_as_typed(), rows }),
+    };
+    let set = vectors::gen::generate(&req)?;
+    vectors::write::write_set(&set, out)
+}

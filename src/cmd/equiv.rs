@@ -259,31 +259,18 @@ fn write_whole(
                 .ok_or(format!("the witness has no {n}"))
         })
         .collect::<Result<_, _>>()?;
-    let gen = vectors::gen::Request {
-        unit: if req.unit == formal::smt::Unit::Rti { vectors::gen::Unit::Rti } else { vectors::gen::Unit::Slab },
-        format: req.format,
-        count: 1,
-        seed: 0,
-        level: 1,
-        threads: 1,
-        command: command_as_typed(),
-        rti: req.rti,
-        slab_variant: req.variant.clone(),
-        tree: None,
-        leaves: 8,
-        max_levels: 64,
-        explicit: Some(vectors::gen::Explicit {
-            class: "smt".into(),
-            covers: format!(
-                "a counterexample of raypipe equiv: an input row on which the DUT's stage registers differ from the {} model ({} in {})",
-                m.unit, m.unit, m.format
-            ),
-            origin: command_as_typed(),
-            rows: vec![row],
-        }),
-    };
-    let set = vectors::gen::generate(&gen)?;
-    vectors::write::write_set(&set, out)
+    write_smt_set(
+        out,
+        if req.unit == formal::smt::Unit::Rti { vectors::gen::Unit::Rti } else { vectors::gen::Unit::Slab },
+        req.format,
+        req.rti,
+        &req.variant,
+        format!(
+            "a counterexample of raypipe equiv: an input row on which the DUT's stage registers differ from the {} model ({} in {})",
+            m.unit, m.unit, m.format
+        ),
+        vec![row],
+    )
 }
 
 /// The set's row layouts, from its manifest.

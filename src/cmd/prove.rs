@@ -298,31 +298,18 @@ fn write_counterexample(
         .iter()
         .map(|n| p.witness.iter().find(|(k, _)| k == n).map(|(_, v)| *v).ok_or(format!("the witness has no {n}")))
         .collect::<Result<_, _>>()?;
-    let req = vectors::gen::Request {
-        unit: vectors::gen::Unit::Slab,
-        format: parse_format(format)?,
-        count: 1,
-        seed: 0,
-        level: 1,
-        threads: 1,
-        command: command_as_typed(),
-        rti: datapath::rti::RtiConfig::default(),
-        slab_variant: variant.to_string(),
-        tree: None,
-        leaves: 8,
-        max_levels: 64,
-        explicit: Some(vectors::gen::Explicit {
-            class: "smt".into(),
-            covers: format!(
-                "a counterexample of raypipe prove slab-never-misses for variant {variant}{}: an input whose exact slab interval is non-empty and which that mutant misses; the expected outputs are the {variant} variant's own",
-                mutation.flags()
-            ),
-            origin: command_as_typed(),
-            rows: vec![row],
-        }),
-    };
-    let set = vectors::gen::generate(&req)?;
-    vectors::write::write_set(&set, out)
+    write_smt_set(
+        out,
+        vectors::gen::Unit::Slab,
+        parse_format(format)?,
+        datapath::rti::RtiConfig::default(),
+        variant,
+        format!(
+            "a counterexample of raypipe prove slab-never-misses for variant {variant}{}: an input whose exact slab interval is non-empty and which that mutant misses; the expected outputs are the {variant} variant's own",
+            mutation.flags()
+        ),
+        vec![row],
+    )
 }
 
 /// The `raypipe explain` command that replays a slab counterexample.
