@@ -315,6 +315,11 @@ fn statement(op: &str) -> String {
 /// or div per its division mode) under error model `em`, on `threads` threads (the result does
 /// not depend on them).
 pub fn enumerate<F: Format>(f: &F, em: ErrorModel, threads: usize) -> Result<Vec<OpLemma>, String> {
+    enumerate_with(f, em, threads, FILTER)
+}
+
+/// [`enumerate`] with the binary64 filter's factor `filter` (negative: every pair decided exactly).
+fn enumerate_with<F: Format>(f: &F, em: ErrorModel, threads: usize, filter: f64) -> Result<Vec<OpLemma>, String> {
     let sc = covers(f, em)?;
     let FormatKind::Float(l) = f.kind() else { unreachable!() };
     let n = 1u64 << l.width();
@@ -378,7 +383,7 @@ pub fn enumerate<F: Format>(f: &F, em: ErrorModel, threads: usize) -> Result<Vec
                                 };
                                 let err_f = (kr as f64 * inv - z).abs();
                                 let term_f = u * z.abs() + eta_op;
-                                if err_f > term_f * FILTER {
+                                if err_f > term_f * filter {
                                     let (err, term) = scaled(op, sc, ka, kb, kr);
                                     if !within(err, term) {
                                         t.violation = Some([ab, bb, rb]);
@@ -690,6 +695,20 @@ mod tests {
                     ls,
                     "{m:?}: the first violation does not depend on threads"
                 );
+            }
+        });
+    }
+
+    /// The binary64 filter decides no pair differently from the exact check: with the filter
+    /// off (every pair decided in 128-bit integers) the results are the same, for the documented
+    /// model and for both mutants (whose first violations the filter must not hide).
+    #[test]
+    fn the_filter_changes_no_verdict() {
+        let f = parse_format("e5m6").unwrap();
+        datapath::with_format!(&f, |f| {
+            for m in [Mutant::None, Mutant::NoEta, Mutant::USixteenth] {
+                let em = m.apply(f.error_model());
+                assert_eq!(enumerate_with(f, em, 2, FILTER).unwrap(), enumerate_with(f, em, 2, -1.0).unwrap(), "{m:?}");
             }
         });
     }
