@@ -236,9 +236,10 @@ pub fn traverse_tree(
     Ok(Some(vectors::traverse::TreeInput { name: scene.name.clone(), nodes: b.nodes, root: 0 }))
 }
 
-/// Writes a one-class vector set of explicit input rows (class `smt`: a proof's counterexample)
-/// of the rti or slab unit to `out`, with the model's expected outputs and stage signals;
-/// returns the set's directory.
+/// Writes a proof's counterexample as a one-vector set of class `smt` of the rti or slab unit
+/// to `out`, with the model's expected outputs and stage signals: the row is the witness's
+/// value of `{key_prefix}NAME` for each input NAME of the unit. Returns the set's directory.
+#[allow(clippy::too_many_arguments)]
 pub fn write_smt_set(
     out: &std::path::Path,
     unit: vectors::gen::Unit,
@@ -246,12 +247,25 @@ pub fn write_smt_set(
     rti: datapath::rti::RtiConfig,
     variant: &str,
     covers: String,
-    rows: Vec<Vec<u64>>,
+    witness: &[(String, u64)],
+    key_prefix: &str,
 ) -> Result<std::path::PathBuf, String> {
+    let names: &[&str] = match unit {
+        vectors::gen::Unit::Rti => &datapath::rti::RTI_INPUTS,
+        vectors::gen::Unit::Slab => &datapath::slab::SLAB_INPUTS,
+        other => return Err(format!("a counterexample set is of the rti or slab unit, not {other:?}")),
+    };
+    let row: Vec<u64> = names
+        .iter()
+        .map(|n| {
+            let key = format!("{key_prefix}{n}");
+            witness.iter().find(|(k, _)| *k == key).map(|(_, v)| *v).ok_or(format!("the witness has no {key}"))
+        })
+        .collect::<Result<_, _>>()?;
     let req = vectors::gen::Request {
         unit,
         format,
-        count: rows.len(),
+        count: 1,
         seed: 0,
         level: 1,
         threads: 1,
@@ -261,7 +275,12 @@ pub fn write_smt_set(
         tree: None,
         leaves: 8,
         max_levels: 64,
-        explicit: Some(vectors::gen::Explicit { class: "smt".into(), covers, origin: command_as_typed(), rows }),
+        explicit: Some(vectors::gen::Explicit {
+            class: "smt".into(),
+            covers,
+            origin: command_as_typed(),
+            rows: vec![row],
+        }),
     };
     let set = vectors::gen::generate(&req)?;
     vectors::write::write_set(&set, out)

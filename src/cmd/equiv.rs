@@ -237,28 +237,13 @@ fn prove_in(
 }
 
 /// Writes a pipelined DUT's whole-input counterexample (the witness's `in_*` values) as a
-/// one-vector set of class `smt` with the model's expected outputs and stage signals; returns
-/// the set's directory.
+/// one-vector set of class `smt`; returns the set's directory.
 fn write_whole(
     out: &std::path::Path,
     m: &vectors::manifest::Manifest,
     req: &formal::smt::Request,
     witness: &[(String, u64)],
 ) -> Result<PathBuf, String> {
-    let names: &[&str] = match req.unit {
-        formal::smt::Unit::Rti => &datapath::rti::RTI_INPUTS,
-        _ => &datapath::slab::SLAB_INPUTS,
-    };
-    let row: Vec<u64> = names
-        .iter()
-        .map(|n| {
-            witness
-                .iter()
-                .find(|(k, _)| *k == format!("in_{n}"))
-                .map(|(_, v)| *v)
-                .ok_or(format!("the witness has no {n}"))
-        })
-        .collect::<Result<_, _>>()?;
     write_smt_set(
         out,
         if req.unit == formal::smt::Unit::Rti { vectors::gen::Unit::Rti } else { vectors::gen::Unit::Slab },
@@ -269,7 +254,8 @@ fn write_whole(
             "a counterexample of raypipe equiv: an input row on which the DUT's stage registers differ from the {} model ({} in {})",
             m.unit, m.unit, m.format
         ),
-        vec![row],
+        witness,
+        "in_",
     )
 }
 
@@ -407,6 +393,11 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
         (None, _) => "ports".into(),
     };
     let hex = |v: u64| format!("{v:#x}");
+    let witness_json = |p: &formal::equiv::stages::StepProof| {
+        (!p.witness.is_empty()).then(|| {
+            p.witness.iter().map(|(k, v)| (k.clone(), serde_json::json!(hex(*v)))).collect::<serde_json::Map<_, _>>()
+        })
+    };
     let j = serde_json::json!({
         "command": command_as_typed(),
         "status": status,
@@ -425,7 +416,7 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
             "method": p.method,
             "result": p.verdict.result,
             "seconds": p.verdict.seconds,
-            "counterexample": (!p.witness.is_empty()).then(|| p.witness.iter().map(|(k, v)| (k.clone(), serde_json::json!(hex(*v)))).collect::<serde_json::Map<_, _>>()),
+            "counterexample": witness_json(p),
             "vectors": written.as_ref().map(|d| d.display().to_string()),
         })),
         "steps": proofs.iter().map(|p| serde_json::json!({
@@ -436,7 +427,7 @@ fn run_stages(a: &Args) -> Result<Outcome, String> {
             "solver": p.verdict.solver,
             "solver_version": p.verdict.version,
             "seconds": p.verdict.seconds,
-            "counterexample": (!p.witness.is_empty()).then(|| p.witness.iter().map(|(k, v)| (k.clone(), serde_json::json!(hex(*v)))).collect::<serde_json::Map<_, _>>()),
+            "counterexample": witness_json(p),
         })).collect::<Vec<_>>(),
     });
     emit(a.json, &j, |_| {

@@ -294,10 +294,6 @@ fn write_counterexample(
     mutation: &SlabMutation,
     p: &formal::prove::Proof,
 ) -> Result<std::path::PathBuf, String> {
-    let row: Vec<u64> = datapath::slab::SLAB_INPUTS
-        .iter()
-        .map(|n| p.witness.iter().find(|(k, _)| k == n).map(|(_, v)| *v).ok_or(format!("the witness has no {n}")))
-        .collect::<Result<_, _>>()?;
     write_smt_set(
         out,
         vectors::gen::Unit::Slab,
@@ -308,7 +304,8 @@ fn write_counterexample(
             "a counterexample of raypipe prove slab-never-misses for variant {variant}{}: an input whose exact slab interval is non-empty and which that mutant misses; the expected outputs are the {variant} variant's own",
             mutation.flags()
         ),
-        vec![row],
+        &p.witness,
+        "",
     )
 }
 

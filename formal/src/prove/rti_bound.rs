@@ -229,6 +229,30 @@ pub fn covers<F: Format>(f: &F, em: ErrorModel) -> Result<Scale, String> {
     Ok(sc)
 }
 
+/// An operation of the RTI datapath whose rounding the lemma bounds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LemmaOp {
+    Add,
+    Sub,
+    Mul,
+    /// `1 ⊘ d` (the recip-mul datapath).
+    Recip,
+    /// `n ⊘ d` (the divide datapath).
+    Div,
+}
+
+impl LemmaOp {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Add => "add",
+            Self::Sub => "sub",
+            Self::Mul => "mul",
+            Self::Recip => "recip",
+            Self::Div => "div",
+        }
+    }
+}
+
 /// One operation's lemma over every operand pair.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OpLemma {
@@ -273,7 +297,7 @@ fn within(err: u128, term: u128) -> bool {
 /// The scaled error and term of `op` on operands `ka`, `kb` with result `kr` (all `k·2^-s`),
 /// both multiplied by the same positive power of two (`u·term` made an integer).
 #[inline(always)]
-fn scaled(op: &str, sc: Scale, ka: i64, kb: i64, kr: i64) -> (u128, u128) {
+fn scaled(op: LemmaOp, sc: Scale, ka: i64, kb: i64, kr: i64) -> (u128, u128) {
     let (s, p) = (sc.s, sc.p);
     let (ka, kb, kr) = (ka as i128, kb as i128, kr as i128);
     // η·2^(2s+p) and add_eta·2^(s+p) as integers (0 when the term is 0)
@@ -282,32 +306,32 @@ fn scaled(op: &str, sc: Scale, ka: i64, kb: i64, kr: i64) -> (u128, u128) {
     let add1 = sc.qa.map_or(0, |q| 1i128 << (s + p - q));
     let (err, term) = match op {
         // scale 2^-s; ×2^p: |kr − K|·2^p ≤ ρ·(|K| + add_eta·2^(s+p))
-        "add" | "sub" => {
-            let k = if op == "add" { ka + kb } else { ka - kb };
+        LemmaOp::Add | LemmaOp::Sub => {
+            let k = if op == LemmaOp::Add { ka + kb } else { ka - kb };
             ((kr - k).abs() << p, k.abs() + add1)
         }
         // scale 2^-2s; ×2^p
-        "mul" => {
+        LemmaOp::Mul => {
             let k = ka * kb;
             (((kr << s) - k).abs() << p, k.abs() + eta2)
         }
         // |1 ⊘ d − 1/d| ≤ ρ(u/|d| + η), times |d|: |r·d − 1| ≤ ρ(u + η|d|); scale 2^-2s; ×2^p
-        "recip" => ((kr * kb - (1i128 << (2 * s))).abs() << p, (1i128 << (2 * s)) + eta1 * kb.abs()),
+        LemmaOp::Recip => ((kr * kb - (1i128 << (2 * s))).abs() << p, (1i128 << (2 * s)) + eta1 * kb.abs()),
         // |n ⊘ d − n/d| ≤ ρ(u|n/d| + η), times |d|: |r·d − n| ≤ ρ(u|n| + η|d|)
-        _ => ((kr * kb - (ka << s)).abs() << p, (ka.abs() << s) + eta1 * kb.abs()),
+        LemmaOp::Div => ((kr * kb - (ka << s)).abs() << p, (ka.abs() << s) + eta1 * kb.abs()),
     };
     (err as u128, term as u128)
 }
 
 /// The lemma's statement for `op`, in words.
-fn statement(op: &str) -> String {
+fn statement(op: LemmaOp) -> String {
     let rho = format!("(1 − 2^-{MARGIN_BITS})");
     match op {
-        "add" => format!("|x ⊕ y − (x + y)| ≤ {rho}·(u·|x + y| + add_eta)"),
-        "sub" => format!("|x ⊖ y − (x − y)| ≤ {rho}·(u·|x − y| + add_eta)"),
-        "mul" => format!("|x ⊗ y − x·y| ≤ {rho}·(u·|x·y| + η)"),
-        "recip" => format!("|1 ⊘ d − 1/d| ≤ {rho}·(u/|d| + η)"),
-        _ => format!("|n ⊘ d − n/d| ≤ {rho}·(u·|n/d| + η)"),
+        LemmaOp::Add => format!("|x ⊕ y − (x + y)| ≤ {rho}·(u·|x + y| + add_eta)"),
+        LemmaOp::Sub => format!("|x ⊖ y − (x − y)| ≤ {rho}·(u·|x − y| + add_eta)"),
+        LemmaOp::Mul => format!("|x ⊗ y − x·y| ≤ {rho}·(u·|x·y| + η)"),
+        LemmaOp::Recip => format!("|1 ⊘ d − 1/d| ≤ {rho}·(u/|d| + η)"),
+        LemmaOp::Div => format!("|n ⊘ d − n/d| ≤ {rho}·(u·|n/d| + η)"),
     }
 }
 
@@ -332,9 +356,10 @@ fn enumerate_with<F: Format>(f: &F, em: ErrorModel, threads: usize, filter: f64)
         })
         .collect();
     let finite: Vec<(u64, F::V, i64)> = (0..n).filter_map(|b| ks[b as usize].map(|k| (b, f.from_bits(b), k))).collect();
-    let ops: &[&'static str] = match f.div_mode() {
-        DivMode::RecipMul => &["add", "sub", "mul", "recip"],
-        DivMode::Divide => &["add", "sub", "mul", "div"],
+    use LemmaOp::{Add, Div, Mul, Recip, Sub};
+    let ops = match f.div_mode() {
+        DivMode::RecipMul => [Add, Sub, Mul, Recip],
+        DivMode::Divide => [Add, Sub, Mul, Div],
     };
     let one = f.one();
     let k_one = 1i64 << sc.s;
@@ -342,11 +367,11 @@ fn enumerate_with<F: Format>(f: &F, em: ErrorModel, threads: usize, filter: f64)
     let inv = 1.0 / scale;
     let u = em.u;
     let mut out = Vec::new();
-    for &op in ops {
-        let eta_op = if matches!(op, "add" | "sub") { em.add_eta } else { em.eta };
+    for op in ops {
+        let eta_op = if matches!(op, Add | Sub) { em.add_eta } else { em.eta };
         // the first operand's list: recip has one operand (the divisor, as b)
         let firsts: Vec<(u64, F::V, i64)> =
-            if op == "recip" { vec![(f.to_bits(one), one, k_one)] } else { finite.clone() };
+            if op == Recip { vec![(f.to_bits(one), one, k_one)] } else { finite.clone() };
         let chunk = firsts.len().div_ceil(threads).max(1);
         let tallies: Vec<Tally> = std::thread::scope(|sc_| {
             let hs: Vec<_> = firsts
@@ -358,14 +383,14 @@ fn enumerate_with<F: Format>(f: &F, em: ErrorModel, threads: usize, filter: f64)
                         for &(ab, av, ka) in part {
                             for &(bb, bv, kb) in finite {
                                 let r = match op {
-                                    "add" => f.add(av, bv),
-                                    "sub" => f.sub(av, bv),
-                                    "mul" => f.mul(av, bv),
-                                    _ => f.div(av, bv),
+                                    Add => f.add(av, bv),
+                                    Sub => f.sub(av, bv),
+                                    Mul => f.mul(av, bv),
+                                    Recip | Div => f.div(av, bv),
                                 };
                                 let rb = f.to_bits(r);
                                 let Some(kr) = ks[rb as usize] else {
-                                    if l.is_nan(rb) && !matches!(op, "recip" | "div") {
+                                    if l.is_nan(rb) && !matches!(op, Recip | Div) {
                                         // finite operands never give NaN in add, sub, mul
                                         t.violation = Some([ab, bb, rb]);
                                         return t;
@@ -376,10 +401,10 @@ fn enumerate_with<F: Format>(f: &F, em: ErrorModel, threads: usize, filter: f64)
                                 // the binary64 filter (sound: see FILTER), then the exact check
                                 let (xa, xb) = (ka as f64 * inv, kb as f64 * inv);
                                 let z = match op {
-                                    "add" => xa + xb,
-                                    "sub" => xa - xb,
-                                    "mul" => xa * xb,
-                                    _ => xa / xb,
+                                    Add => xa + xb,
+                                    Sub => xa - xb,
+                                    Mul => xa * xb,
+                                    Recip | Div => xa / xb,
                                 };
                                 let err_f = (kr as f64 * inv - z).abs();
                                 let term_f = u * z.abs() + eta_op;
@@ -420,7 +445,7 @@ fn enumerate_with<F: Format>(f: &F, em: ErrorModel, threads: usize, filter: f64)
             (Some(tallies.iter().map(|t| t.cases).sum()), Some(tallies.iter().map(|t| t.overflowed).sum()))
         };
         out.push(OpLemma {
-            op,
+            op: op.name(),
             statement: statement(op),
             cases,
             overflowed,
@@ -464,7 +489,7 @@ pub fn find_witness<F: Format>(f: &F, em: ErrorModel) -> Option<Witness> {
             if !r.is_finite() {
                 continue;
             }
-            let (err, term) = scaled("mul", sc, (x * scale) as i64, (y * scale) as i64, (r * scale) as i64);
+            let (err, term) = scaled(LemmaOp::Mul, sc, (x * scale) as i64, (y * scale) as i64, (r * scale) as i64);
             if err <= 4 * term {
                 continue;
             }
@@ -653,19 +678,19 @@ mod tests {
     fn the_scaled_check_matches_hand_worked_cases() {
         let sc = Scale { s: 24, kbits: 40, p: 11, q: Some(25), qa: None };
         let k = |x: f64| (x * 2f64.powi(24)) as i64;
-        let (e, t) = scaled("mul", sc, k(1.0), k(1.0 + 2f64.powi(-10)), k(1.0 + 2f64.powi(-10)));
+        let (e, t) = scaled(LemmaOp::Mul, sc, k(1.0), k(1.0 + 2f64.powi(-10)), k(1.0 + 2f64.powi(-10)));
         assert_eq!(e, 0);
         assert!(within(e, t));
-        let (e, t) = scaled("add", sc, k(1.0), k(2f64.powi(-11)), k(1.0));
+        let (e, t) = scaled(LemmaOp::Add, sc, k(1.0), k(2f64.powi(-11)), k(1.0));
         // err·2^11 = 2^-11·2^24·2^11 = 2^24; term = (1 + 2^-11)·2^24
         assert_eq!((e, t), (1 << 24, (1 << 24) + (1 << 13)));
         assert!(within(e, t));
-        let (e, t) = scaled("mul", sc, k(2f64.powi(-24)), k(0.5), 0);
+        let (e, t) = scaled(LemmaOp::Mul, sc, k(2f64.powi(-24)), k(0.5), 0);
         // scale 2^-48 × 2^11: err = 2^-25·2^59 = 2^34, term = 2^-25·2^48 + 2^-25·2^59
         assert_eq!((e, t), (1 << 34, (1 << 23) + (1 << 34)));
         assert!(within(e, t));
         // without η the same product is far outside its term
-        let (e, t) = scaled("mul", Scale { q: None, ..sc }, k(2f64.powi(-24)), k(0.5), 0);
+        let (e, t) = scaled(LemmaOp::Mul, Scale { q: None, ..sc }, k(2f64.powi(-24)), k(0.5), 0);
         assert!(!within(e, t));
     }
 

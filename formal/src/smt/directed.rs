@@ -117,6 +117,9 @@ impl Emitter {
         self.value("t_far", &far);
         self.flag("outside", &format!("(or {})", outside.join(" ")));
         self.flag("hit", "(and (not outside) (rp_le t_near t_far))");
+        // (the table's stage-0 rows carry their stage; the bounds are stage 1)
+        let n = self.signals.len();
+        self.stages.resize(n, 1);
         Ok(())
     }
 }

@@ -15,7 +15,8 @@
 //! - Compares are signed (`bvslt`, `bvsle`); there is no NaN, and the input read is the identity.
 
 use super::ieee::bv;
-use datapath::format::{DivMode, FxOverflow, FxRound};
+use datapath::format::{DivMode, Fixed, FxOverflow, FxRound};
+use datapath::Format;
 use std::fmt::Write;
 
 /// The SMT-LIB form of one fixed-point format with its datapath options.
@@ -36,6 +37,18 @@ pub struct FixedSmt {
 }
 
 impl FixedSmt {
+    /// The SMT form of fixed-point format `x`.
+    pub fn of(x: &Fixed) -> Self {
+        Self {
+            int_bits: x.int_bits,
+            frac_bits: x.frac_bits,
+            round: x.round,
+            overflow: x.overflow,
+            div: x.div,
+            one: x.to_bits(x.one()),
+        }
+    }
+
     /// Width in bits.
     pub fn width(&self) -> u32 {
         self.int_bits + self.frac_bits

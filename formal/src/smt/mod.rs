@@ -197,29 +197,21 @@ pub fn emit_stage_range(req: &Request, lo: u8, hi: u8) -> Result<Model, String> 
     datapath::with_format!(&req.format, |f| emit_in(req, f, Some((lo, hi))))
 }
 
-fn float_of<F: Format>(f: &F) -> Result<FormatSmt, String> {
-    Ok(match f.kind() {
+/// The SMT form of the request's format (`f` is the format inside `req.format`).
+fn float_of<F: Format>(req: &Request, f: &F) -> FormatSmt {
+    match f.kind() {
         FormatKind::Float(lay) => {
             FormatSmt::Ieee(IeeeSmt { lay, ftz: f.flushes(), propagate: f.nan_propagates(), div: f.div_mode() })
         }
-        FormatKind::Fixed { int_bits, frac_bits } => {
-            let datapath::AnyFormat::Fixed(x) = f.name().parse::<datapath::AnyFormat>()? else {
-                return Err(format!("{}: not a fixed-point format name", f.name()));
-            };
-            FormatSmt::Fixed(FixedSmt {
-                int_bits,
-                frac_bits,
-                round: x.round,
-                overflow: x.overflow,
-                div: f.div_mode(),
-                one: f.to_bits(f.one()),
-            })
+        FormatKind::Fixed { .. } => {
+            let AnyFormat::Fixed(x) = req.format else { unreachable!("a fixed-point kind is AnyFormat::Fixed") };
+            FormatSmt::Fixed(FixedSmt::of(&x))
         }
-    })
+    }
 }
 
 fn emit_in<F: Format>(req: &Request, f: &F, cut: Option<(u8, u8)>) -> Result<Model, String> {
-    let x = float_of(f)?;
+    let x = float_of(req, f);
     let mut e = Emitter {
         x,
         text: String::new(),
@@ -251,39 +243,25 @@ fn emit_in<F: Format>(req: &Request, f: &F, cut: Option<(u8, u8)>) -> Result<Mod
         }
         Unit::Slab => {
             let cfg = req.slab_config(f)?;
-            if cfg.directed {
-                if cut.is_some() {
-                    return Err(
-                        "the directed slab variant has no stage table of fixed shape: no stage range to cut".into()
-                    );
-                }
-                let _ = writeln!(e.text, "; slab variant directed: {cfg:?}");
-                let env = Env { thr: 0, cull: Cull::TwoSided, slab: Some(cfg), delta: 0 };
-                e.inputs(&SLAB_INPUTS, &["dx", "dy", "dz"]);
-                let ends = directed::Ends {
-                    top: e.x.lit(f.to_bits(f.from_f64(f64::INFINITY))),
-                    bottom: e.x.lit(f.to_bits(f.from_f64(f64::NEG_INFINITY))),
-                    no_one: f.to_f64(f.one()) != 1.0,
-                };
-                e.slab_directed(&env, &ends)?;
-                let n = e.signals.len();
-                e.stages.resize(n, 1);
-                return Ok(Model {
-                    text: e.text,
-                    inputs: SLAB_INPUTS.iter().map(|s| s.to_string()).collect(),
-                    signals: e.signals.into_iter().zip(e.flags).collect(),
-                    stages: e.stages,
-                    width: x.width(),
-                    float: x,
-                });
+            if cfg.directed && cut.is_some() {
+                return Err("the directed slab variant has no stage table of fixed shape: no stage range to cut".into());
             }
             let delta = f.to_bits(Slab::new(*f, cfg).delta());
             let _ = writeln!(e.text, "; slab variant {}: {cfg:?}", req.variant);
             let env = Env { thr: 0, cull: Cull::TwoSided, slab: Some(cfg), delta };
             // d is read by the table's own rows (dx, dy, dz)
             e.inputs(&SLAB_INPUTS, &["dx", "dy", "dz"]);
-            for d in SLAB_TABLE.iter() {
-                e.row(d, &env)?;
+            if cfg.directed {
+                let ends = directed::Ends {
+                    top: e.x.lit(f.to_bits(f.from_f64(f64::INFINITY))),
+                    bottom: e.x.lit(f.to_bits(f.from_f64(f64::NEG_INFINITY))),
+                    no_one: f.to_f64(f.one()) != 1.0,
+                };
+                e.slab_directed(&env, &ends)?;
+            } else {
+                for d in SLAB_TABLE.iter() {
+                    e.row(d, &env)?;
+                }
             }
             SLAB_INPUTS.iter().map(|s| s.to_string()).collect()
         }
