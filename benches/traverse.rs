@@ -96,6 +96,7 @@ fn bench_export(c: &mut Criterion) {
         leaves: 8,
         max_levels: 64,
         explicit: None,
+        closure: None,
     };
     g.throughput(Throughput::Elements(12 * 64));
     g.bench_function("rti_f32_generate_and_write", |bch| {

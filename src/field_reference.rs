@@ -62,6 +62,7 @@ fn request(unit: Unit, scene: &Scene) -> Request {
         leaves: 4,
         max_levels: 64,
         explicit: None,
+        closure: None,
     }
 }
 

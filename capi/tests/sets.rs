@@ -22,6 +22,7 @@ fn request(unit: Unit, format: &str, rti: RtiConfig, variant: &str) -> Request {
         leaves: 8,
         max_levels: 64,
         explicit: None,
+        closure: None,
         threads: 1,
     }
 }

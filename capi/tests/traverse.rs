@@ -46,6 +46,7 @@ fn request(format: &str) -> Request {
         leaves: 8,
         max_levels: 64,
         explicit: None,
+        closure: None,
         threads: 1,
     }
 }

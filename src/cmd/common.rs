@@ -281,6 +281,7 @@ pub fn write_smt_set(
             origin: command_as_typed(),
             rows: vec![row],
         }),
+        closure: None,
     };
     let set = vectors::gen::generate(&req)?;
     vectors::write::write_set(&set, out)

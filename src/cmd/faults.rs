@@ -59,6 +59,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
                 leaves: 8,
                 max_levels: 64,
                 explicit: None,
+                closure: None,
                 threads: threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
                 format: format.unwrap_or_else(|| "f32".parse().expect("built-in format name")),
                 count: count as usize,

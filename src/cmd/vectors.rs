@@ -62,6 +62,14 @@ pub struct Args {
     /// packing (fields from bit 0 in file order).
     #[arg(long, requires = "wrapper")]
     pub axis_map: Option<PathBuf>,
+    /// Close the coverage: append a class `close` of directed vectors, found by a seeded
+    /// search, that reach the bins of the coverage model the set leaves empty (units rti, slab,
+    /// op, capture; docs/coverage.md).
+    #[arg(long, conflicts_with_all = ["check", "minimal"])]
+    pub close: bool,
+    /// Candidates the closure's search may measure at most.
+    #[arg(long, default_value_t = vectors::close::DEFAULT_BUDGET, requires = "close")]
+    pub close_budget: u64,
     #[command(flatten)]
     pub rti: RtiArgs,
 }
@@ -86,6 +94,8 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         levels,
         wrapper,
         axis_map,
+        close,
+        close_budget,
         rti,
     } = a;
     if let Some(dir) = check {
@@ -141,6 +151,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         leaves: leaves as usize,
         max_levels: levels as usize,
         explicit: None,
+        closure: None,
         threads: threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
         format,
         count: count as usize,
@@ -150,7 +161,27 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         rti: rti.config()?,
         slab_variant: variant,
     };
-    let set = vectors::gen::generate(&req)?;
+    let set = if close {
+        if unit == vectors::gen::Unit::Traverse {
+            return Err("--close covers the units rti, slab, op and capture (not traverse yet)".into());
+        }
+        limit("--close-budget", close_budget, 100_000_000, "the search measures candidates one batch at a time")?;
+        let c = vectors::close::close(&req, close_budget)?;
+        let pct = |(h, n): (u64, u64)| 100.0 * h as f64 / n.max(1) as f64;
+        println!(
+            "coverage closure: {} of {} reachable bins before ({:.1} %), {} after ({:.1} %); {} of {} candidates kept as class close",
+            c.before.0,
+            c.before.1,
+            pct(c.before),
+            c.after.0,
+            pct(c.after),
+            c.kept,
+            c.candidates
+        );
+        c.set
+    } else {
+        vectors::gen::generate(&req)?
+    };
     let set = if minimal {
         let (cut, c) = faults::minimal::minimal(&set, &command_without_threads())?;
         let m = cut.manifest.minimal.as_ref().expect("a minimal set says so");

@@ -116,7 +116,27 @@ fn request_from(m: &Manifest, unit: Unit, format: AnyFormat, contents: &[Vec<Vec
         leaves,
         max_levels,
         explicit: explicit_from(m, unit, contents)?,
+        closure: closure_from(m, contents)?,
     })
+}
+
+/// A set with a coverage-closure class (`raypipe vectors --close`): its rows are given (the
+/// search that found them is not repeated), so the regenerated set takes them from the set.
+fn closure_from(m: &Manifest, contents: &[Vec<Vec<u64>>]) -> Result<Option<crate::gen::Explicit>, String> {
+    let Some(cl) = &m.closure else { return Ok(None) };
+    let class = m
+        .classes
+        .get(cl.class as usize)
+        .filter(|_| cl.class as usize + 1 == m.classes.len())
+        .ok_or("manifest.json: field closure: its class is not the last class")?;
+    let rows = contents.first().ok_or("the set has no input file")?;
+    // op rows keep (opcode, a, b); the others drop the class column only
+    Ok(Some(crate::gen::Explicit {
+        class: class.name.clone(),
+        covers: class.covers.clone(),
+        origin: cl.origin.clone(),
+        rows: rows.iter().filter(|r| r.first() == Some(&u64::from(cl.class))).map(|r| r[1..].to_vec()).collect(),
+    }))
 }
 
 /// A set whose manifest names an `origin` holds given input rows (one class): they are what

@@ -166,13 +166,15 @@ impl Coverage {
                         None => continue,
                     },
                 };
-                let out = x.dir == "out" && matches!(x.kind, Kind::Ieee { .. });
+                // (capture holds and moves its inputs' bits: no rule of computed values applies)
+                let out = x.dir == "out" && matches!(x.kind, Kind::Ieee { .. }) && m.unit != "capture";
                 let canonical = !m.format.contains("propagate");
                 let ftz = m.format.contains("ftz");
                 let why = |name: &str| -> Option<&'static str> {
                     match name {
                         "other NaN" if out && canonical => Some(WHY_CANONICAL),
                         "+subnormal" | "-subnormal" if out && ftz => Some(WHY_FTZ),
+                        _ if out => unit_value_reason(m, x, name),
                         _ => None,
                     }
                 };
@@ -210,7 +212,7 @@ impl Coverage {
         }
         for (stage, signal) in rows {
             coverpoints.push(Coverpoint {
-                signal,
+                signal: signal.clone(),
                 role: "stage signals".into(),
                 stage: Some(stage),
                 kind: "rounding".into(),
@@ -222,7 +224,7 @@ impl Coverage {
                         unreachable: match n {
                             "flushed" if !ftz => Some(WHY_NO_FTZ),
                             "underflow" if ftz => Some(WHY_FTZ_UNDERFLOW),
-                            _ => None,
+                            _ => unit_rounding_reason(m, &signal, n),
                         },
                     })
                     .collect(),
@@ -247,72 +249,14 @@ impl Coverage {
         contents: &[Vec<Vec<u64>>],
         range: std::ops::Range<usize>,
     ) -> Result<(), String> {
-        // the expected-output row's flag named by a care_when
-        let out_flag = |row: usize, name: &str| -> Option<bool> {
-            let f = m.files.get(1)?;
-            let k = f.fields.iter().position(|x| x.name == name)?;
-            Some(contents.get(1)?.get(row)?.get(k)? & 1 == 1)
-        };
-        // per call, not per row: the compares and where their operands are
-        let ftz = m.format.contains("ftz");
-        let cmps = compares(m);
-        let ariths = arith_rows(m);
-        let op_rounding = op_unit_rounding(m);
+        let bins = RowBins::new(m);
+        let mut hits = Vec::new();
         for row in range {
-            let mut cp = 0;
-            for (i, f) in m.files.iter().enumerate() {
-                if !per_vector(m, i) {
-                    continue;
-                }
-                let vals = contents.get(i).and_then(|c| c.get(row)).ok_or(format!("{}: no row {}", f.name, row + 1))?;
-                for (k, x) in f.fields.iter().enumerate() {
-                    let Some(bin) = bin_of(x, vals[k], m) else { continue };
-                    let p = &mut self.coverpoints[cp];
-                    cp += 1;
-                    if let Some(flag) = &x.care_when {
-                        if out_flag(row, flag) == Some(false) {
-                            continue;
-                        }
-                    }
-                    if let Some(b) = p.bins.get_mut(bin) {
-                        b.count += 1;
-                    }
-                }
-            }
-            for &(_, _, a, b) in &cmps {
-                let (Some(x), Some(y)) = (operand(m, contents, row, a, ftz), operand(m, contents, row, b, ftz)) else {
-                    cp += 1;
-                    continue;
-                };
-                let bin = match (x, y) {
-                    (None, _) | (_, None) => 3,
-                    (Some(x), Some(y)) if x < y => 0,
-                    (Some(x), Some(y)) if x == y => 1,
-                    _ => 2,
-                };
-                self.coverpoints[cp].bins[bin].count += 1;
-                cp += 1;
-            }
-            for &(_, name, op, a, b) in &ariths {
-                let bin = rounding_event(m, contents, row, name, op, a, b, ftz);
-                if let Some(bin) = bin {
-                    self.coverpoints[cp].bins[bin].count += 1;
-                }
-                cp += 1;
-            }
-            if op_rounding {
-                // the op unit: the operation the row's opcode selects (0 add, 1 sub, 2 mul,
-                // 3 div in divide mode; the reciprocal mode's a * (1/b) rounds twice: not counted)
-                let opcode = field(m, "opcode").and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied());
-                let op = match opcode {
-                    Some(0) => Some("add"),
-                    Some(1) => Some("sub"),
-                    Some(2) => Some("mul"),
-                    Some(3) if m.format.contains("divide") => Some("div"),
-                    _ => None,
-                };
-                if let Some(bin) = op.and_then(|op| rounding_event(m, contents, row, "result", op, "a", "b", ftz)) {
-                    self.coverpoints[cp].bins[bin].count += 1;
+            hits.clear();
+            bins.hits(contents, row, &mut hits)?;
+            for &(cp, bin) in &hits {
+                if let Some(b) = self.coverpoints.get_mut(cp).and_then(|p| p.bins.get_mut(bin)) {
+                    b.count += 1;
                 }
             }
             self.vectors += 1;
@@ -363,6 +307,93 @@ impl Coverage {
                     .map(move |b| format!("{} {}: {}", p.role, p.signal, b.name))
             })
             .collect()
+    }
+}
+
+/// The bins one row hits, as (coverpoint, bin) indices into [`Coverage::model`]'s order: what
+/// counting and the coverage closure's search share (the compares and operations of the set's
+/// unit found once).
+pub struct RowBins<'a> {
+    m: &'a Manifest,
+    ftz: bool,
+    cmps: Vec<(u8, &'static str, &'static str, &'static str)>,
+    ariths: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
+    op_rounding: bool,
+}
+
+impl<'a> RowBins<'a> {
+    /// The lookup for sets with manifest `m`.
+    pub fn new(m: &'a Manifest) -> Self {
+        RowBins {
+            m,
+            ftz: m.format.contains("ftz"),
+            cmps: compares(m),
+            ariths: arith_rows(m),
+            op_rounding: op_unit_rounding(m),
+        }
+    }
+
+    /// Appends to `out` the (coverpoint, bin) of every bin row `row` of `contents` hits.
+    pub fn hits(&self, contents: &[Vec<Vec<u64>>], row: usize, out: &mut Vec<(usize, usize)>) -> Result<(), String> {
+        let (m, ftz) = (self.m, self.ftz);
+        // the expected-output row's flag named by a care_when
+        let out_flag = |name: &str| -> Option<bool> {
+            let f = m.files.get(1)?;
+            let k = f.fields.iter().position(|x| x.name == name)?;
+            Some(contents.get(1)?.get(row)?.get(k)? & 1 == 1)
+        };
+        let mut cp = 0;
+        for (i, f) in m.files.iter().enumerate() {
+            if !per_vector(m, i) {
+                continue;
+            }
+            let vals = contents.get(i).and_then(|c| c.get(row)).ok_or(format!("{}: no row {}", f.name, row + 1))?;
+            for (k, x) in f.fields.iter().enumerate() {
+                let Some(bin) = bin_of(x, vals[k], m) else { continue };
+                let here = cp;
+                cp += 1;
+                if let Some(flag) = &x.care_when {
+                    if out_flag(flag) == Some(false) {
+                        continue;
+                    }
+                }
+                out.push((here, bin));
+            }
+        }
+        for &(_, _, a, b) in &self.cmps {
+            if let (Some(x), Some(y)) = (operand(m, contents, row, a, ftz), operand(m, contents, row, b, ftz)) {
+                let bin = match (x, y) {
+                    (None, _) | (_, None) => 3,
+                    (Some(x), Some(y)) if x < y => 0,
+                    (Some(x), Some(y)) if x == y => 1,
+                    _ => 2,
+                };
+                out.push((cp, bin));
+            }
+            cp += 1;
+        }
+        for &(_, name, op, a, b) in &self.ariths {
+            if let Some(bin) = rounding_event(m, contents, row, name, op, a, b, ftz) {
+                out.push((cp, bin));
+            }
+            cp += 1;
+        }
+        if self.op_rounding {
+            // the op unit: the operation the row's opcode selects (0 add, 1 sub, 2 mul,
+            // 3 div in divide mode; the reciprocal mode's a * (1/b) rounds twice: not counted)
+            let opcode = field(m, "opcode").and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied());
+            let op = match opcode {
+                Some(0) => Some("add"),
+                Some(1) => Some("sub"),
+                Some(2) => Some("mul"),
+                Some(3) if m.format.contains("divide") => Some("div"),
+                _ => None,
+            };
+            if let Some(bin) = op.and_then(|op| rounding_event(m, contents, row, "result", op, "a", "b", ftz)) {
+                out.push((cp, bin));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -463,6 +494,99 @@ pub const ROUNDING_BINS: [&str; 7] = ["exact", "inexact", "tie", "overflow", "un
 pub const WHY_NO_FTZ: &str = "the format keeps subnormals: no result is flushed";
 /// Why a flush-to-zero format never underflows.
 pub const WHY_FTZ_UNDERFLOW: &str = "flush-to-zero: every tiny result is flushed (counted as flushed)";
+
+/// Why a sum or difference is never tiny and inexact (IEEE formats with subnormals).
+pub const WHY_SUM_TINY_EXACT: &str = "a sum or difference of two values is a multiple of the smallest subnormal, so one below the smallest normal in magnitude is a subnormal exactly: with gradual underflow an add or subtract never underflows inexactly";
+/// Why the RTI unit's t, u and v are never negative where they are compared.
+pub const WHY_RTI_SIGN: &str = "compared only when valid: then |det| > det_threshold >= 0 (det a number, not zero) and u', v', t' are NaN-free and zero or of det's sign (u_ok, v_ok, t_ok), and 1/det has det's sign: the product (or quotient) is +0, -0, positive, +inf or NaN, never a negative nonzero value";
+/// Why the RTI unit's u and v never reach the largest finite value.
+pub const WHY_RTI_UV_BOUNDED: &str = "compared only when valid: then 0 <= u' <= u'+v' <= det (or the mirror for det < 0; uv_ok, v' of u''s sign), so u = u' x (1/det) is at most det x fl(1/det) rounded (at most 2) while 1/det is finite, and +inf or NaN when it overflows; in divide mode u = u'/det is at most 1 (v alike)";
+/// Why the RTI unit's u and v never overflow.
+pub const WHY_RTI_UV_NO_OVERFLOW: &str = "compared only when valid: |u'| <= |det| (uv_ok), so u' x (1/det) is at most 2 while 1/det is finite, and an infinite 1/det is an infinite operand (an exact result); u'/det is at most 1 (v alike)";
+/// Why 1/x never rounds to the largest finite value.
+pub const WHY_RECIP_NOT_MAX: &str = "1/x rounds to +-max only for |x| in (2^-(emax+1), 2^-(emax+1)/(1 - 2^-(M+2))], a relative width below 2^-(M+1); that range is subnormal, where values are 2^(2-M) apart relative to 2^-(emax+1), so it holds no value";
+/// Why 1/x never rounds a tie.
+pub const WHY_RECIP_NO_TIE: &str = "1/x is exact when x is a power of two, and otherwise (x = m 2^e, m odd > 1) has an infinite binary expansion, never halfway between two values";
+/// Why the RTI unit's 1/det is a number where it is compared.
+pub const WHY_RTI_DET_NUMBER: &str =
+    "compared only when valid: then |det| > det_threshold, so det is not NaN and 1/det is not NaN";
+/// Why the conservative guard removes tiny and overflowed reciprocals.
+pub const WHY_GUARD_RECIP: &str = "the conservative guard: 1/d of a finite nonzero d that is subnormal, zero or infinite is the canonical NaN (counted as NaN)";
+/// Why the conservative guard removes overflowed differences.
+pub const WHY_GUARD_SUB: &str =
+    "the conservative guard: a difference of finite operands that overflows is the canonical NaN (counted as NaN)";
+/// Why Embree's direction preparation leaves no zero and no infinite reciprocal.
+pub const WHY_EMBREE: &str = "embree preparation: |d| < delta becomes +-delta (delta = 2/max rounded up, > 0), so pd is never zero, and 1/pd is at most 1/delta <= max/2 in magnitude: never infinite from a finite pd, never an overflow";
+/// Why a widened entry distance never takes some values.
+pub const WHY_WIDEN_NEAR: &str = "t_near is tn_xyz stepped toward -inf (nextDown) at least once: nextDown never returns -0 or +inf, and from two steps on never +max (only nextDown(+inf) is +max)";
+/// Why a widened exit distance never takes some values.
+pub const WHY_WIDEN_FAR: &str = "t_far is tf_xyz stepped toward +inf (nextUp) at least once: nextUp never returns +0 or -inf, and from two steps on never -max (only nextUp(-inf) is -max)";
+
+/// Whether the set's format is an IEEE-like float with gradual underflow.
+fn gradual(m: &Manifest) -> bool {
+    m.params.get("float") == Some(&1) && m.params.get("ftz") != Some(&1)
+}
+
+/// A unit's reason why a value-class bin of output or stage field `x` is unreachable.
+fn unit_value_reason(m: &Manifest, x: &Field, bin: &str) -> Option<&'static str> {
+    if !matches!(x.kind, Kind::Ieee { .. }) {
+        return None;
+    }
+    let neg_nonzero = matches!(bin, "-subnormal" | "-min normal" | "-normal" | "-max finite" | "-inf");
+    let divide = m.params.get("recip_mul") == Some(&0);
+    let widen = m.params.get("slab_widen_ulps").copied().unwrap_or(0);
+    let guard = m.params.get("slab_guard") == Some(&1);
+    let embree = m.params.get("slab_embree") == Some(&1) && gradual(m);
+    let valid = x.care_when.as_deref() == Some("valid");
+    match (m.unit.as_str(), x.name.as_str()) {
+        ("rti", "t" | "u" | "v") if valid && neg_nonzero => Some(WHY_RTI_SIGN),
+        ("rti", "u" | "v") if valid && (bin == "+max finite" || (divide && bin == "+inf")) => Some(WHY_RTI_UV_BOUNDED),
+        ("rti", "inv_det") if valid && matches!(bin, "+max finite" | "-max finite") => Some(WHY_RECIP_NOT_MAX),
+        ("rti", "inv_det") if valid && bin.ends_with("NaN") => Some(WHY_RTI_DET_NUMBER),
+        ("slab", "inv_dx" | "inv_dy" | "inv_dz") => match bin {
+            "+max finite" | "-max finite" => Some(WHY_RECIP_NOT_MAX),
+            "+subnormal" | "-subnormal" if guard => Some(WHY_GUARD_RECIP),
+            "+inf" | "-inf" if embree => Some(WHY_EMBREE),
+            _ => None,
+        },
+        ("slab", "pdx" | "pdy" | "pdz") if embree && matches!(bin, "+0" | "-0") => Some(WHY_EMBREE),
+        ("slab", "t_near") if widen >= 1 && gradual(m) => match bin {
+            "-0" | "+inf" => Some(WHY_WIDEN_NEAR),
+            "+max finite" if widen >= 2 => Some(WHY_WIDEN_NEAR),
+            _ => None,
+        },
+        ("slab", "t_far") if widen >= 1 && gradual(m) => match bin {
+            "+0" | "-inf" => Some(WHY_WIDEN_FAR),
+            "-max finite" if widen >= 2 => Some(WHY_WIDEN_FAR),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// A unit's reason why rounding bin `bin` of operation coverpoint `signal` (`name (op)`) is
+/// unreachable.
+fn unit_rounding_reason(m: &Manifest, signal: &str, bin: &str) -> Option<&'static str> {
+    let (name, op) = signal.split_once(" (")?;
+    let op = op.trim_end_matches(')');
+    let guard = m.params.get("slab_guard") == Some(&1);
+    let valid = field(m, name).is_some_and(|x| x.1.care_when.as_deref() == Some("valid"));
+    let recip = matches!((m.unit.as_str(), name), ("rti", "inv_det") | ("slab", "inv_dx" | "inv_dy" | "inv_dz"));
+    match (bin, op) {
+        ("underflow", "add" | "sub") if gradual(m) => Some(WHY_SUM_TINY_EXACT),
+        ("tie", "div") if recip => Some(WHY_RECIP_NO_TIE),
+        ("NaN", "div") if m.unit == "rti" && name == "inv_det" && valid => Some(WHY_RTI_DET_NUMBER),
+        ("overflow" | "underflow", "div") if m.unit == "slab" && recip && guard => Some(WHY_GUARD_RECIP),
+        ("overflow", "sub") if m.unit == "slab" && guard => Some(WHY_GUARD_SUB),
+        ("overflow", "div") if m.unit == "slab" && recip && m.params.get("slab_embree") == Some(&1) && gradual(m) => {
+            Some(WHY_EMBREE)
+        }
+        ("overflow", "mul" | "div") if m.unit == "rti" && valid && (name == "u" || name == "v") => {
+            Some(WHY_RTI_UV_NO_OVERFLOW)
+        }
+        _ => None,
+    }
+}
 
 /// The rounded operations of the set's unit with IEEE-like operands: (stage, signal, op, a, b).
 fn arith_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str, &'static str)> {

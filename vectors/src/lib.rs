@@ -7,6 +7,7 @@
 pub mod axis;
 pub mod capture;
 pub mod check;
+pub mod close;
 pub mod cover;
 pub mod gen;
 pub mod hdl;

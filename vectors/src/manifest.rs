@@ -147,6 +147,19 @@ pub struct Manifest {
     /// counterexamples: `raypipe prove ... --out`); absent for a generated set.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub origin: Option<String>,
+    /// The coverage-closure class (`raypipe vectors --close`): its rows are given, found by a
+    /// search, not drawn from the seed; absent for a set without one.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub closure: Option<Closure>,
+}
+
+/// The class a coverage closure appended (`raypipe vectors --close`).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Closure {
+    /// Its class id (the last class).
+    pub class: u32,
+    /// What found its rows (the search, its seed and budget).
+    pub origin: String,
 }
 
 /// What a minimal set was cut from and what it keeps detecting.

@@ -21,6 +21,7 @@ fn req(unit: Unit, format: &str) -> Request {
         leaves: 8,
         max_levels: 64,
         explicit: None,
+        closure: None,
         threads: 1,
     }
 }

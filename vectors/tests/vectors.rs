@@ -23,6 +23,7 @@ fn req(unit: Unit, format: &str, count: usize) -> Request {
         leaves: 8,
         max_levels: 64,
         explicit: None,
+        closure: None,
         threads: 1,
     }
 }

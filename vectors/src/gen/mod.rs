@@ -98,6 +98,9 @@ pub struct Request {
     pub max_levels: usize,
     /// Input rows given instead of drawn from the seed (unit slab): a proof's counterexamples.
     pub explicit: Option<Explicit>,
+    /// Input rows appended as one more class after the seeded classes (units rti, slab, op,
+    /// capture): the coverage closure's directed vectors (`crate::close`).
+    pub closure: Option<Explicit>,
 }
 
 /// A set's input rows given by their writer (e.g. `raypipe prove --out`), one class.
@@ -193,12 +196,15 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
     if req.explicit.is_some() && req.unit != Unit::Slab {
         return Err("given input rows are supported for the slab unit only".into());
     }
+    if req.closure.is_some() && req.unit == Unit::Traverse {
+        return Err("a traverse set has no closure class".into());
+    }
     let w = f.width();
     let k = kind_of(&f);
     let mut r = SplitMix64::new(req.seed);
     let mut options = BTreeMap::new();
     let mut params = format_params(&f);
-    let (classes, latency, stages): (Vec<(String, String)>, u32, Vec<Stage>);
+    let (mut classes, latency, stages): (Vec<(String, String)>, u32, Vec<Stage>);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(req.threads.max(1)).build().map_err(|e| e.to_string())?;
     let unit = req.unit.name();
     let mut files: Vec<Rows> = Vec::new();
@@ -388,6 +394,10 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
                     Ok(Some(rti_rows(&rti, c as u64, &bits).to_vec()))
                 })
             })?;
+            let per_class = append_closure(req, &mut classes, per_class, RTI_INPUTS.len(), |c, bits| {
+                let bits: Vec<u64> = bits.iter().map(|&b| f.to_bits(f.from_bits(b))).collect();
+                rti_rows(&rti, c, &bits).to_vec()
+            })?;
             counts = push_rows(&mut files, per_class);
         }
         Unit::Slab => {
@@ -512,6 +522,10 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
                         Ok(Some(slab_rows(&slab, c as u64, &bits).to_vec()))
                     })
                 })?;
+                let per_class = append_closure(req, &mut classes, per_class, names.len(), |c, bits| {
+                    let bits: Vec<u64> = bits.iter().map(|&b| f.to_bits(f.from_bits(b))).collect();
+                    slab_rows(&slab, c, &bits).to_vec()
+                })?;
                 counts = push_rows(&mut files, per_class);
             }
         }
@@ -535,6 +549,13 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
                     inputs.extend(bits);
                     Ok(Some(vec![inputs, expected, stages]))
                 })
+            })?;
+            let n_in = crate::capture::input_layout(&k, w).0.len() - 1;
+            let per_class = append_closure(req, &mut classes, per_class, n_in, |c, bits| {
+                let [expected, stages] = crate::capture::out_rows(&rti, bits, &NoFault);
+                let mut inputs = vec![c];
+                inputs.extend_from_slice(bits);
+                vec![inputs, expected, stages]
             })?;
             counts = push_rows(&mut files, per_class);
         }
@@ -595,6 +616,20 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
                             pairs.push((3, r.next_u64() & mask, s | (op << 60)));
                         }
                     }
+                }
+            }
+            if let Some(cl) = &req.closure {
+                let c = classes.len() as u64;
+                classes.push((cl.class.clone(), cl.covers.clone()));
+                counts.push(0);
+                for row in &cl.rows {
+                    let [op, a, b] = row[..] else {
+                        return Err(format!("an op input row has {} fields, not 3 (opcode, a, b)", row.len()));
+                    };
+                    if op >= OPCODES.len() as u64 {
+                        return Err(format!("opcode {op} does not exist"));
+                    }
+                    pairs.push((c, a & mask, (b & mask) | (op << 60)));
                 }
             }
             for (c, a, bop) in pairs {
@@ -670,8 +705,38 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
             .collect(),
         minimal: None,
         origin: req.explicit.as_ref().map(|e| e.origin.clone()),
+        closure: req
+            .closure
+            .as_ref()
+            .map(|cl| manifest::Closure { class: classes.len() as u32 - 1, origin: cl.origin.clone() }),
     };
     Ok(VectorSet { manifest, files: files.into_iter().map(|fr| (fr.name, fr.lines.join("\n") + "\n")).collect() })
+}
+
+/// `per_class` with the request's closure rows appended as one more class (named in
+/// `classes`); `rows(class, input bits)` builds a row's files. Unchanged without a closure.
+fn append_closure(
+    req: &Request,
+    classes: &mut Vec<(String, String)>,
+    mut per_class: Vec<crate::rows::ClassRows>,
+    inputs: usize,
+    rows: impl Fn(u64, &[u64]) -> Vec<Vec<u64>>,
+) -> Result<Vec<crate::rows::ClassRows>, String> {
+    let Some(cl) = &req.closure else { return Ok(per_class) };
+    if req.explicit.is_some() {
+        return Err("a set of given rows has no closure class".into());
+    }
+    let c = classes.len() as u64;
+    classes.push((cl.class.clone(), cl.covers.clone()));
+    let mut out = Vec::with_capacity(cl.rows.len());
+    for bits in &cl.rows {
+        if bits.len() != inputs {
+            return Err(format!("a closure input row has {} fields, not {inputs}", bits.len()));
+        }
+        out.push(rows(c, bits));
+    }
+    per_class.push(out);
+    Ok(per_class)
 }
 
 /// What the manifest says of acceptable values.
