@@ -140,6 +140,7 @@ pub fn field_reference() -> Result<String, String> {
         out += &format!("| `{k}` | {v} |\n");
     }
     out += "| `minimal` | (a minimal set only) what it was cut from and the faults it keeps detecting |\n";
-    out += "| `origin` | (a set of given rows only, e.g. a proof's counterexample: `raypipe prove slab-never-misses --out`) the command that wrote the input rows; `vectors --check` rebuilds the set from its own input rows instead of the seed |\n\n";
+    out += "| `origin` | (a set of given rows only, e.g. a proof's counterexample: `raypipe prove slab-never-misses --out`) the command that wrote the input rows; `vectors --check` rebuilds the set from its own input rows instead of the seed |\n";
+    out += "| `closure` | (a set written with `raypipe vectors --close` only) `class`: the id of the last class, `close`, whose input rows a coverage-directed search found (docs/coverage.md); `origin`: the search, its seed and budget. `vectors --check` rebuilds the other classes from the seed and the close class from the set's own input rows |\n\n";
     Ok(out + &sections)
 }

@@ -96,3 +96,60 @@ fn cover_reports_merges_and_gates() {
     }
     let _ = std::fs::remove_dir_all(&tmp);
 }
+
+/// `vectors --close`: the closed set reaches every reachable bin (`cover --fail-under 100`
+/// passes it; slab conservative and traverse in fp16 and f32), `vectors --check` accepts it,
+/// and --close is refused where it does not apply (exit 2: with --check or --minimal, a budget
+/// over the limit).
+#[test]
+fn vectors_close_from_the_command_line() {
+    let tmp = std::env::temp_dir().join(format!("raypipe-close-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).unwrap();
+    let s = tmp.join("slab");
+    let o = raypipe(&[
+        "vectors",
+        "--unit",
+        "slab",
+        "--variant",
+        "conservative",
+        "--format",
+        "fp16",
+        "--close",
+        "--out",
+        &s.display().to_string(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("coverage closure:") && text.contains("close "), "{text}");
+    let ss = s.display().to_string();
+    assert!(raypipe(&["cover", &ss, "--fail-under", "100"]).status.success());
+    assert!(raypipe(&["vectors", "--check", &ss]).status.success());
+    let m: serde_json::Value = serde_json::from_slice(&std::fs::read(s.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(m["classes"].as_array().unwrap().last().unwrap()["name"], "close");
+    assert!(m["closure"]["origin"].as_str().unwrap().contains("seed"));
+    // traverse (built-in scene): every closure ray is also checked against the stack traversal
+    for format in ["fp16", "f32"] {
+        let t = tmp.join(format!("trav-{format}"));
+        let ts = t.display().to_string();
+        let o = raypipe(&["vectors", "--unit", "traverse", "--format", format, "--close", "--out", &ts]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(raypipe(&["cover", &ts, "--fail-under", "100"]).status.success(), "traverse {format}");
+        assert!(raypipe(&["vectors", "--check", &ts]).status.success());
+    }
+    for args in [
+        vec!["vectors", "--unit", "rti", "--close", "--check", "x"],
+        vec!["vectors", "--unit", "rti", "--close", "--minimal"],
+        vec!["vectors", "--unit", "rti", "--close", "--close-budget", "1000000000"],
+    ] {
+        let out = tmp.join("x").display().to_string();
+        let mut v = args.clone();
+        v.extend(["--out", &out]);
+        let o = raypipe(&v);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(!err.contains("panicked"));
+        assert!(!tmp.join("x").exists());
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}

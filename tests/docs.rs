@@ -199,3 +199,16 @@ fn the_vector_field_reference_is_generated() {
     let have = std::fs::read_to_string(&path).unwrap_or_default();
     assert!(have == want, "docs/vector-fields.md is stale: RAYPIPE_BLESS_DOCS=1 cargo test --release --test docs");
 }
+
+/// `docs/coverage-model.md` is what the coverage model says
+/// (`RAYPIPE_BLESS_DOCS=1 cargo test --release --test docs` rewrites it).
+#[test]
+fn the_coverage_model_reference_is_generated() {
+    let want = raypipe::cover_reference::coverage_reference().unwrap();
+    let path = root().join("docs/coverage-model.md");
+    if std::env::var_os("RAYPIPE_BLESS_DOCS").is_some() {
+        std::fs::write(&path, &want).unwrap();
+    }
+    let have = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(have == want, "docs/coverage-model.md is stale: RAYPIPE_BLESS_DOCS=1 cargo test --release --test docs");
+}

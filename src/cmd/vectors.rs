@@ -162,18 +162,16 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         slab_variant: variant,
     };
     let set = if close {
-        if unit == vectors::gen::Unit::Traverse {
-            return Err("--close covers the units rti, slab, op and capture (not traverse yet)".into());
-        }
         limit("--close-budget", close_budget, 100_000_000, "the search measures candidates one batch at a time")?;
         let c = vectors::close::close(&req, close_budget)?;
         let pct = |(h, n): (u64, u64)| 100.0 * h as f64 / n.max(1) as f64;
         println!(
-            "coverage closure: {} of {} reachable bins before ({:.1} %), {} after ({:.1} %); {} of {} candidates kept as class close",
+            "coverage closure: before {} of {} reachable bins ({:.1} %), after {} of {} ({:.1} %; the close class's own bin included); {} of {} candidates kept as class close",
             c.before.0,
             c.before.1,
             pct(c.before),
             c.after.0,
+            c.after.1,
             pct(c.after),
             c.kept,
             c.candidates

@@ -58,9 +58,6 @@ pub fn close(req: &Request, budget: u64) -> Result<Closed, String> {
     if req.closure.is_some() || req.explicit.is_some() {
         return Err("--close applies to a generated set (not to given rows or an already closed set)".into());
     }
-    if !matches!(req.unit, Unit::Rti | Unit::Slab | Unit::Op | Unit::Capture) {
-        return Err("--close covers the units rti, slab, op and capture (traverse sets are rays through a scene's tree: not yet)".into());
-    }
     let base = generate(req)?;
     let before = Coverage::measure(&base.manifest, &set_rows(&base)?)?.totals();
     let origin = format!(

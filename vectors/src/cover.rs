@@ -174,16 +174,25 @@ impl Coverage {
                     match name {
                         "other NaN" if out && canonical => Some(WHY_CANONICAL),
                         "+subnormal" | "-subnormal" if out && ftz => Some(WHY_FTZ),
-                        _ if out => unit_value_reason(m, x, name),
+                        _ if x.dir == "out" && m.unit != "capture" => unit_value_reason(m, x, name),
                         _ => None,
                     }
                 };
+                let empty_class = |k: usize| kind == "class" && m.classes.get(k).is_some_and(|c| c.count == 0);
                 coverpoints.push(Coverpoint {
                     signal: x.name.clone(),
                     role: role_name(&f.role).into(),
                     stage: x.stage,
                     kind: kind.into(),
-                    bins: bins.into_iter().map(|name| Bin { unreachable: why(&name), name, count: 0 }).collect(),
+                    bins: bins
+                        .into_iter()
+                        .enumerate()
+                        .map(|(k, name)| Bin {
+                            unreachable: if empty_class(k) { Some(WHY_NO_CLASS_ROWS) } else { why(&name) },
+                            name,
+                            count: 0,
+                        })
+                        .collect(),
                 });
             }
         }
@@ -500,7 +509,7 @@ pub const WHY_SUM_TINY_EXACT: &str = "a sum or difference of two values is a mul
 /// Why the RTI unit's t, u and v are never negative where they are compared.
 pub const WHY_RTI_SIGN: &str = "compared only when valid: then |det| > det_threshold >= 0 (det a number, not zero) and u', v', t' are NaN-free and zero or of det's sign (u_ok, v_ok, t_ok), and 1/det has det's sign: the product (or quotient) is +0, -0, positive, +inf or NaN, never a negative nonzero value";
 /// Why the RTI unit's u and v never reach the largest finite value.
-pub const WHY_RTI_UV_BOUNDED: &str = "compared only when valid: then 0 <= u' <= u'+v' <= det (or the mirror for det < 0; uv_ok, v' of u''s sign), so u = u' x (1/det) is at most det x fl(1/det) rounded (at most 2) while 1/det is finite, and +inf or NaN when it overflows; in divide mode u = u'/det is at most 1 (v alike)";
+pub const WHY_RTI_UV_BOUNDED: &str = "compared only when valid: then (det > 0) 0 <= u', 0 <= v' and u' <= fl(u' + v') <= det (u_ok, v_ok, uv_ok; the mirror for det < 0), so u = u' x (1/det) is at most det x fl(1/det) rounded (at most 2) while 1/det is finite, and +inf or NaN when it overflows; in divide mode u = u'/det is at most 1 (v alike)";
 /// Why the RTI unit's u and v never overflow.
 pub const WHY_RTI_UV_NO_OVERFLOW: &str = "compared only when valid: |u'| <= |det| (uv_ok), so u' x (1/det) is at most 2 while 1/det is finite, and an infinite 1/det is an infinite operand (an exact result); u'/det is at most 1 (v alike)";
 /// Why 1/x never rounds to the largest finite value.
@@ -511,12 +520,21 @@ pub const WHY_RECIP_NO_TIE: &str = "1/x is exact when x is a power of two, and o
 pub const WHY_RTI_DET_NUMBER: &str =
     "compared only when valid: then |det| > det_threshold, so det is not NaN and 1/det is not NaN";
 /// Why the conservative guard removes tiny and overflowed reciprocals.
-pub const WHY_GUARD_RECIP: &str = "the conservative guard: 1/d of a finite nonzero d that is subnormal, zero or infinite is the canonical NaN (counted as NaN)";
+pub const WHY_GUARD_RECIP: &str = "the conservative guard: 1/d of a finite nonzero d whose result is subnormal, zero or infinite (overflowed) is the canonical NaN (counted as NaN)";
 /// Why the conservative guard removes overflowed differences.
 pub const WHY_GUARD_SUB: &str =
     "the conservative guard: a difference of finite operands that overflows is the canonical NaN (counted as NaN)";
 /// Why Embree's direction preparation leaves no zero and no infinite reciprocal.
 pub const WHY_EMBREE: &str = "embree preparation: |d| < delta becomes +-delta (delta = 2/max rounded up, > 0), so pd is never zero, and 1/pd is at most 1/delta <= max/2 in magnitude: never infinite from a finite pd, never an overflow";
+/// Why a class bin stays empty.
+pub const WHY_NO_CLASS_ROWS: &str =
+    "the class has no vectors in this format (its manifest count is 0: a floats-only class in fixed point)";
+/// Why a fixed-point reciprocal is never 0 or one step.
+pub const WHY_FIXED_RECIP: &str = "every value x of q<I>.<F> has |x| < 2^(I-1), so |1/x| > 2^(F-I+1) steps >= 2 steps when F >= I (and 1/0 and a too large 1/x saturate): no rounding gives 0 or one step";
+/// Why the RTI unit's fixed-point t, u and v are never negative where they are compared.
+pub const WHY_RTI_SIGN_FIXED: &str = "compared only when valid: then det is nonzero and u', v', t' are zero or of det's sign (u_ok, v_ok, t_ok), as is 1/det: the exact product (or quotient) is >= 0, and no rounding (floor, ceil, toward zero, nearest) of a value >= 0 is negative when the format saturates";
+/// Why the RTI unit's fixed-point u and v never saturate high.
+pub const WHY_RTI_UV_BOUNDED_FIXED: &str = "compared only when valid: then 0 <= u' <= fl(u' + v') <= det (det > 0; the mirror for det < 0), so u = u' x (1/det) is at most det x fl(1/det) plus a rounding, at most 2 + 2 steps below the largest value of a format with at least 3 integer bits (1/det saturated is below 1/det, det x (1/det) <= 1 + det x step); u'/det is at most 1 (v alike)";
 /// Why a widened entry distance never takes some values.
 pub const WHY_WIDEN_NEAR: &str = "t_near is tn_xyz stepped toward -inf (nextDown) at least once: nextDown never returns -0 or +inf, and from two steps on never +max (only nextDown(+inf) is +max)";
 /// Why a widened exit distance never takes some values.
@@ -529,6 +547,9 @@ fn gradual(m: &Manifest) -> bool {
 
 /// A unit's reason why a value-class bin of output or stage field `x` is unreachable.
 fn unit_value_reason(m: &Manifest, x: &Field, bin: &str) -> Option<&'static str> {
+    if let Kind::Fixed { int, frac } = x.kind {
+        return fixed_value_reason(m, x, bin, int, frac);
+    }
     if !matches!(x.kind, Kind::Ieee { .. }) {
         return None;
     }
@@ -560,6 +581,22 @@ fn unit_value_reason(m: &Manifest, x: &Field, bin: &str) -> Option<&'static str>
             "-max finite" if widen >= 2 => Some(WHY_WIDEN_FAR),
             _ => None,
         },
+        _ => None,
+    }
+}
+
+/// [`unit_value_reason`] for a fixed-point field `x` of format `q<int>.<frac>`.
+fn fixed_value_reason(m: &Manifest, x: &Field, bin: &str, int: u32, frac: u32) -> Option<&'static str> {
+    let saturating = !m.format.contains("wrap");
+    let valid = x.care_when.as_deref() == Some("valid");
+    let recip =
+        matches!((m.unit.as_str(), x.name.as_str()), ("rti", "inv_det") | ("slab", "inv_dx" | "inv_dy" | "inv_dz"));
+    match (m.unit.as_str(), x.name.as_str()) {
+        _ if recip && saturating && frac >= int && matches!(bin, "0" | "+1 step" | "-1 step") => Some(WHY_FIXED_RECIP),
+        ("rti", "t" | "u" | "v") if valid && saturating && matches!(bin, "-1 step" | "min" | "negative") => {
+            Some(WHY_RTI_SIGN_FIXED)
+        }
+        ("rti", "u" | "v") if valid && saturating && int >= 3 && bin == "+max" => Some(WHY_RTI_UV_BOUNDED_FIXED),
         _ => None,
     }
 }
@@ -863,6 +900,65 @@ mod tests {
         assert_eq!(utc(0), "1970-01-01T00:00:00");
         assert_eq!(utc(951_782_400), "2000-02-29T00:00:00");
         assert_eq!(utc(1_796_390_257), "2026-12-04T13:17:37");
+    }
+
+    /// The arithmetic behind three reasons, over every fp16 and e5m6 value: 1/x never rounds
+    /// to ±max and is never a tie (WHY_RECIP_NOT_MAX, WHY_RECIP_NO_TIE); a tiny sum of two
+    /// e5m6 values is exact (WHY_SUM_TINY_EXACT, every pair).
+    #[test]
+    fn reciprocals_and_tiny_sums_exhaustively() {
+        use datapath::Format;
+        for name in ["fp16", "e5m6"] {
+            let f: datapath::AnyFormat = name.parse().unwrap();
+            datapath::with_format!(f, |f| {
+                let datapath::format::FormatKind::Float(l) = f.kind() else { unreachable!() };
+                let n = 1u64 << f.width();
+                let max = f.to_f64(f.from_bits((((1u64 << l.exp_bits) - 2) << l.man_bits) | l.man_mask()));
+                let mut ties = 0;
+                for b in 0..n {
+                    let x = f.from_bits(b);
+                    let xf = f.to_f64(x);
+                    if !xf.is_finite() || xf == 0.0 {
+                        continue;
+                    }
+                    let r = f.to_f64(f.div(f.one(), x));
+                    assert_ne!(r.abs(), max, "{name}: 1/{xf}");
+                    // a tie: r x = 1 ± half a step exactly; the exact 1/x against the midpoint
+                    if r.is_finite() && r != 0.0 {
+                        let up = f.to_f64(f.next_up(f.from_f64(r)));
+                        let down = f.to_f64(f.next_down(f.from_f64(r)));
+                        for nb in [up, down] {
+                            if nb.is_finite() && ((r + nb) / 2.0) * xf == 1.0 {
+                                ties += 1;
+                            }
+                        }
+                    }
+                }
+                assert_eq!(ties, 0, "{name}");
+            });
+        }
+        let f: datapath::AnyFormat = "e5m6".parse().unwrap();
+        datapath::with_format!(f, |f| {
+            let min_normal = (2f64).powi(-14);
+            let n = 1u64 << f.width();
+            let mut tiny = 0u64;
+            for a in 0..n {
+                let x = f.to_f64(f.from_bits(a));
+                if !x.is_finite() {
+                    continue;
+                }
+                for b in 0..n {
+                    let y = f.to_f64(f.from_bits(b));
+                    if !y.is_finite() || (x + y).abs() >= min_normal {
+                        continue;
+                    }
+                    assert_eq!(f.to_f64(f.add(f.from_bits(a), f.from_bits(b))), x + y, "{x} + {y}");
+                    tiny += 1;
+                }
+            }
+            // every pair of subnormals and of nearby normals of opposite signs
+            assert!(tiny > 1 << 14, "{tiny}");
+        });
     }
 
     #[test]

@@ -260,6 +260,7 @@ pub(crate) fn generate<F: Format>(
     seed: u64,
     level: u32,
     rays_layout: Layout,
+    closure: Option<&crate::gen::Explicit>,
 ) -> Result<TraverseParts, String> {
     if n == 0 || n > 255 {
         return Err(format!("--leaves must be 1..=255, got {n}"));
@@ -309,7 +310,28 @@ pub(crate) fn generate<F: Format>(
     }
     let crosses = crosses(level);
     let float = is_float(&f);
-    let per_class = crate::rows::per_class_rows(seed, crosses.len(), count, |c, r| {
+    // a ray's rows (class c), once the hardware traversal is checked against the stack
+    // traversal: it must visit the same leaves, in order
+    let rows_of = |c: usize, bits: &[u64], o: &Observed| -> Result<Vec<Vec<u64>>, String> {
+        let xs = |i: usize| f.to_f64(f.from_bits(bits[i]));
+        let ray = s.prepare([xs(0), xs(1), xs(2)], [xs(3), xs(4), xs(5)], xs(6), xs(7));
+        let g = golden::bvh::stack_traverse(&golden, n, |i| {
+            let nd = &tree.nodes[i as usize];
+            let b = s.store_box(nd.min, nd.max).ok()?;
+            let out = s.test(&ray, &b);
+            out.hit.then(|| f.to_f64(out.t_near))
+        });
+        if g.leaves != o.result.leaves {
+            return Err(format!(
+                "history traversal differs from the stack traversal (class {c}, ray {bits:x?}): {:?} vs {:?}",
+                o.result.leaves, g.leaves
+            ));
+        }
+        let mut row = vec![c as u64];
+        row.extend_from_slice(bits);
+        Ok(vec![row, expected_row(&o.result, n, depth)])
+    };
+    let mut per_class = crate::rows::per_class_rows(seed, crosses.len(), count, |c, r| {
         let (gen, keep) = crosses[c];
         if gen == 8 && !float {
             return Ok(None);
@@ -321,27 +343,23 @@ pub(crate) fn generate<F: Format>(
             if !keeps(gen, &o, n) || !keep.is_none_or(|k| keeps(k, &o, n)) {
                 continue;
             }
-            // the hardware traversal must visit the stack traversal's leaves, in order
-            let xs = |i: usize| f.to_f64(f.from_bits(bits[i]));
-            let ray = s.prepare([xs(0), xs(1), xs(2)], [xs(3), xs(4), xs(5)], xs(6), xs(7));
-            let g = golden::bvh::stack_traverse(&golden, n, |i| {
-                let nd = &tree.nodes[i as usize];
-                let b = s.store_box(nd.min, nd.max).ok()?;
-                let out = s.test(&ray, &b);
-                out.hit.then(|| f.to_f64(out.t_near))
-            });
-            if g.leaves != o.result.leaves {
-                return Err(format!(
-                    "history traversal differs from the stack traversal (class {c}, ray {bits:x?}): {:?} vs {:?}",
-                    o.result.leaves, g.leaves
-                ));
-            }
-            let mut row = vec![c as u64];
-            row.extend_from_slice(&bits);
-            return Ok(Some(vec![row, expected_row(&o.result, n, depth)]));
+            return rows_of(c, &bits, &o).map(Some);
         }
         Ok(None) // the class is rare or impossible on this tree: its count says so
     })?;
+    if let Some(cl) = closure {
+        let c = crosses.len();
+        let mut rows = Vec::with_capacity(cl.rows.len());
+        for bits in &cl.rows {
+            if bits.len() != RAY_INPUTS.len() {
+                return Err(format!("a closure ray has {} fields, not {}", bits.len(), RAY_INPUTS.len()));
+            }
+            let bits: Vec<u64> = bits.iter().map(|&b| f.to_bits(f.from_bits(b))).collect();
+            let o = run(&s, &hw, n, &bits, &leaf_depth, deepest, &NoFault);
+            rows.push(rows_of(c, &bits, &o)?);
+        }
+        per_class.push(rows);
+    }
     let counts = crate::rows::push_rows(&mut files[..2], per_class);
     let mut params = BTreeMap::new();
     params.insert("leaves".into(), n as u64);

@@ -196,8 +196,8 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
     if req.explicit.is_some() && req.unit != Unit::Slab {
         return Err("given input rows are supported for the slab unit only".into());
     }
-    if req.closure.is_some() && req.unit == Unit::Traverse {
-        return Err("a traverse set has no closure class".into());
+    if req.closure.is_some() && req.explicit.is_some() {
+        return Err("a set of given rows has no closure class".into());
     }
     let w = f.width();
     let k = kind_of(&f);
@@ -657,8 +657,12 @@ pub(crate) fn generate_in<F: Format>(f: F, req: &Request) -> Result<VectorSet, S
                     req.seed,
                     req.level,
                     inputs_layout(&crate::traverse::RAY_INPUTS, vec![]),
+                    req.closure.as_ref(),
                 )
             })?;
+            if let Some(cl) = &req.closure {
+                classes.push((cl.class.clone(), cl.covers.clone()));
+            }
             files = parts.files;
             counts = parts.counts;
             params.extend(parts.params);
