@@ -150,7 +150,8 @@ pub fn close(req: &Request, budget: u64) -> Result<Closed, String> {
 /// det = D, u' = o.x, v' = D o.z, t' = −D o.y, and u, v, t are o.x / D, o.z, −o.y (rounded):
 /// the template itself (D = 1), with o.x or o.z the smallest normal (u or v at the smallest
 /// normal), o.y = −max (t at the largest finite value), D = ±2^−emin (1/det at ±the smallest
-/// normal) and D the value below 1 with o.y = −max (t' x (1/det) above the largest finite).
+/// normal) and D the value below 1 with o.y = −max (t' x (1/det) above the largest finite);
+/// and three placements whose differences lose M + 1 bits (p.y, p.z, det_xy, u'_xy, v'_xy).
 fn templates(unit: Unit, kinds: &[Kind]) -> Vec<Vec<u64>> {
     let Some(Kind::Ieee { exp, man }) = kinds.first() else { return Vec::new() };
     let (exp, man) = (*exp, *man);
@@ -194,6 +195,13 @@ fn templates(unit: Unit, kinds: &[Kind]) -> Vec<Vec<u64>> {
         with(&[(1, max), (11, one - 1)]),
         // o.y = 1 and v1.z = 1: q.x = 1, so v'_x = d.x
         with(&[(1, one), (13, one)]),
+        // cancellation of M + 1 bits (p1 = the value below 1): d = (1, 1, 1), v2 = (p1, 1, 1)
+        // gives p.y = p1 - 1 and p.z = 1 - p1; o = (0, 0, 1), d = (p1, 1, 0), v1 = (1, 1, 0)
+        // gives det_xy = 1 - p1 and v'_xy = 1 - p1
+        with(&[(3, one), (5, one), (14, one - 1), (15, one)]),
+        with(&[(2, one), (3, one - 1), (12, one)]),
+        // and with o = (1, 1, 1): u'_xy = 1 - p1
+        with(&[(0, one), (1, one), (2, one), (3, one - 1), (12, one)]),
     ]
 }
 
@@ -253,7 +261,7 @@ fn mutate(
         match &kinds[i] {
             Kind::Ieee { exp, man } => {
                 let (exp, man) = (*exp, *man);
-                match r.below(10) {
+                match r.below(11) {
                     8 | 9 if !targets.is_empty() => {
                         // a value of the class of a bin still empty, or (half the time) one 1
                         // to 8 encodings beside it
@@ -265,6 +273,16 @@ fn mutate(
                         }
                     }
                     8 | 9 => x[i] = r.next_u64() & mask(w),
+                    10 => {
+                        // a pair: input i ± a power of two, another float input the encoding
+                        // below it, of either sign (a − b or a + b loses M + 1 bits)
+                        let j = r.below(n) as usize;
+                        if j != i && kinds[j] == kinds[i] {
+                            let e = 1 + r.below((1u64 << exp) - 2);
+                            x[i] = (e << man) | (r.below(2) << (exp + man));
+                            x[j] = (x[i] - 1) ^ (r.below(2) << (exp + man));
+                        }
+                    }
                     0 | 1 => {
                         // an edge encoding, or (half the time) one 1 to 8 encodings beside it
                         let e = float_edges(exp, man);

@@ -239,6 +239,32 @@ impl Coverage {
                     .collect(),
             });
         }
+        for (stage, name, op, _, _) in arith_rows(m).into_iter().filter(|r| r.2 == "add" || r.2 == "sub") {
+            let man = m.params.get("man").copied().unwrap_or(0);
+            coverpoints.push(Coverpoint {
+                signal: format!("{name} ({op})"),
+                role: "stage signals".into(),
+                stage: Some(stage),
+                kind: "cancellation".into(),
+                bins: cancellation_bins(man)
+                    .into_iter()
+                    .map(|n| Bin { name: n, count: 0, unreachable: None })
+                    .collect(),
+            });
+        }
+        for e in events(m) {
+            coverpoints.push(Coverpoint {
+                signal: e.signal(),
+                role: "events".into(),
+                stage: None,
+                kind: "event".into(),
+                bins: e
+                    .bins()
+                    .iter()
+                    .map(|&n| Bin { name: n.into(), count: 0, unreachable: e.unreachable(m, n) })
+                    .collect(),
+            });
+        }
         Coverage { unit: m.unit.clone(), format: m.format.clone(), vectors: 0, coverpoints }
     }
 
@@ -328,6 +354,7 @@ pub struct RowBins<'a> {
     cmps: Vec<(u8, &'static str, &'static str, &'static str)>,
     ariths: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
     op_rounding: bool,
+    events: Vec<Event>,
 }
 
 impl<'a> RowBins<'a> {
@@ -339,6 +366,7 @@ impl<'a> RowBins<'a> {
             cmps: compares(m),
             ariths: arith_rows(m),
             op_rounding: op_unit_rounding(m),
+            events: events(m),
         }
     }
 
@@ -401,6 +429,23 @@ impl<'a> RowBins<'a> {
             if let Some(bin) = op.and_then(|op| rounding_event(m, contents, row, "result", op, "a", "b", ftz)) {
                 out.push((cp, bin));
             }
+            cp += 1;
+        }
+        for &(_, name, op, a, b) in self.ariths.iter().filter(|r| r.2 == "add" || r.2 == "sub") {
+            if let Some(bin) = cancellation(m, contents, row, name, op, a, b, ftz) {
+                out.push((cp, bin));
+            }
+            cp += 1;
+        }
+        for e in &self.events {
+            let v = |n: &str| operand(m, contents, row, n, ftz);
+            let flag = |n: &str| {
+                field(m, n).and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied()).map(|b| b & 1 == 1)
+            };
+            for bin in e.measure(m, &v, &flag) {
+                out.push((cp, bin));
+            }
+            cp += 1;
         }
         Ok(())
     }
@@ -526,6 +571,8 @@ pub const WHY_GUARD_SUB: &str =
     "the conservative guard: a difference of finite operands that overflows is the canonical NaN (counted as NaN)";
 /// Why Embree's direction preparation leaves no zero and no infinite reciprocal.
 pub const WHY_EMBREE: &str = "embree preparation: |d| < delta becomes +-delta (delta = 2/max rounded up, > 0), so pd is never zero, and 1/pd is at most 1/delta <= max/2 in magnitude: never infinite from a finite pd, never an overflow";
+/// Why Embree's preparation in fixed point leaves no tiny pd and no saturated reciprocal.
+pub const WHY_EMBREE_FIXED: &str = "embree preparation: |d| < delta becomes +-delta (delta = 2/max rounded up, more than one step), so pd is never 0 or one step, and |1/pd| <= 1/delta <= max/2: never saturated";
 /// Why a class bin stays empty.
 pub const WHY_NO_CLASS_ROWS: &str =
     "the class has no vectors in this format (its manifest count is 0: a floats-only class in fixed point)";
@@ -591,7 +638,12 @@ fn fixed_value_reason(m: &Manifest, x: &Field, bin: &str, int: u32, frac: u32) -
     let valid = x.care_when.as_deref() == Some("valid");
     let recip =
         matches!((m.unit.as_str(), x.name.as_str()), ("rti", "inv_det") | ("slab", "inv_dx" | "inv_dy" | "inv_dz"));
+    let embree = m.params.get("slab_embree") == Some(&1) && m.params.get("slab_delta").is_some_and(|&d| d > 1);
     match (m.unit.as_str(), x.name.as_str()) {
+        ("slab", "pdx" | "pdy" | "pdz") if embree && matches!(bin, "0" | "+1 step" | "-1 step") => {
+            Some(WHY_EMBREE_FIXED)
+        }
+        _ if recip && embree && saturating && matches!(bin, "+max" | "min") => Some(WHY_EMBREE_FIXED),
         _ if recip && saturating && frac >= int && matches!(bin, "0" | "+1 step" | "-1 step") => Some(WHY_FIXED_RECIP),
         ("rti", "t" | "u" | "v") if valid && saturating && matches!(bin, "-1 step" | "min" | "negative") => {
             Some(WHY_RTI_SIGN_FIXED)
@@ -779,6 +831,287 @@ fn neighbour(r: f64, up: bool, exp: u32, man: u32) -> f64 {
         n
     } else {
         -n
+    }
+}
+
+/// The bins of a subtraction's (or addition's) cancellation depth: the bits lost, the exponent of
+/// the larger operand minus the exponent of the result, for operands of opposite effective
+/// signs.
+pub fn cancellation_bins(man: u64) -> Vec<String> {
+    vec![
+        "same signs or a zero operand (no cancellation)".into(),
+        "0 bits lost".into(),
+        "1 bit lost".into(),
+        format!("2 to {man} bits lost"),
+        format!("{} or more bits lost", man + 1),
+        "exact zero (x - x)".into(),
+    ]
+}
+
+/// The exponent of a nonzero finite binary64 value (floor of log2 |v|).
+fn exponent(v: f64) -> i64 {
+    let b = v.abs().to_bits();
+    let e = ((b >> 52) & 0x7ff) as i64;
+    if e == 0 {
+        // a binary64 subnormal: below every format value raypipe has, but stay exact
+        return -1023 - (b.leading_zeros() as i64 - 12);
+    }
+    e - 1023
+}
+
+/// The cancellation bin of `name = a op b` in row `row` (None: don't-care or a NaN / infinite
+/// operand or result).
+#[allow(clippy::too_many_arguments)]
+fn cancellation(
+    m: &Manifest,
+    contents: &[Vec<Vec<u64>>],
+    row: usize,
+    name: &str,
+    op: &str,
+    a: &str,
+    b: &str,
+    ftz: bool,
+) -> Option<usize> {
+    let man = m.params.get("man").copied()? as i64;
+    let r = operand(m, contents, row, name, false)??;
+    let x = operand(m, contents, row, a, ftz)??;
+    let y = operand(m, contents, row, b, ftz)??;
+    if !(x.is_finite() && y.is_finite() && r.is_finite()) {
+        return None;
+    }
+    let y = if op == "sub" { -y } else { y };
+    if x == 0.0 || y == 0.0 || (x > 0.0) == (y > 0.0) {
+        return Some(0);
+    }
+    if x == -y {
+        return Some(5);
+    }
+    if r == 0.0 {
+        // flushed (FTZ): everything lost
+        return Some(4);
+    }
+    let lost = exponent(x).max(exponent(y)) - exponent(r);
+    Some(match lost {
+        i64::MIN..=0 => 1,
+        1 => 2,
+        l if l <= man => 3,
+        _ => 4,
+    })
+}
+
+/// A per-unit event coverpoint.
+#[derive(Clone, Copy, Debug)]
+enum Event {
+    /// RTI: det against the threshold (and its sign).
+    RtiDet,
+    /// Slab: the origin against the box on one axis.
+    SlabOrigin(usize),
+    /// Slab: the box's extent on one axis.
+    SlabExtent(usize),
+    /// Slab, conservative: which guard fired.
+    SlabGuard,
+    /// Capture: a hit whose t equals the held hit's.
+    CaptureTie,
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// The event coverpoints of the set's unit.
+fn events(m: &Manifest) -> Vec<Event> {
+    let float = m.params.get("float") == Some(&1);
+    match m.unit.as_str() {
+        "rti" if field(m, "det").is_some() => vec![Event::RtiDet],
+        "slab" => {
+            let mut v: Vec<Event> = (0..3).map(Event::SlabOrigin).chain((0..3).map(Event::SlabExtent)).collect();
+            if m.params.get("slab_guard") == Some(&1) && float {
+                v.push(Event::SlabGuard);
+            }
+            v
+        }
+        "capture" => vec![Event::CaptureTie],
+        _ => Vec::new(),
+    }
+}
+
+/// Why an event bin of a fixed-point set is never reached.
+pub const WHY_EVENT_FIXED_NAN: &str = "fixed point has no NaN";
+/// Why a zero threshold leaves a bin empty.
+pub const WHY_ZERO_THRESHOLD: &str = "the det threshold is 0: no nonzero det is at or below it in magnitude";
+
+impl Event {
+    fn signal(self) -> String {
+        match self {
+            Event::RtiDet => "det against the threshold".into(),
+            Event::SlabOrigin(a) => format!("origin against the box, axis {}", AXES[a]),
+            Event::SlabExtent(a) => format!("box extent, axis {}", AXES[a]),
+            Event::SlabGuard => "conservative guard fired".into(),
+            Event::CaptureTie => "a hit's t equals the held hit's t".into(),
+        }
+    }
+
+    fn bins(self) -> &'static [&'static str] {
+        match self {
+            Event::RtiDet => &[
+                "det > threshold",
+                "0 < det <= threshold",
+                "det = +-0",
+                "-threshold <= det < 0",
+                "det < -threshold (culled under backface culling)",
+                "NaN",
+            ],
+            Event::SlabOrigin(_) => &[
+                "o < min",
+                "o = min (on the min face)",
+                "min < o < max",
+                "o = max (on the max face)",
+                "o > max",
+                "NaN",
+            ],
+            Event::SlabExtent(_) => &["min < max", "min = max (zero extent)", "min > max (empty)", "NaN"],
+            Event::SlabGuard => &["no guard", "reciprocal guarded", "difference guarded"],
+            Event::CaptureTie => &["no tie", "tie (the tie rule decides)"],
+        }
+    }
+
+    fn unreachable(self, m: &Manifest, bin: &str) -> Option<&'static str> {
+        let float = m.params.get("float") == Some(&1);
+        if bin == "NaN" && !float {
+            return Some(WHY_EVENT_FIXED_NAN);
+        }
+        let zero_thr = m.params.get("det_thr").is_some_and(|&b| {
+            let (exp, man) = (m.params.get("exp").copied().unwrap_or(0), m.params.get("man").copied().unwrap_or(0));
+            if float {
+                b & ((1u64 << (exp + man)) - 1) == 0
+            } else {
+                b == 0
+            }
+        });
+        match (self, bin) {
+            (Event::RtiDet, "0 < det <= threshold" | "-threshold <= det < 0") if zero_thr => Some(WHY_ZERO_THRESHOLD),
+            _ => None,
+        }
+    }
+
+    /// The bins row values hit: `v(name)` an operand as the datapath reads it, `flag(name)` a
+    /// 1-bit field.
+    fn measure(
+        self,
+        m: &Manifest,
+        v: &dyn Fn(&str) -> Option<Option<f64>>,
+        flag: &dyn Fn(&str) -> Option<bool>,
+    ) -> Vec<usize> {
+        let num = |n: &str| v(n);
+        match self {
+            Event::RtiDet => {
+                let Some(det) = num("det") else { return Vec::new() };
+                let thr = m.params.get("det_thr").map_or(0.0, |&b| decode(m, b));
+                vec![match det {
+                    None => 5,
+                    Some(d) if d > thr => 0,
+                    Some(d) if d > 0.0 => 1,
+                    Some(d) if d == 0.0 => 2,
+                    Some(d) if d >= -thr => 3,
+                    Some(_) => 4,
+                }]
+            }
+            Event::SlabOrigin(a) => {
+                let (Some(o), Some(lo), Some(hi)) =
+                    (num(&format!("o{}", AXES[a])), num(&format!("min{}", AXES[a])), num(&format!("max{}", AXES[a])))
+                else {
+                    return Vec::new();
+                };
+                let (Some(o), Some(lo), Some(hi)) = (o, lo, hi) else { return vec![5] };
+                vec![if o == lo {
+                    1
+                } else if o == hi {
+                    3
+                } else if o < lo {
+                    0
+                } else if o > hi {
+                    4
+                } else {
+                    2
+                }]
+            }
+            Event::SlabExtent(a) => {
+                let (Some(lo), Some(hi)) = (num(&format!("min{}", AXES[a])), num(&format!("max{}", AXES[a]))) else {
+                    return Vec::new();
+                };
+                vec![match (lo, hi) {
+                    (Some(lo), Some(hi)) if lo < hi => 0,
+                    (Some(lo), Some(hi)) if lo == hi => 1,
+                    (Some(_), Some(_)) => 2,
+                    _ => 3,
+                }]
+            }
+            Event::SlabGuard => {
+                let finite = |x: Option<Option<f64>>| matches!(x, Some(Some(x)) if x.is_finite());
+                let nan = |x: Option<Option<f64>>| matches!(x, Some(None));
+                let mut out = Vec::new();
+                for a in AXES {
+                    let d = num(&format!("pd{a}"));
+                    if finite(d) && d != Some(Some(0.0)) && nan(num(&format!("inv_d{a}"))) {
+                        out.push(1);
+                        break;
+                    }
+                }
+                'sub: for a in AXES {
+                    for (r, b) in [("lo", "min"), ("hi", "max")] {
+                        if finite(num(&format!("{b}{a}")))
+                            && finite(num(&format!("o{a}")))
+                            && nan(num(&format!("{r}{a}")))
+                        {
+                            out.push(2);
+                            break 'sub;
+                        }
+                    }
+                }
+                if out.is_empty() {
+                    out.push(0);
+                }
+                out
+            }
+            Event::CaptureTie => {
+                let slots = m.params.get("slots").copied().unwrap_or(0) as usize;
+                let tie = (1..slots).any(|s| {
+                    flag(&format!("hit{s}")) == Some(true)
+                        && flag(&format!("c{}_hit", s - 1)) == Some(true)
+                        && matches!((num(&format!("t{s}")), num(&format!("c{}_t", s - 1))), (Some(Some(x)), Some(Some(y))) if x == y)
+                });
+                vec![usize::from(tie)]
+            }
+        }
+    }
+}
+
+/// The value of encoding `b` in the set's format (a NaN as NaN).
+fn decode(m: &Manifest, b: u64) -> f64 {
+    let p = |k: &str| m.params.get(k).copied().unwrap_or(0);
+    if p("float") == 1 {
+        let (exp, man) = (p("exp") as u32, p("man") as u32);
+        let e = (b >> man) & ((1 << exp) - 1);
+        let f = b & ((1 << man) - 1);
+        let bias = (1i64 << (exp - 1)) - 1;
+        let mag = if e == (1 << exp) - 1 {
+            if f != 0 {
+                return f64::NAN;
+            }
+            f64::INFINITY
+        } else if e == 0 {
+            f as f64 * (2f64).powi((1 - bias - man as i64) as i32)
+        } else {
+            (f as f64 + (1u64 << man) as f64) * (2f64).powi((e as i64 - bias - man as i64) as i32)
+        };
+        if (b >> (exp + man)) & 1 == 1 {
+            -mag
+        } else {
+            mag
+        }
+    } else {
+        let w = p("width") as u32;
+        // in steps, as `operand` reads fixed-point fields
+        let s = if w == 64 { b as i64 } else { ((b << (64 - w)) as i64) >> (64 - w) };
+        s as f64
     }
 }
 

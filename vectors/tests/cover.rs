@@ -194,3 +194,52 @@ fn every_closure_row_adds_a_bin_and_the_closure_is_deterministic() {
 fn explicit_close() -> vectors::gen::Explicit {
     vectors::gen::Explicit { class: "close".into(), covers: String::new(), origin: "test".into(), rows: Vec::new() }
 }
+
+/// Cancellation depth and slab events on hand-made rows. RTI fp16: v0 = (p1, -1, 0.5),
+/// v1 = (1, 1, 2), v2 = (1.5, -1, 3), o = (1.25, 0, 0) with p1 = 1 - 2^-11 gives e1x = 2^-11
+/// (11 bits lost), e1y = 1 + 1 (same signs), e1z = 1.5 (1 bit), e2x ~ 0.5 (1 bit), e2y = 0
+/// (exact zero), e2z = 2.5 (0 bits), sx ~ 0.25 (2 bits); slab: the box x slabs of
+/// `compare_outcomes_by_hand` against the origin 0.
+#[test]
+fn cancellation_and_events_by_hand() {
+    let row = vec![
+        0x3d00, 0, 0, 0, 0, 0x3c00, 0, 0x7c00, 0x3bff, 0xbc00, 0x3800, 0x3c00, 0x3c00, 0x4000, 0x3e00, 0xbc00, 0x4200,
+    ];
+    let ex =
+        vectors::gen::Explicit { class: "hand".into(), covers: String::new(), origin: "test".into(), rows: vec![row] };
+    let set = generate(&Request { closure: Some(ex), ..req(Unit::Rti, "fp16") }).unwrap();
+    let rows = set_rows(&set).unwrap();
+    let n = rows[0].len();
+    let mut c = Coverage::model(&set.manifest);
+    c.add_rows(&set.manifest, &rows, n - 1..n).unwrap();
+    let bin = |sig: &str| -> usize {
+        let p = c.coverpoints.iter().find(|p| p.kind == "cancellation" && p.signal == format!("{sig} (sub)")).unwrap();
+        let hit: Vec<usize> = p.bins.iter().enumerate().filter(|(_, b)| b.count > 0).map(|(k, _)| k).collect();
+        assert_eq!(hit.len(), 1, "{sig}: {hit:?}");
+        hit[0]
+    };
+    assert_eq!(
+        ["e1x", "e1y", "e1z", "e2x", "e2y", "e2z", "sx"].map(bin),
+        [4, 0, 2, 2, 5, 1, 3],
+        "bins: {:?}",
+        vectors::cover::cancellation_bins(10)
+    );
+    // slab: origin 0 below each x slab [1, 2], [1, 1], [2, 1], [1, 2]; extents <, =, >, <
+    let (one, two, inf, m1) = (0x3c00u64, 0x4000, 0x7c00, 0xbc00);
+    let srow = |lo: u64, hi: u64| vec![0, 0, 0, one, 0, 0, 0, inf, lo, m1, m1, hi, one, one];
+    let ex = vectors::gen::Explicit {
+        class: "hand".into(),
+        covers: String::new(),
+        origin: "test".into(),
+        rows: vec![srow(one, two), srow(one, one), srow(two, one), srow(0, two)],
+    };
+    let set =
+        generate(&Request { explicit: Some(ex), slab_variant: "plain".into(), ..req(Unit::Slab, "fp16") }).unwrap();
+    let c = Coverage::measure(&set.manifest, &set_rows(&set).unwrap()).unwrap();
+    let counts = |sig: &str| -> Vec<u64> {
+        c.coverpoints.iter().find(|p| p.signal == sig).unwrap().bins.iter().map(|b| b.count).collect()
+    };
+    assert_eq!(counts("origin against the box, axis x"), [3, 1, 0, 0, 0, 0]);
+    assert_eq!(counts("box extent, axis x"), [2, 1, 1, 0]);
+    assert_eq!(counts("origin against the box, axis y"), [0, 0, 4, 0, 0, 0]);
+}
