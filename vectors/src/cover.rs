@@ -1005,13 +1005,17 @@ impl Event {
             Event::RtiDet => {
                 let Some(det) = num("det") else { return Vec::new() };
                 let thr = m.params.get("det_thr").map_or(0.0, |&b| decode(m, b));
-                vec![match det {
-                    None => 5,
-                    Some(d) if d > thr => 0,
-                    Some(d) if d > 0.0 => 1,
-                    Some(d) if d == 0.0 => 2,
-                    Some(d) if d >= -thr => 3,
-                    Some(_) => 4,
+                let Some(d) = det else { return vec![5] };
+                vec![if d > thr {
+                    0
+                } else if d > 0.0 {
+                    1
+                } else if d == 0.0 {
+                    2
+                } else if d >= -thr {
+                    3
+                } else {
+                    4
                 }]
             }
             Event::SlabOrigin(a) => {
