@@ -124,6 +124,26 @@ fn vectors_close_from_the_command_line() {
     assert!(text.contains("coverage closure:") && text.contains("close "), "{text}");
     let ss = s.display().to_string();
     assert!(raypipe(&["cover", &ss, "--fail-under", "100"]).status.success());
+    // the HTML view: no holes in the closed set, some in the set without the close class
+    let h = tmp.join("cov.html");
+    let hs = h.display().to_string();
+    for _ in 0..2 {
+        assert!(raypipe(&["cover", &ss, "--html", &hs]).status.success());
+    }
+    let page = std::fs::read_to_string(&h).unwrap();
+    assert!(page.contains("None: every reachable bin is hit") && page.contains("class=\"b un\""), "{}", &page[..400]);
+    let open = tmp.join("open");
+    let os = open.display().to_string();
+    let o = raypipe(&["vectors", "--unit", "slab", "--variant", "conservative", "--format", "fp16", "--out", &os]);
+    assert!(o.status.success());
+    assert!(raypipe(&["cover", &os, "--html", &hs]).status.success());
+    let page = std::fs::read_to_string(&h).unwrap();
+    assert!(page.contains("<h2>Holes (") && page.contains("class=\"b hole\""));
+    let mine = tmp.join("mine.html");
+    std::fs::write(&mine, "<html>mine</html>").unwrap();
+    let o = raypipe(&["cover", &ss, "--html", &mine.display().to_string()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "<html>mine</html>");
     assert!(raypipe(&["vectors", "--check", &ss]).status.success());
     let m: serde_json::Value = serde_json::from_slice(&std::fs::read(s.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(m["classes"].as_array().unwrap().last().unwrap()["name"], "close");

@@ -19,6 +19,10 @@ pub struct Args {
     /// Also write the coverage as UCIS 1.0 XML to FILE (read by pyucis and coverage tools).
     #[arg(long)]
     pub ucis: Option<PathBuf>,
+    /// Also write the coverage as one HTML page to FILE (per stage, bins hit / reachable; the
+    /// holes listed).
+    #[arg(long)]
+    pub html: Option<PathBuf>,
     /// Print the coverage as JSON (every coverpoint and bin count).
     #[arg(long)]
     pub json: bool,
@@ -33,7 +37,13 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     }
     if let Some(u) = &a.ucis {
         // before the work: a file raypipe did not write is never replaced
-        check_ucis_path(u)?;
+        check_written_path("--ucis", u, "writtenBy=\"raypipe ")?;
+    }
+    if let Some(h) = &a.html {
+        check_written_path("--html", h, vectors::cover_html::GENERATOR)?;
+        if a.ucis.as_ref() == Some(h) {
+            return Err("--html and --ucis name the same file".into());
+        }
     }
     let mut total: Option<vectors::cover::Coverage> = None;
     for dir in &a.sets {
@@ -68,9 +78,13 @@ pub fn run(a: Args) -> Result<Outcome, String> {
             contradictions.join("; ")
         ));
     }
+    let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
     if let Some(u) = &a.ucis {
-        let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
         vectors::outdir::atomic_write(u, c.ucis_xml(&vectors::cover::utc(now), &command_as_typed()).as_bytes())?;
+    }
+    if let Some(h) = &a.html {
+        let page = vectors::cover_html::page(&c, &command_as_typed(), &vectors::cover::utc(now));
+        vectors::outdir::atomic_write(h, page.as_bytes())?;
     }
     let unreachable = c.coverpoints.iter().flat_map(|p| &p.bins).filter(|b| b.unreachable.is_some()).count();
     let j = serde_json::json!({
@@ -122,21 +136,22 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     })
 }
 
-/// Refuses a `--ucis` path raypipe may not write, before any work: a directory, a missing
-/// parent directory, or an existing file raypipe did not write.
-fn check_ucis_path(path: &std::path::Path) -> Result<(), String> {
+/// Refuses an output path (`flag`) raypipe may not write, before any work: a directory, a
+/// missing parent directory, or an existing file raypipe did not write (its first lines do not
+/// hold `marker`).
+fn check_written_path(flag: &str, path: &std::path::Path, marker: &str) -> Result<(), String> {
     let shown = path.display();
     if path.is_dir() {
-        return Err(format!("--ucis {shown} is a directory"));
+        return Err(format!("{flag} {shown} is a directory"));
     }
     let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
     if !parent.is_dir() {
-        return Err(format!("--ucis {shown}: no directory {}", parent.display()));
+        return Err(format!("{flag} {shown}: no directory {}", parent.display()));
     }
     if path.exists() {
         let text = std::fs::read_to_string(path).unwrap_or_default();
-        if !text.lines().take(2).any(|l| l.contains("writtenBy=\"raypipe ")) {
-            return Err(format!("--ucis {shown} exists and raypipe did not write it: not replacing it"));
+        if !text.lines().take(4).any(|l| l.contains(marker)) {
+            return Err(format!("{flag} {shown} exists and raypipe did not write it: not replacing it"));
         }
     }
     Ok(())
