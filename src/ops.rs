@@ -210,6 +210,108 @@ fn specials(width: u32, man: u32) -> Vec<u64> {
     v
 }
 
+/// Item `i` of the sweep: every pair in order (exhaustive), or the specials' pairs `sp` first,
+/// then random pairs (masked to the format's width).
+fn pair_of(cfg: &OpsConfig, sp: &[u64], mask: u64, i: u64) -> (u64, u64) {
+    let s = sp.len() as u64;
+    if cfg.exhaustive {
+        (i >> 16, i & 0xffff)
+    } else if i < s * s {
+        (sp[(i / s) as usize], sp[(i % s) as usize])
+    } else {
+        let mut r = SplitMix64::for_item(cfg.seed, OPS_STREAM, i);
+        (r.next_u64() & mask, r.next_u64() & mask)
+    }
+}
+
+/// Coverage counts as an engine accumulator.
+#[derive(Default)]
+struct CoverAcc(vectors::cover_file::CoverCounts);
+
+impl engine::Merge for CoverAcc {
+    fn merge(&mut self, other: Self) {
+        self.0.merge_counts(other.0);
+    }
+}
+
+/// The functional coverage of the engine's shard of the sweep (`raypipe ops --cover`): every
+/// item as a row of the op unit's coverage model (`vectors::cover`; the manifest of an op set
+/// of the format defines it). Rows: class `special` for the specials' pairs, `random` for the
+/// others (exhaustive: every pair); the opcode of the operation (`recip` is `div` with a = 1,
+/// `cmp` is one `lt` and one `le` row); the expected outputs as the op unit computes them.
+pub fn cover(cfg: &OpsConfig) -> Result<(vectors::manifest::Manifest, vectors::cover::Coverage), String> {
+    let n = items(cfg)?;
+    let (of, _) = oracle_format(&cfg.format)?;
+    let op = oracle_op_of(&cfg.op)?;
+    let set = vectors::gen::generate(&vectors::gen::Request {
+        unit: vectors::gen::Unit::Op,
+        format: cfg.format.clone(),
+        count: 1,
+        seed: 1,
+        level: 1,
+        threads: 1,
+        command: "raypipe ops --cover".into(),
+        rti: datapath::rti::RtiConfig::default(),
+        slab_variant: "plain".into(),
+        tree: None,
+        leaves: 8,
+        max_levels: 64,
+        explicit: None,
+        closure: None,
+    })?;
+    let m = set.manifest;
+    let model = vectors::cover::Coverage::model(&m);
+    let (offsets, total) = vectors::cover_file::offsets(&model);
+    let opcodes: &[u64] = match op {
+        OracleOp::Add => &[0],
+        OracleOp::Sub => &[1],
+        OracleOp::Mul => &[2],
+        OracleOp::Div | OracleOp::Recip => &[3],
+        OracleOp::Lt => &[4],
+        OracleOp::Le => &[5],
+        OracleOp::Cmp => &[4, 5],
+    };
+    let bar = engine::Progress::new(cfg.engine.shard_items(n), "pairs (coverage)", !cfg.progress);
+    let acc = datapath::with_format!(cfg.format, |f| {
+        let width = f.width();
+        let mask = if width == 64 { u64::MAX } else { (1u64 << width) - 1 };
+        let man = match of {
+            OracleFormat::Binary16 => 10,
+            OracleFormat::BFloat16 => 7,
+            OracleFormat::Binary32 => 23,
+        };
+        let sp = specials(width, man);
+        let one = f.to_bits(f.one());
+        let bins = vectors::cover::RowBins::new(&m);
+        engine::run(
+            &cfg.engine,
+            n,
+            &bar,
+            || (vec![vec![vec![0u64; 4]], vec![vec![0u64; 2]]], Vec::new()),
+            |(contents, hits), range| {
+                let mut acc = CoverAcc::default();
+                for i in range {
+                    let (a, b) = pair_of(cfg, &sp, mask, i);
+                    let a = if op == OracleOp::Recip { one } else { a };
+                    let class = u64::from(cfg.exhaustive || i >= (sp.len() * sp.len()) as u64);
+                    for &code in opcodes {
+                        let (res, cmp) = vectors::gen::op_eval(&f, code, f.from_bits(a), f.from_bits(b));
+                        contents[0][0].copy_from_slice(&[class, code, a, b]);
+                        contents[1][0].copy_from_slice(&[res, cmp]);
+                        hits.clear();
+                        if bins.hits(contents, 0, hits).is_ok() {
+                            acc.0.add(hits, &offsets, total);
+                        }
+                    }
+                }
+                acc
+            },
+        )
+    });
+    bar.finish();
+    Ok((m, acc.0.into_coverage(&model)))
+}
+
 /// Runs the engine's shard of the sweep.
 pub fn accumulate(cfg: &OpsConfig) -> Result<OpsData, String> {
     let n = items(cfg)?;
@@ -227,19 +329,9 @@ pub fn accumulate(cfg: &OpsConfig) -> Result<OpsData, String> {
             OracleFormat::Binary32 => 23,
         };
         let sp = specials(width, man);
-        let s = sp.len() as u64;
         // the canonical NaN: what the model makes of any NaN input (the canonical rule)
         let canonical = f.to_bits(f.from_f64(f64::NAN));
-        let pair = |i: u64| -> (u64, u64) {
-            if cfg.exhaustive {
-                (i >> 16, i & 0xffff)
-            } else if i < s * s {
-                (sp[(i / s) as usize], sp[(i % s) as usize])
-            } else {
-                let mut r = SplitMix64::for_item(cfg.seed, OPS_STREAM, i);
-                (r.next_u64() & mask, r.next_u64() & mask)
-            }
-        };
+        let pair = |i: u64| pair_of(cfg, &sp, mask, i);
         engine::run(
             &cfg.engine,
             n,

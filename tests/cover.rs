@@ -173,3 +173,52 @@ fn vectors_close_from_the_command_line() {
     }
     let _ = std::fs::remove_dir_all(&tmp);
 }
+
+/// `ops --cover FILE`: the sweep's coverage as a file `raypipe cover` reads; two shards' files
+/// merged equal the one-pass file bin by bin, a file merges with a vector set of the same unit
+/// and format, and a file raypipe did not write is refused before any work (exit 2).
+#[test]
+fn ops_cover_files_merge_like_one_pass() {
+    let tmp = std::env::temp_dir().join(format!("raypipe-opscover-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).unwrap();
+    let p = |n: &str| tmp.join(n).display().to_string();
+    let ops = |extra: &[&str]| {
+        let mut v = vec!["ops", "--format", "fp16", "--op", "mul", "--count", "30000", "--quiet"];
+        v.extend_from_slice(extra);
+        let o = raypipe(&v);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    ops(&["--cover", &p("whole.json")]);
+    ops(&["--cover", &p("s0.json"), "--shard", "0/2", "--partial", &p("p0.json")]);
+    ops(&["--cover", &p("s1.json"), "--shard", "1/2", "--partial", &p("p1.json")]);
+    let json = |args: &[&str]| -> serde_json::Value {
+        let mut v = vec!["cover", "--json"];
+        v.extend_from_slice(args);
+        let o = raypipe(&v);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let whole = json(&[&p("whole.json")]);
+    let merged = json(&[&p("s0.json"), &p("s1.json")]);
+    assert_eq!(whole["vectors"], 30000);
+    assert_eq!(whole["coverpoints"], merged["coverpoints"]);
+    assert_eq!(whole["vectors"], merged["vectors"]);
+    // the result coverpoint counts every row once
+    let result = whole["coverpoints"].as_array().unwrap().iter().find(|c| c["signal"] == "result").unwrap();
+    let sum: u64 = result["bins"].as_array().unwrap().iter().map(|b| b["count"].as_u64().unwrap()).sum();
+    assert_eq!(sum, 30000);
+    // with a vector set of the same unit and format
+    let set = tmp.join("set");
+    let o =
+        raypipe(&["vectors", "--unit", "op", "--format", "fp16", "--count", "2", "--out", &set.display().to_string()]);
+    assert!(o.status.success());
+    let both = json(&[&p("whole.json"), &set.display().to_string()]);
+    assert!(both["vectors"].as_u64().unwrap() > 30000);
+    // a stranger's file is not replaced
+    std::fs::write(tmp.join("mine.json"), "{}").unwrap();
+    let o = raypipe(&["ops", "--format", "fp16", "--op", "mul", "--count", "10", "--cover", &p("mine.json")]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(tmp.join("mine.json")).unwrap(), "{}");
+    let _ = std::fs::remove_dir_all(&tmp);
+}

@@ -7,7 +7,8 @@ use super::prelude::*;
 /// The options of `raypipe cover`.
 #[derive(clap::Args, Clone)]
 pub struct Args {
-    /// Vector set directories (one unit, format and options; their counts are added).
+    /// Vector set directories or coverage files (`ops --cover`) of one unit, format and options
+    /// (their counts are added).
     #[arg(required = true)]
     pub sets: Vec<PathBuf>,
     /// Fail (exit 1) when fewer than this percentage of the bins are hit.
@@ -47,12 +48,18 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     }
     let mut total: Option<vectors::cover::Coverage> = None;
     for dir in &a.sets {
-        let path = dir.join("manifest.json");
-        let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let m: vectors::manifest::Manifest =
-            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-        let contents = vectors::read::read_files(dir, &m).map_err(|e| format!("{}: {e}", dir.display()))?;
-        let c = vectors::cover::Coverage::measure(&m, &contents).map_err(|e| format!("{}: {e}", dir.display()))?;
+        // a coverage file (`ops --cover`), or a vector set's directory
+        let c = if dir.is_file() {
+            let text = std::fs::read_to_string(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+            vectors::cover_file::read(&text).map_err(|e| format!("{}: {e}", dir.display()))?.1
+        } else {
+            let path = dir.join("manifest.json");
+            let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let m: vectors::manifest::Manifest =
+                serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+            let contents = vectors::read::read_files(dir, &m).map_err(|e| format!("{}: {e}", dir.display()))?;
+            vectors::cover::Coverage::measure(&m, &contents).map_err(|e| format!("{}: {e}", dir.display()))?
+        };
         match &mut total {
             None => total = Some(c),
             Some(t) => t.merge(&c).map_err(|e| format!("{}: {e}", dir.display()))?,
@@ -139,7 +146,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
 /// Refuses an output path (`flag`) raypipe may not write, before any work: a directory, a
 /// missing parent directory, or an existing file raypipe did not write (its first lines do not
 /// hold `marker`).
-fn check_written_path(flag: &str, path: &std::path::Path, marker: &str) -> Result<(), String> {
+pub fn check_written_path(flag: &str, path: &std::path::Path, marker: &str) -> Result<(), String> {
     let shown = path.display();
     if path.is_dir() {
         return Err(format!("{flag} {shown} is a directory"));

@@ -23,6 +23,10 @@ pub struct Args {
     /// Print the results as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Also measure the functional coverage of the sweep (the op unit's coverage model) and
+    /// write it to FILE (`raypipe cover FILE…` reports and merges it; docs/coverage.md).
+    #[arg(long)]
+    pub cover: Option<PathBuf>,
     #[command(flatten)]
     pub run: EngineArgs,
     #[command(flatten)]
@@ -31,8 +35,12 @@ pub struct Args {
 
 /// Runs `raypipe ops`.
 pub fn run(a: Args) -> Result<Outcome, String> {
-    let Args { format, op, exhaustive, count, seed, json, run, sharding } = a;
+    let Args { format, op, exhaustive, count, seed, json, cover, run, sharding } = a;
     let sh = shard_of(sharding.shard.as_deref(), sharding.partial.as_deref())?;
+    if let Some(c) = &cover {
+        // before the work: a file raypipe did not write is never replaced
+        super::cover::check_written_path("--cover", c, vectors::cover_file::KIND)?;
+    }
     let cfg = raypipe::ops::OpsConfig {
         format,
         op,
@@ -43,6 +51,17 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         progress: !run.quiet,
     };
     let data = raypipe::ops::accumulate(&cfg)?;
+    if let Some(path) = &cover {
+        let (m, c) = raypipe::ops::cover(&cfg)?;
+        vectors::outdir::atomic_write(path, vectors::cover_file::write(&c, &m, &command_as_typed()).as_bytes())?;
+        let (hit, bins) = c.totals();
+        eprintln!(
+            "coverage: {hit} of {bins} reachable bins of the op unit's model ({:.1} %), {} rows; written to {}",
+            100.0 * hit as f64 / bins.max(1) as f64,
+            c.vectors,
+            path.display()
+        );
+    }
     let id = Run { args: raypipe::ops::args(&cfg), scene_hash: String::new(), chunk: raypipe::ops::CHUNK, shard: sh };
     conclude(json, sharding.partial.as_deref(), id, data)
 }

@@ -9,6 +9,7 @@ pub mod capture;
 pub mod check;
 pub mod close;
 pub mod cover;
+pub mod cover_file;
 pub mod cover_html;
 pub mod gen;
 pub mod hdl;

@@ -27,7 +27,8 @@ pub(crate) fn op_text(op: Op, a: &str, b: &str, note: &str) -> String {
     }
 }
 
-pub(crate) fn op_eval<F: Format>(f: &F, op: u64, x: F::V, y: F::V) -> (u64, u64) {
+/// The op unit's result of opcode `op` (0 add, 1 sub, 2 mul, 3 div, 4 lt, 5 le) on x and y: (result bits, compare bit).
+pub fn op_eval<F: Format>(f: &F, op: u64, x: F::V, y: F::V) -> (u64, u64) {
     op_eval_faulty(f, op, x, y, &NoFault)
 }
 
