@@ -245,7 +245,7 @@ pub fn cover(cfg: &OpsConfig) -> Result<(vectors::manifest::Manifest, vectors::c
     let op = oracle_op_of(&cfg.op)?;
     let set = vectors::gen::generate(&vectors::gen::Request {
         unit: vectors::gen::Unit::Op,
-        format: cfg.format.clone(),
+        format: cfg.format,
         count: 1,
         seed: 1,
         level: 1,
