@@ -57,8 +57,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
             let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             let m: vectors::manifest::Manifest =
                 serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-            let contents = vectors::read::read_files(dir, &m).map_err(|e| format!("{}: {e}", dir.display()))?;
-            vectors::cover::Coverage::measure(&m, &contents).map_err(|e| format!("{}: {e}", dir.display()))?
+            vectors::cover::Coverage::measure_dir(dir, &m).map_err(|e| format!("{}: {e}", dir.display()))?
         };
         match &mut total {
             None => total = Some(c),

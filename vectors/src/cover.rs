@@ -277,6 +277,79 @@ impl Coverage {
         Ok(c)
     }
 
+    /// The coverage of the set in directory `dir` (manifest `m`), read row by row: its
+    /// per-vector files in lockstep, one row in memory at a time, every file's SHA-256 and row
+    /// count checked against the manifest (a mismatch is an error, after the rows are read).
+    pub fn measure_dir(dir: &std::path::Path, m: &Manifest) -> Result<Self, String> {
+        use sha2::{Digest, Sha256};
+        use std::io::BufRead;
+        let mut c = Self::model(m);
+        let bins = RowBins::new(m);
+        let mut readers = Vec::new();
+        for (i, fm) in m.files.iter().enumerate() {
+            let file = std::fs::File::open(dir.join(&fm.name)).map_err(|e| format!("{}: {e}", fm.name))?;
+            let widths: Vec<u32> = fm.fields.iter().map(|x| x.width).collect();
+            readers.push((
+                std::io::BufReader::with_capacity(1 << 16, file),
+                Sha256::new(),
+                widths,
+                per_vector(m, i),
+                0usize,
+            ));
+        }
+        let mut contents: Vec<Vec<Vec<u64>>> = m.files.iter().map(|_| vec![Vec::new()]).collect();
+        let mut line = String::new();
+        let mut hits = Vec::new();
+        let rows = m.files.first().map_or(0, |f| f.rows);
+        for _ in 0..rows {
+            for (i, (r, sha, widths, pv, n)) in readers.iter_mut().enumerate() {
+                if !*pv {
+                    continue;
+                }
+                let fm = &m.files[i];
+                line.clear();
+                if r.read_line(&mut line).map_err(|e| format!("{}: {e}", fm.name))? == 0 {
+                    return Err(format!("{}: {} rows, manifest says {}", fm.name, n, fm.rows));
+                }
+                sha.update(line.as_bytes());
+                *n += 1;
+                let l = line.trim_end_matches('\n');
+                if l.len() != fm.digits as usize {
+                    return Err(format!(
+                        "{} line {n}: {} hex digits, the manifest says {}",
+                        fm.name,
+                        l.len(),
+                        fm.digits
+                    ));
+                }
+                contents[i][0] = crate::pack::unpack(l, widths).map_err(|e| format!("{} line {n}: {e}", fm.name))?;
+            }
+            hits.clear();
+            bins.hits(&contents, 0, &mut hits)?;
+            for &(p, b) in &hits {
+                if let Some(b) = c.coverpoints.get_mut(p).and_then(|p| p.bins.get_mut(b)) {
+                    b.count += 1;
+                }
+            }
+            c.vectors += 1;
+        }
+        for (i, (mut r, mut sha, _, pv, n)) in readers.into_iter().enumerate() {
+            let fm = &m.files[i];
+            // the rest of the file (all of it for a file without a row per vector)
+            let mut rest = Vec::new();
+            std::io::Read::read_to_end(&mut r, &mut rest).map_err(|e| format!("{}: {e}", fm.name))?;
+            if pv && !rest.is_empty() {
+                return Err(format!("{}: more rows than the manifest's {} ({n} read)", fm.name, fm.rows));
+            }
+            sha.update(&rest);
+            let hex: String = sha.finalize().iter().map(|b| format!("{b:02x}")).collect();
+            if hex != fm.sha256 {
+                return Err(format!("{}: sha256 differs from the manifest", fm.name));
+            }
+        }
+        Ok(c)
+    }
+
     /// Counts the rows `range` of a set into the bins.
     pub fn add_rows(
         &mut self,
@@ -350,6 +423,7 @@ impl Coverage {
 /// unit found once).
 pub struct RowBins<'a> {
     m: &'a Manifest,
+    ix: Ix<'a>,
     ftz: bool,
     cmps: Vec<(u8, &'static str, &'static str, &'static str)>,
     ariths: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
@@ -362,6 +436,7 @@ impl<'a> RowBins<'a> {
     pub fn new(m: &'a Manifest) -> Self {
         RowBins {
             m,
+            ix: Ix::new(m),
             ftz: m.format.contains("ftz"),
             cmps: compares(m),
             ariths: arith_rows(m),
@@ -374,9 +449,9 @@ impl<'a> RowBins<'a> {
     pub fn hits(&self, contents: &[Vec<Vec<u64>>], row: usize, out: &mut Vec<(usize, usize)>) -> Result<(), String> {
         let (m, ftz) = (self.m, self.ftz);
         // the expected-output row's flag named by a care_when
+        let ix = &self.ix;
         let out_flag = |name: &str| -> Option<bool> {
-            let f = m.files.get(1)?;
-            let k = f.fields.iter().position(|x| x.name == name)?;
+            let k = *ix.outs.get(name)?;
             Some(contents.get(1)?.get(row)?.get(k)? & 1 == 1)
         };
         let mut cp = 0;
@@ -398,7 +473,7 @@ impl<'a> RowBins<'a> {
             }
         }
         for &(_, _, a, b) in &self.cmps {
-            if let (Some(x), Some(y)) = (operand(m, contents, row, a, ftz), operand(m, contents, row, b, ftz)) {
+            if let (Some(x), Some(y)) = (operand(ix, contents, row, a, ftz), operand(ix, contents, row, b, ftz)) {
                 let bin = match (x, y) {
                     (None, _) | (_, None) => 3,
                     (Some(x), Some(y)) if x < y => 0,
@@ -410,7 +485,7 @@ impl<'a> RowBins<'a> {
             cp += 1;
         }
         for &(_, name, op, a, b) in &self.ariths {
-            if let Some(bin) = rounding_event(m, contents, row, name, op, a, b, ftz) {
+            if let Some(bin) = rounding_event(ix, contents, row, name, op, a, b, ftz) {
                 out.push((cp, bin));
             }
             cp += 1;
@@ -418,7 +493,7 @@ impl<'a> RowBins<'a> {
         if self.op_rounding {
             // the op unit: the operation the row's opcode selects (0 add, 1 sub, 2 mul,
             // 3 div in divide mode; the reciprocal mode's a * (1/b) rounds twice: not counted)
-            let opcode = field(m, "opcode").and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied());
+            let opcode = ix.field("opcode").and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied());
             let op = match opcode {
                 Some(0) => Some("add"),
                 Some(1) => Some("sub"),
@@ -426,21 +501,21 @@ impl<'a> RowBins<'a> {
                 Some(3) if m.format.contains("divide") => Some("div"),
                 _ => None,
             };
-            if let Some(bin) = op.and_then(|op| rounding_event(m, contents, row, "result", op, "a", "b", ftz)) {
+            if let Some(bin) = op.and_then(|op| rounding_event(ix, contents, row, "result", op, "a", "b", ftz)) {
                 out.push((cp, bin));
             }
             cp += 1;
         }
         for &(_, name, op, a, b) in self.ariths.iter().filter(|r| r.2 == "add" || r.2 == "sub") {
-            if let Some(bin) = cancellation(m, contents, row, name, op, a, b, ftz) {
+            if let Some(bin) = cancellation(ix, contents, row, name, op, a, b, ftz) {
                 out.push((cp, bin));
             }
             cp += 1;
         }
         for e in &self.events {
-            let v = |n: &str| operand(m, contents, row, n, ftz);
+            let v = |n: &str| operand(ix, contents, row, n, ftz);
             let flag = |n: &str| {
-                field(m, n).and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied()).map(|b| b & 1 == 1)
+                ix.field(n).and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied()).map(|b| b & 1 == 1)
             };
             for bin in e.measure(m, &v, &flag) {
                 out.push((cp, bin));
@@ -725,7 +800,7 @@ fn stage_table_of(m: &Manifest) -> Vec<datapath::stage::SigDef> {
 /// The rounding event of operation `name = a op b` in row `row` (None: don't-care).
 #[allow(clippy::too_many_arguments)]
 fn rounding_event(
-    m: &Manifest,
+    ix: &Ix,
     contents: &[Vec<Vec<u64>>],
     row: usize,
     name: &str,
@@ -734,13 +809,13 @@ fn rounding_event(
     b: &str,
     ftz: bool,
 ) -> Option<usize> {
-    let (_, rf, _) = field(m, name)?;
+    let (_, rf, _) = ix.field(name)?;
     let Kind::Ieee { exp, man } = rf.kind else { return None };
     let val = |n: &str, flush: bool| -> Option<Option<f64>> {
         if n == "one" {
             return Some(Some(1.0));
         }
-        operand(m, contents, row, n, flush)
+        operand(ix, contents, row, n, flush)
     };
     let r = val(name, false)?;
     let (x, y) = (val(a, ftz)?, val(b, ftz)?);
@@ -863,7 +938,7 @@ fn exponent(v: f64) -> i64 {
 /// operand or result).
 #[allow(clippy::too_many_arguments)]
 fn cancellation(
-    m: &Manifest,
+    ix: &Ix,
     contents: &[Vec<Vec<u64>>],
     row: usize,
     name: &str,
@@ -872,10 +947,11 @@ fn cancellation(
     b: &str,
     ftz: bool,
 ) -> Option<usize> {
+    let m = ix.m;
     let man = m.params.get("man").copied()? as i64;
-    let r = operand(m, contents, row, name, false)??;
-    let x = operand(m, contents, row, a, ftz)??;
-    let y = operand(m, contents, row, b, ftz)??;
+    let r = operand(ix, contents, row, name, false)??;
+    let x = operand(ix, contents, row, a, ftz)??;
+    let y = operand(ix, contents, row, b, ftz)??;
     if !(x.is_finite() && y.is_finite() && r.is_finite()) {
         return None;
     }
@@ -1148,13 +1224,42 @@ fn field<'a>(m: &'a Manifest, name: &str) -> Option<(usize, &'a Field, usize)> {
         .find_map(|(i, f)| f.fields.iter().position(|x| x.name == name).map(|k| (i, &f.fields[k], k)))
 }
 
+/// Field positions by name, found once per set for the per-row paths ([`field`]'s answers).
+struct Ix<'a> {
+    m: &'a Manifest,
+    fields: std::collections::HashMap<&'a str, (usize, &'a Field, usize)>,
+    /// The expected-output file's fields (what a care_when names).
+    outs: std::collections::HashMap<&'a str, usize>,
+}
+
+impl<'a> Ix<'a> {
+    fn new(m: &'a Manifest) -> Self {
+        let mut fields = std::collections::HashMap::new();
+        for (i, f) in m.files.iter().enumerate().filter(|(i, _)| per_vector(m, *i)) {
+            for (k, x) in f.fields.iter().enumerate() {
+                fields.entry(x.name.as_str()).or_insert((i, x, k));
+            }
+        }
+        let mut outs = std::collections::HashMap::new();
+        if let Some(f) = m.files.get(1) {
+            for (k, x) in f.fields.iter().enumerate() {
+                outs.entry(x.name.as_str()).or_insert(k);
+            }
+        }
+        Ix { m, fields, outs }
+    }
+
+    fn field(&self, name: &str) -> Option<(usize, &'a Field, usize)> {
+        self.fields.get(name).copied()
+    }
+}
+
 /// Operand `name` of row `row` as the datapath's compare reads it: `Some(None)` a NaN,
 /// `Some(Some(v))` a number; `None` when the value is don't-care in this row (care_when).
-fn operand(m: &Manifest, contents: &[Vec<Vec<u64>>], row: usize, name: &str, ftz: bool) -> Option<Option<f64>> {
-    let (i, x, k) = field(m, name)?;
+fn operand(ix: &Ix, contents: &[Vec<Vec<u64>>], row: usize, name: &str, ftz: bool) -> Option<Option<f64>> {
+    let (i, x, k) = ix.field(name)?;
     if let Some(flag) = &x.care_when {
-        let f = m.files.get(1)?;
-        let j = f.fields.iter().position(|y| &y.name == flag)?;
+        let j = *ix.outs.get(flag.as_str())?;
         if contents.get(1)?.get(row)?.get(j)? & 1 == 0 {
             return None;
         }

@@ -243,3 +243,28 @@ fn cancellation_and_events_by_hand() {
     assert_eq!(counts("box extent, axis x"), [2, 1, 1, 0]);
     assert_eq!(counts("origin against the box, axis y"), [0, 0, 4, 0, 0, 0]);
 }
+
+/// Reading a written set row by row (`measure_dir`, what `raypipe cover` does) gives the
+/// coverage of the set in memory; a changed data file is refused.
+#[test]
+fn streaming_a_set_from_disk_equals_measuring_it_in_memory() {
+    let tmp = std::env::temp_dir().join(format!("raypipe-measure-dir-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    for (unit, format) in [(Unit::Rti, "fp16"), (Unit::Slab, "f32"), (Unit::Capture, "bf16"), (Unit::Op, "fp16")] {
+        let set = generate(&req(unit, format)).unwrap();
+        let dir = tmp.join(format!("{unit:?}"));
+        vectors::write::write_set(&set, &dir).unwrap();
+        let text = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
+        let m: vectors::manifest::Manifest = serde_json::from_str(&text).unwrap();
+        let from_disk = Coverage::measure_dir(&dir, &m).unwrap();
+        let in_memory = Coverage::measure(&set.manifest, &set_rows(&set).unwrap()).unwrap();
+        assert_eq!(from_disk, in_memory, "{unit:?} {format}");
+        // one digit changed in the inputs: the hash no longer matches
+        let f = dir.join(&m.files[0].name);
+        let mut t = std::fs::read_to_string(&f).unwrap().into_bytes();
+        t[2] = if t[2] == b'0' { b'1' } else { b'0' };
+        std::fs::write(&f, t).unwrap();
+        assert!(Coverage::measure_dir(&dir, &m).unwrap_err().contains("sha256"), "{unit:?}");
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}
