@@ -92,6 +92,9 @@ pub fn render(c: &Campaign) -> String {
             o.what,
             o.not_applicable.as_deref().map(|w| format!(" [{w}]")).unwrap_or_default()
         );
+        if !o.first_bins.is_empty() {
+            s += &format!("{:<24}   first vector's rarest bins: {}\n", "", o.first_bins.join("; "));
+        }
     }
     let applicable = c.faults.iter().filter(|o| o.applicable && !o.benign).count();
     s += &format!(

@@ -345,6 +345,20 @@ fn nan_payload_inputs_expose_the_nan_rule_on_the_probes() {
         assert_eq!(f["detected"], true, "{fmt}");
         assert_eq!(f["benign"], true);
         assert_eq!(f["first_class"], "inf_nan", "{fmt}");
+        // the coverage that mattered: the first vector's rarest bins, fewest vectors first, and
+        // one of them a NaN on a stage signal (that is what the fault needs)
+        let bins: Vec<&str> = f["first_bins"].as_array().unwrap().iter().map(|b| b.as_str().unwrap()).collect();
+        assert!(!bins.is_empty() && bins.len() <= 3, "{bins:?}");
+        let n = |b: &str| -> u64 { b.rsplit_once(" (").unwrap().1.split(' ').next().unwrap().parse().unwrap() };
+        assert!(bins.windows(2).all(|w| n(w[0]) <= n(w[1])), "{bins:?}");
+        let all: Vec<String> = v["faults"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|g| g["detected"] == true)
+            .flat_map(|g| g["first_bins"].as_array().unwrap().iter().map(|b| b.as_str().unwrap().to_string()))
+            .collect();
+        assert!(all.iter().any(|b| b.contains("NaN")), "{fmt}: {all:?}");
         let (_, o) = campaign(&["--format", fmt]);
         let f = o["faults"].as_array().unwrap().iter().find(|f| f["name"] == "rti.e1x.nan").unwrap().clone();
         assert_eq!(f["detected"], false, "{fmt}: benign on the compared outputs");

@@ -47,7 +47,14 @@ pub struct Outcome {
     pub first_class: Option<String>,
     /// How many vectors of each class detect it (classes in the manifest's order).
     pub by_class: Vec<(String, usize)>,
+    /// The coverage that mattered: the rarest bins of the set's coverage model the first
+    /// detecting vector hits (at most [`FIRST_BINS`], fewest set vectors first; the class
+    /// coverpoint aside), each as `role signal: bin (n of N vectors)`.
+    pub first_bins: Vec<String>,
 }
+
+/// How many of the first detecting vector's rarest bins an outcome names.
+pub const FIRST_BINS: usize = 3;
 
 /// A whole campaign.
 #[derive(Clone, Debug, Serialize)]
@@ -181,6 +188,7 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
             catching: Vec::new(),
             first_class: None,
             by_class: m.classes.iter().map(|c| (c.name.clone(), 0)).collect(),
+            first_bins: Vec::new(),
         })
         .collect();
     with_format!(any, |f| {
@@ -242,6 +250,29 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
         }
         Ok::<(), String>(())
     })?;
+    // which coverage mattered: the first detecting vector's rarest bins in this set
+    let cov = vectors::cover::Coverage::measure(m, rows)?;
+    let row_bins = vectors::cover::RowBins::new(m);
+    let mut hits = Vec::new();
+    for o in &mut outcomes {
+        let Some(i) = o.first_vector else { continue };
+        hits.clear();
+        row_bins.hits(rows, i, &mut hits)?;
+        let mut named: Vec<(u64, usize, String)> = hits
+            .iter()
+            .filter(|&&(p, _)| cov.coverpoints[p].kind != "class")
+            .map(|&(p, b)| {
+                let (cp, bin) = (&cov.coverpoints[p], &cov.coverpoints[p].bins[b]);
+                (
+                    bin.count,
+                    p,
+                    format!("{} {}: {} ({} of {} vectors)", cp.role, cp.signal, bin.name, bin.count, cov.vectors),
+                )
+            })
+            .collect();
+        named.sort_by_key(|&(n, p, _)| (n, p));
+        o.first_bins = named.into_iter().take(FIRST_BINS).map(|x| x.2).collect();
+    }
     let counted = |o: &&Outcome| o.applicable && !o.benign;
     Ok(Campaign {
         unit: m.unit.clone(),
