@@ -5,12 +5,14 @@
 //! The search, deterministic for a request and budget (no dependence on threads):
 //! 1. Generate the set the request asks for and measure its coverage.
 //! 2. Draw candidates in batches of [`BATCH`] from `SplitMix64(seed ^ CLOSE_SEED)`. A candidate
-//!    is the input row of an earlier vector (one of the set's, or a kept candidate: a kept one
-//!    with probability 1/2 once there are any) with one to three of its inputs changed
-//!    ([`mutate`]): an edge encoding of the field's kind, a random encoding, another input of
-//!    the same row (its bits, or its bits ± 1: equal operands, exact cancellation, one-ulp
-//!    differences), its own negation, or every float input's exponent shifted together
-//!    (products and quotients into the subnormal and overflow ranges).
+//!    is the input row of an earlier vector — one of the set's, a kept candidate (half the time
+//!    once there are any) or a start row (`templates`: rti and slab in float formats) — with
+//!    one to three of its inputs changed (`mutate`): an edge encoding of the field's kind or
+//!    one 1 to 8 encodings beside it, a random encoding, another input of the same row (its
+//!    bits, or its bits ± 1), its own negation, ± a power of two, a pair (a power of two and in
+//!    another input the encoding below it, either sign: M + 1 bits cancel), the exponents of
+//!    all float inputs or of one input group shifted together, or a value of a float value
+//!    class still empty somewhere (± 1 to 8 encodings).
 //! 3. Build each candidate's rows with the unit's model (the same rows the set's other classes
 //!    get), take the bins it hits, and keep it when one of them is still empty; its bins count
 //!    from then on, so a later candidate is kept only for a bin no kept row reached.
