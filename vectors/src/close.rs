@@ -22,7 +22,7 @@
 //! them). The kept rows are given rows: `vectors --check` rebuilds the class from the set's own
 //! input rows, not by repeating the search.
 
-use crate::cover::{Coverage, RowBins, FLOAT_BINS};
+use crate::cover::{Coverage, RowBins, CROSS_CLASSES, FLOAT_BINS};
 use crate::gen::{generate, Explicit, Request, Unit, VectorSet, OPCODES};
 use crate::manifest::Kind;
 use crate::read::set_rows;
@@ -31,11 +31,11 @@ use datapath::rng::SplitMix64;
 /// Candidates built and measured together (one set generation per batch).
 pub const BATCH: usize = 2048;
 /// Candidates in a row without a new bin after which the search stops.
-pub const STALL: u64 = 16 * BATCH as u64;
+pub const STALL: u64 = 48 * BATCH as u64;
 /// Mixed into the request's seed for the search's generator.
 pub const CLOSE_SEED: u64 = 0xC105_E000_C0FE_0001;
 /// The default candidate budget.
-pub const DEFAULT_BUDGET: u64 = 200_000;
+pub const DEFAULT_BUDGET: u64 = 400_000;
 
 /// A closed set and what the closure did.
 #[derive(Clone, Debug)]
@@ -89,6 +89,7 @@ pub fn close(req: &Request, budget: u64) -> Result<Closed, String> {
         .skip(1)
         .map(|x| x.name.strip_suffix(['x', 'y', 'z']).unwrap_or(&x.name).to_string())
         .collect();
+    let names: Vec<String> = m.files[0].fields.iter().skip(1).map(|x| x.name.clone()).collect();
     let seeds: Vec<Vec<u64>> = contents[0].iter().map(|r| r[1..].to_vec()).collect();
     let starts = templates(req.unit, &kinds);
     if seeds.is_empty() {
@@ -111,6 +112,26 @@ pub fn close(req: &Request, budget: u64) -> Result<Closed, String> {
             .collect();
         targets.sort_unstable();
         targets.dedup();
+        // operand-cross bins still empty whose two operands are inputs: (input a, input b,
+        // class of a, class of b)
+        let pairs: Vec<(usize, usize, usize, usize)> = cov
+            .coverpoints
+            .iter()
+            .filter(|p| p.kind == "operand cross")
+            .filter_map(|p| {
+                let (_, ops) = p.signal.split_once(": ")?;
+                let (a, b) = ops.split_once(" x ")?;
+                let (ia, ib) = (names.iter().position(|n| n == a)?, names.iter().position(|n| n == b)?);
+                Some(
+                    p.bins
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, b)| b.count == 0 && b.unreachable.is_none())
+                        .map(move |(k, _)| (ia, ib, k / CROSS_CLASSES.len(), k % CROSS_CLASSES.len())),
+                )
+            })
+            .flatten()
+            .collect();
         let batch: Vec<Vec<u64>> = (0..n)
             .map(|_| {
                 let from = match r.below(4) {
@@ -118,6 +139,16 @@ pub fn close(req: &Request, budget: u64) -> Result<Closed, String> {
                     0 if !starts.is_empty() => &starts[r.below(starts.len() as u64) as usize],
                     _ => &seeds[r.below(seeds.len() as u64) as usize],
                 };
+                if !pairs.is_empty() && r.below(8) == 0 {
+                    // both operands of an empty cross bin given values of its classes
+                    let (ia, ib, ca, cb) = pairs[r.below(pairs.len() as u64) as usize];
+                    let mut x = from.clone();
+                    if let (Kind::Ieee { exp, man }, Kind::Ieee { .. }) = (&kinds[ia], &kinds[ib]) {
+                        x[ia] = cross_encoding(ca, *exp, *man, &mut r);
+                        x[ib] = cross_encoding(cb, *exp, *man, &mut r);
+                    }
+                    return x;
+                }
                 mutate(from, &kinds, &widths, &groups, &targets, req.unit, &mut r)
             })
             .collect();
@@ -223,6 +254,20 @@ fn class_encoding(bin: usize, exp: u32, man: u32, r: &mut SplitMix64) -> u64 {
         _ if bin == 12 => (top << man) | (1 << (man - 1)),
         _ => (top << man) | (1 + r.below(mm)),
     }
+}
+
+/// An encoding of cross class `CROSS_CLASSES[c]` (zero, subnormal, normal, inf, NaN), either
+/// sign.
+fn cross_encoding(c: usize, exp: u32, man: u32, r: &mut SplitMix64) -> u64 {
+    // the value-class bins of each cross class, in FLOAT_BINS order
+    let bins: &[usize] = match c {
+        0 => &[0, 1],
+        1 => &[2, 3],
+        2 => &[4, 5, 6, 7, 8, 9],
+        3 => &[10, 11],
+        _ => &[12, 13],
+    };
+    class_encoding(bins[r.below(bins.len() as u64) as usize], exp, man, r)
 }
 
 /// Edge encodings of a float field with `exp` exponent and `man` fraction bits: exponents 0,

@@ -252,6 +252,22 @@ impl Coverage {
                     .collect(),
             });
         }
+        for (stage, name, op, a, b) in crossed_rows(m) {
+            coverpoints.push(Coverpoint {
+                signal: format!("{name} ({op}): {a} x {b}"),
+                role: "stage signals".into(),
+                stage: Some(stage),
+                kind: "operand cross".into(),
+                bins: CROSS_CLASSES
+                    .iter()
+                    .flat_map(|x| CROSS_CLASSES.iter().map(move |y| format!("{x} x {y}")))
+                    .map(|n| {
+                        let unreachable = cross_reason(m, b, &n);
+                        Bin { name: n, count: 0, unreachable }
+                    })
+                    .collect(),
+            });
+        }
         for e in events(m) {
             coverpoints.push(Coverpoint {
                 signal: e.signal(),
@@ -428,6 +444,8 @@ pub struct RowBins<'a> {
     cmps: Vec<(u8, &'static str, &'static str, &'static str)>,
     ariths: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
     op_rounding: bool,
+    crossed: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
+    min_normal: f64,
     events: Vec<Event>,
 }
 
@@ -441,6 +459,8 @@ impl<'a> RowBins<'a> {
             cmps: compares(m),
             ariths: arith_rows(m),
             op_rounding: op_unit_rounding(m),
+            crossed: crossed_rows(m),
+            min_normal: min_normal(m),
             events: events(m),
         }
     }
@@ -509,6 +529,12 @@ impl<'a> RowBins<'a> {
         for &(_, name, op, a, b) in self.ariths.iter().filter(|r| r.2 == "add" || r.2 == "sub") {
             if let Some(bin) = cancellation(ix, contents, row, name, op, a, b, ftz) {
                 out.push((cp, bin));
+            }
+            cp += 1;
+        }
+        for &(_, _, _, a, b) in &self.crossed {
+            if let (Some(x), Some(y)) = (operand(ix, contents, row, a, ftz), operand(ix, contents, row, b, ftz)) {
+                out.push((cp, cross_class(x, self.min_normal) * CROSS_CLASSES.len() + cross_class(y, self.min_normal)));
             }
             cp += 1;
         }
@@ -662,6 +688,14 @@ pub const WHY_WIDEN_NEAR: &str = "t_near is tn_xyz stepped toward -inf (nextDown
 /// Why a widened exit distance never takes some values.
 pub const WHY_WIDEN_FAR: &str = "t_far is tf_xyz stepped toward +inf (nextUp) at least once: nextUp never returns +0 or -inf, and from two steps on never -max (only nextUp(-inf) is -max)";
 
+/// Why a reciprocal never overflows under flush-to-zero.
+pub const WHY_FTZ_RECIP: &str = "flush-to-zero: every nonzero operand is normal, |x| >= 2^emin, so |1/x| <= 2^-emin = 2^(bias-1) < max: 1/x never overflows (+-inf only as 1/+-0, exactly); where RTI compares them det is nonzero, so 1/det and u, v (at most 2 x ... finite) are finite";
+
+/// Whether the set's format is an IEEE-like float with flush-to-zero.
+fn ftz_float(m: &Manifest) -> bool {
+    m.params.get("float") == Some(&1) && m.params.get("ftz") == Some(&1)
+}
+
 /// Whether the set's format is an IEEE-like float with gradual underflow.
 fn gradual(m: &Manifest) -> bool {
     m.params.get("float") == Some(&1) && m.params.get("ftz") != Some(&1)
@@ -686,6 +720,8 @@ fn unit_value_reason(m: &Manifest, x: &Field, bin: &str) -> Option<&'static str>
         ("rti", "u" | "v") if valid && (bin == "+max finite" || (divide && bin == "+inf")) => Some(WHY_RTI_UV_BOUNDED),
         ("rti", "inv_det") if valid && matches!(bin, "+max finite" | "-max finite") => Some(WHY_RECIP_NOT_MAX),
         ("rti", "inv_det") if valid && bin.ends_with("NaN") => Some(WHY_RTI_DET_NUMBER),
+        ("rti", "inv_det") if valid && ftz_float(m) && matches!(bin, "+inf" | "-inf") => Some(WHY_FTZ_RECIP),
+        ("rti", "u" | "v") if valid && ftz_float(m) && bin == "+inf" => Some(WHY_FTZ_RECIP),
         ("slab", "inv_dx" | "inv_dy" | "inv_dz") => match bin {
             "+max finite" | "-max finite" => Some(WHY_RECIP_NOT_MAX),
             "+subnormal" | "-subnormal" if guard => Some(WHY_GUARD_RECIP),
@@ -742,6 +778,7 @@ fn unit_rounding_reason(m: &Manifest, signal: &str, bin: &str) -> Option<&'stati
         ("NaN", "div") if m.unit == "rti" && name == "inv_det" && valid => Some(WHY_RTI_DET_NUMBER),
         ("overflow" | "underflow", "div") if m.unit == "slab" && recip && guard => Some(WHY_GUARD_RECIP),
         ("overflow", "sub") if m.unit == "slab" && guard => Some(WHY_GUARD_SUB),
+        ("overflow", "div") if recip && ftz_float(m) => Some(WHY_FTZ_RECIP),
         ("overflow", "div") if m.unit == "slab" && recip && m.params.get("slab_embree") == Some(&1) && gradual(m) => {
             Some(WHY_EMBREE)
         }
@@ -973,6 +1010,62 @@ fn cancellation(
         l if l <= man => 3,
         _ => 4,
     })
+}
+
+/// The operand classes of a cross: zero (either sign), subnormal, normal (the smallest and
+/// largest included), infinite, NaN — as the datapath reads the operand (FTZ: a subnormal as
+/// zero).
+pub const CROSS_CLASSES: [&str; 5] = ["zero", "subnormal", "normal", "inf", "NaN"];
+
+/// The cross class of an operand read by `operand` in a format whose smallest normal is
+/// `min_normal`.
+fn cross_class(v: Option<f64>, min_normal: f64) -> usize {
+    let Some(v) = v else { return 4 };
+    if v == 0.0 {
+        0
+    } else if v.is_infinite() {
+        3
+    } else if v.abs() < min_normal {
+        1
+    } else {
+        2
+    }
+}
+
+/// The smallest normal of the set's float format (0 for fixed point).
+fn min_normal(m: &Manifest) -> f64 {
+    match (m.params.get("float"), m.params.get("exp")) {
+        (Some(1), Some(&e)) => (2f64).powi(2 - (1i32 << (e - 1))),
+        _ => 0.0,
+    }
+}
+
+/// The operations whose operand classes are crossed: every rounded operation of the stage
+/// table with two signal operands (not the constant 1) that is not gated by a care_when (the
+/// signals after RTI's valid bit are defined only where valid is 1, which constrains their
+/// operands; they are not crossed).
+fn crossed_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str, &'static str)> {
+    arith_rows(m)
+        .into_iter()
+        .filter(|&(_, name, _, a, _)| a != "one" && field(m, name).is_some_and(|x| x.1.care_when.is_none()))
+        .collect()
+}
+
+/// Why a cross bin is unreachable (`b` the second operand's signal, `bin` "x x y").
+fn cross_reason(m: &Manifest, b: &str, bin: &str) -> Option<&'static str> {
+    let (x, y) = bin.split_once(" x ")?;
+    let ftz = m.params.get("ftz") == Some(&1);
+    let guard = m.params.get("slab_guard") == Some(&1);
+    if ftz && (x == "subnormal" || y == "subnormal") {
+        return Some(WHY_FTZ);
+    }
+    if m.unit == "slab" && guard && b.starts_with("inv_d") && y == "subnormal" {
+        return Some(WHY_GUARD_RECIP);
+    }
+    if m.unit == "slab" && m.params.get("slab_embree") == Some(&1) && !ftz && b.starts_with("inv_d") && y == "inf" {
+        return Some(WHY_EMBREE);
+    }
+    None
 }
 
 /// A per-unit event coverpoint.
