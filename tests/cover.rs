@@ -124,6 +124,31 @@ fn vectors_close_from_the_command_line() {
     assert!(text.contains("coverage closure:") && text.contains("close "), "{text}");
     let ss = s.display().to_string();
     assert!(raypipe(&["cover", &ss, "--fail-under", "100"]).status.success());
+    // --json: the closure's numbers, the classes (close last)
+    let sj = tmp.join("slab-json");
+    let o = raypipe(&[
+        "vectors",
+        "--unit",
+        "slab",
+        "--format",
+        "fp16",
+        "--close",
+        "--close-budget",
+        "20000",
+        "--json",
+        "--out",
+        &sj.display().to_string(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let c = &j["closure"];
+    assert!(c["bins_hit_after"].as_u64().unwrap() > c["bins_hit_before"].as_u64().unwrap());
+    assert!(c["candidates"].as_u64().unwrap() <= 20000);
+    assert_eq!(j["classes"].as_array().unwrap().last().unwrap()["name"], "close");
+    assert_eq!(j["classes"].as_array().unwrap().last().unwrap()["count"], c["kept"]);
+    let o = raypipe(&["vectors", "--check", &sj.display().to_string(), "--json"]);
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(j["vectors"].as_u64().unwrap() > 0);
     // the HTML view: no holes in the closed set, some in the set without the close class
     let h = tmp.join("cov.html");
     let hs = h.display().to_string();

@@ -70,6 +70,9 @@ pub struct Args {
     /// Candidates the closure's search may measure at most.
     #[arg(long, default_value_t = vectors::close::DEFAULT_BUDGET, requires = "close")]
     pub close_budget: u64,
+    /// Print what was written (or checked) as JSON.
+    #[arg(long)]
+    pub json: bool,
     #[command(flatten)]
     pub rti: RtiArgs,
 }
@@ -96,17 +99,28 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         axis_map,
         close,
         close_budget,
+        json,
         rti,
     } = a;
     if let Some(dir) = check {
         let n = vectors::check::check_set(&dir)?;
-        println!(
-            "{}: {n} vectors; the manifest, the HDL packages and every input, expected and stage row are what this raypipe writes",
-            dir.display()
-        );
-        if let Some(detects) = raypipe::faults::check_minimal(&dir)? {
-            println!("{}: a minimal set; it still detects all {detects} faults its manifest names", dir.display());
-        }
+        let detects = raypipe::faults::check_minimal(&dir)?;
+        let j = serde_json::json!({
+            "command": command_as_typed(),
+            "checked": dir.display().to_string(),
+            "vectors": n,
+            "minimal_detects": detects,
+        });
+        emit(json, &j, |_| {
+            let mut s = format!(
+                "{}: {n} vectors; the manifest, the HDL packages and every input, expected and stage row are what this raypipe writes\n",
+                dir.display()
+            );
+            if let Some(d) = detects {
+                s += &format!("{}: a minimal set; it still detects all {d} faults its manifest names\n", dir.display());
+            }
+            s
+        })?;
         return Ok(Outcome::Pass);
     }
     let out = out.ok_or("--out is required")?;
@@ -161,29 +175,20 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         rti: rti.config()?,
         slab_variant: variant,
     };
+    let mut closure: Option<vectors::close::Closed> = None;
     let set = if close {
         limit("--close-budget", close_budget, 100_000_000, "the search measures candidates one batch at a time")?;
         let c = vectors::close::close(&req, close_budget)?;
-        let pct = |(h, n): (u64, u64)| 100.0 * h as f64 / n.max(1) as f64;
-        println!(
-            "coverage closure: before {} of {} reachable bins ({:.1} %), after {} of {} ({:.1} %; the close class's own bin included); {} of {} candidates kept as class close",
-            c.before.0,
-            c.before.1,
-            pct(c.before),
-            c.after.0,
-            c.after.1,
-            pct(c.after),
-            c.kept,
-            c.candidates
-        );
+        closure = Some(c.clone());
         c.set
     } else {
         vectors::gen::generate(&req)?
     };
+    let mut minimal_line: Option<String> = None;
     let set = if minimal {
         let (cut, c) = faults::minimal::minimal(&set, &command_without_threads())?;
         let m = cut.manifest.minimal.as_ref().expect("a minimal set says so");
-        println!(
+        minimal_line = Some(format!(
             "minimal set: {} of {} vectors ({:.1} %) detect the {} faults of the {} bank the default set detects from the outputs ({} escape both; see raypipe faults)",
             cut.manifest.files[0].rows,
             m.from_vectors,
@@ -191,7 +196,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
             m.detects.len(),
             cut.manifest.unit,
             c.escaped
-        );
+        ));
         cut
     } else {
         set
@@ -202,14 +207,54 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     };
     vectors::write::write_set_with(&set, &out, &extra)?;
     let m = &set.manifest;
-    println!(
-        "wrote {}: unit {}, format {}, {} vectors ({}), seed {}",
-        out.display(),
-        m.unit,
-        m.format,
-        m.files[0].rows,
-        m.classes.iter().map(|c| format!("{} {}", c.name, c.count)).collect::<Vec<_>>().join(", "),
-        m.seed
-    );
+    let pct = |(h, n): (u64, u64)| 100.0 * h as f64 / n.max(1) as f64;
+    let j = serde_json::json!({
+        "command": command_as_typed(),
+        "out": out.display().to_string(),
+        "unit": m.unit,
+        "format": m.format,
+        "seed": m.seed,
+        "vectors": m.files[0].rows,
+        "classes": m.classes.iter().map(|c| serde_json::json!({"name": c.name, "count": c.count})).collect::<Vec<_>>(),
+        "closure": closure.as_ref().map(|c| serde_json::json!({
+            "bins_hit_before": c.before.0,
+            "bins_before": c.before.1,
+            "bins_hit_after": c.after.0,
+            "bins_after": c.after.1,
+            "candidates": c.candidates,
+            "kept": c.kept,
+        })),
+        "minimal": m.minimal,
+    });
+    emit(json, &j, |_| {
+        let mut s = String::new();
+        if let Some(c) = &closure {
+            s += &format!(
+                "coverage closure: before {} of {} reachable bins ({:.1} %), after {} of {} ({:.1} %; the close class's own bin included); {} of {} candidates kept as class close\n",
+                c.before.0,
+                c.before.1,
+                pct(c.before),
+                c.after.0,
+                c.after.1,
+                pct(c.after),
+                c.kept,
+                c.candidates
+            );
+        }
+        if let Some(l) = &minimal_line {
+            s += l;
+            s += "\n";
+        }
+        s += &format!(
+            "wrote {}: unit {}, format {}, {} vectors ({}), seed {}\n",
+            out.display(),
+            m.unit,
+            m.format,
+            m.files[0].rows,
+            m.classes.iter().map(|c| format!("{} {}", c.name, c.count)).collect::<Vec<_>>().join(", "),
+            m.seed
+        );
+        s
+    })?;
     Ok(Outcome::Pass)
 }
