@@ -210,6 +210,17 @@ fn specials(width: u32, man: u32) -> Vec<u64> {
     v
 }
 
+/// The operand mask of a `width`-bit format and its special operands ([`specials`]).
+fn sweep_operands(of: OracleFormat, width: u32) -> (u64, Vec<u64>) {
+    let mask = if width == 64 { u64::MAX } else { (1u64 << width) - 1 };
+    let man = match of {
+        OracleFormat::Binary16 => 10,
+        OracleFormat::BFloat16 => 7,
+        OracleFormat::Binary32 => 23,
+    };
+    (mask, specials(width, man))
+}
+
 /// Item `i` of the sweep: every pair in order (exhaustive), or the specials' pairs `sp` first,
 /// then random pairs (masked to the format's width).
 fn pair_of(cfg: &OpsConfig, sp: &[u64], mask: u64, i: u64) -> (u64, u64) {
@@ -273,14 +284,7 @@ pub fn cover(cfg: &OpsConfig) -> Result<(vectors::manifest::Manifest, vectors::c
     };
     let bar = engine::Progress::new(cfg.engine.shard_items(n), "pairs (coverage)", !cfg.progress);
     let acc = datapath::with_format!(cfg.format, |f| {
-        let width = f.width();
-        let mask = if width == 64 { u64::MAX } else { (1u64 << width) - 1 };
-        let man = match of {
-            OracleFormat::Binary16 => 10,
-            OracleFormat::BFloat16 => 7,
-            OracleFormat::Binary32 => 23,
-        };
-        let sp = specials(width, man);
+        let (mask, sp) = sweep_operands(of, f.width());
         let one = f.to_bits(f.one());
         let bins = vectors::cover::RowBins::new(&m);
         engine::run(
@@ -321,14 +325,7 @@ pub fn accumulate(cfg: &OpsConfig) -> Result<OpsData, String> {
     let bar = engine::Progress::new(cfg.engine.shard_items(n), "pairs", !cfg.progress);
     bar.message(format!("{} {}", cfg.format.name(), cfg.op));
     let acc = datapath::with_format!(cfg.format, |f| {
-        let width = f.width();
-        let mask = if width == 64 { u64::MAX } else { (1u64 << width) - 1 };
-        let man = match of {
-            OracleFormat::Binary16 => 10,
-            OracleFormat::BFloat16 => 7,
-            OracleFormat::Binary32 => 23,
-        };
-        let sp = specials(width, man);
+        let (mask, sp) = sweep_operands(of, f.width());
         // the canonical NaN: what the model makes of any NaN input (the canonical rule)
         let canonical = f.to_bits(f.from_f64(f64::NAN));
         let pair = |i: u64| pair_of(cfg, &sp, mask, i);

@@ -60,8 +60,6 @@ pub fn close(req: &Request, budget: u64) -> Result<Closed, String> {
     if req.closure.is_some() || req.explicit.is_some() {
         return Err("--close applies to a generated set (not to given rows or an already closed set)".into());
     }
-    let base = generate(req)?;
-    let before = Coverage::measure(&base.manifest, &set_rows(&base)?)?.totals();
     let origin = format!(
         "raypipe vectors --close: coverage-directed search, seed {} ^ {CLOSE_SEED:#x}, budget {budget}",
         req.seed
@@ -80,6 +78,9 @@ pub fn close(req: &Request, budget: u64) -> Result<Closed, String> {
     let m = &with_class.manifest;
     let contents = set_rows(&with_class)?;
     let mut cov = Coverage::measure(m, &contents)?;
+    // the request's set's coverage: the empty close class's bin is unreachable (a class without
+    // vectors), so it adds nothing to the totals
+    let before = cov.totals();
     let kinds: Vec<Kind> = m.files[0].fields.iter().skip(1).map(|x| x.kind.clone()).collect();
     let widths: Vec<u32> = m.files[0].fields.iter().skip(1).map(|x| x.width).collect();
     // an input's group: its name without a trailing axis letter (ox, oy, oz: o)
@@ -171,7 +172,7 @@ pub fn close(req: &Request, budget: u64) -> Result<Closed, String> {
         }
     }
     let n_kept = kept.len();
-    let set = if kept.is_empty() { base } else { generate(&Request { closure: Some(explicit(kept)), ..req.clone() })? };
+    let set = generate(&Request { closure: (!kept.is_empty()).then(|| explicit(kept)), ..req.clone() })?;
     let coverage = Coverage::measure(&set.manifest, &set_rows(&set)?)?;
     Ok(Closed { before, after: coverage.totals(), candidates, kept: n_kept, coverage, set })
 }
@@ -236,6 +237,15 @@ fn templates(unit: Unit, kinds: &[Kind]) -> Vec<Vec<u64>> {
         // and with o = (1, 1, 1): u'_xy = 1 - p1
         with(&[(0, one), (1, one), (2, one), (3, one - 1), (12, one)]),
     ]
+}
+
+/// `v`, or (half the time) the encoding 1 to 8 above or below it (within `mask`).
+fn nudge(v: u64, mask: u64, r: &mut SplitMix64) -> u64 {
+    if r.below(2) != 0 {
+        return v;
+    }
+    let k = 1 + r.below(8);
+    (if r.below(2) == 0 { v.wrapping_add(k) } else { v.wrapping_sub(k) }) & mask
 }
 
 /// An encoding of float value class `FLOAT_BINS[bin]` (a random one where the class has many).
@@ -314,10 +324,7 @@ fn mutate(
                         // to 8 encodings beside it
                         let t = targets[r.below(targets.len() as u64) as usize];
                         x[i] = class_encoding(t, exp, man, r);
-                        if r.below(2) == 0 {
-                            let k = 1 + r.below(8);
-                            x[i] = if r.below(2) == 0 { x[i].wrapping_add(k) } else { x[i].wrapping_sub(k) } & mask(w);
-                        }
+                        x[i] = nudge(x[i], mask(w), r);
                     }
                     8 | 9 => x[i] = r.next_u64() & mask(w),
                     10 => {
@@ -334,10 +341,7 @@ fn mutate(
                         // an edge encoding, or (half the time) one 1 to 8 encodings beside it
                         let e = float_edges(exp, man);
                         x[i] = e[r.below(e.len() as u64) as usize];
-                        if r.below(2) == 0 {
-                            let k = 1 + r.below(8);
-                            x[i] = if r.below(2) == 0 { x[i].wrapping_add(k) } else { x[i].wrapping_sub(k) } & mask(w);
-                        }
+                        x[i] = nudge(x[i], mask(w), r);
                     }
                     2 => x[i] = r.next_u64() & mask(w),
                     3 => {

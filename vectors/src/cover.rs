@@ -239,7 +239,7 @@ impl Coverage {
                     .collect(),
             });
         }
-        for (stage, name, op, _, _) in arith_rows(m).into_iter().filter(|r| r.2 == "add" || r.2 == "sub") {
+        for (stage, name, op, _, _) in cancel_rows(m) {
             let man = m.params.get("man").copied().unwrap_or(0);
             coverpoints.push(Coverpoint {
                 signal: format!("{name} ({op})"),
@@ -444,6 +444,7 @@ pub struct RowBins<'a> {
     cmps: Vec<(u8, &'static str, &'static str, &'static str)>,
     ariths: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
     op_rounding: bool,
+    cancels: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
     crossed: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
     min_normal: f64,
     events: Vec<Event>,
@@ -459,6 +460,7 @@ impl<'a> RowBins<'a> {
             cmps: compares(m),
             ariths: arith_rows(m),
             op_rounding: op_unit_rounding(m),
+            cancels: cancel_rows(m),
             crossed: crossed_rows(m),
             min_normal: min_normal(m),
             events: events(m),
@@ -526,7 +528,7 @@ impl<'a> RowBins<'a> {
             }
             cp += 1;
         }
-        for &(_, name, op, a, b) in self.ariths.iter().filter(|r| r.2 == "add" || r.2 == "sub") {
+        for &(_, name, op, a, b) in &self.cancels {
             if let Some(bin) = cancellation(ix, contents, row, name, op, a, b, ftz) {
                 out.push((cp, bin));
             }
@@ -1040,6 +1042,12 @@ fn min_normal(m: &Manifest) -> f64 {
     }
 }
 
+/// The operations whose cancellation depth is counted: every add and subtract of
+/// [`arith_rows`].
+fn cancel_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str, &'static str)> {
+    arith_rows(m).into_iter().filter(|r| r.2 == "add" || r.2 == "sub").collect()
+}
+
 /// The operations whose operand classes are crossed: every rounded operation of the stage
 /// table with two signal operands (not the constant 1) that is not gated by a care_when (the
 /// signals after RTI's valid bit are defined only where valid is 1, which constrains their
@@ -1261,31 +1269,41 @@ impl Event {
 fn decode(m: &Manifest, b: u64) -> f64 {
     let p = |k: &str| m.params.get(k).copied().unwrap_or(0);
     if p("float") == 1 {
-        let (exp, man) = (p("exp") as u32, p("man") as u32);
-        let e = (b >> man) & ((1 << exp) - 1);
-        let f = b & ((1 << man) - 1);
-        let bias = (1i64 << (exp - 1)) - 1;
-        let mag = if e == (1 << exp) - 1 {
-            if f != 0 {
-                return f64::NAN;
-            }
-            f64::INFINITY
-        } else if e == 0 {
+        ieee_value(b, p("exp") as u32, p("man") as u32, false).unwrap_or(f64::NAN)
+    } else {
+        // in steps, as `operand` reads fixed-point fields
+        fixed_steps(b, p("width") as u32)
+    }
+}
+
+/// The value of an IEEE-like encoding `v` with `exp` exponent and `man` fraction bits (a
+/// subnormal as a zero of its sign under `ftz`); None for a NaN.
+fn ieee_value(v: u64, exp: u32, man: u32, ftz: bool) -> Option<f64> {
+    let neg = (v >> (exp + man)) & 1 == 1;
+    let e = (v >> man) & ((1 << exp) - 1);
+    let f = v & ((1 << man) - 1);
+    let bias = (1i64 << (exp - 1)) - 1;
+    let mag = if e == (1 << exp) - 1 {
+        if f != 0 {
+            return None;
+        }
+        f64::INFINITY
+    } else if e == 0 {
+        if ftz {
+            0.0
+        } else {
             f as f64 * (2f64).powi((1 - bias - man as i64) as i32)
-        } else {
-            (f as f64 + (1u64 << man) as f64) * (2f64).powi((e as i64 - bias - man as i64) as i32)
-        };
-        if (b >> (exp + man)) & 1 == 1 {
-            -mag
-        } else {
-            mag
         }
     } else {
-        let w = p("width") as u32;
-        // in steps, as `operand` reads fixed-point fields
-        let s = if w == 64 { b as i64 } else { ((b << (64 - w)) as i64) >> (64 - w) };
-        s as f64
-    }
+        (f as f64 + (1u64 << man) as f64) * (2f64).powi((e as i64 - bias - man as i64) as i32)
+    };
+    Some(if neg { -mag } else { mag })
+}
+
+/// A `w`-bit two's-complement encoding as a signed integer (fixed point in steps).
+fn fixed_steps(v: u64, w: u32) -> f64 {
+    let s = if w == 64 { v as i64 } else { ((v << (64 - w)) as i64) >> (64 - w) };
+    s as f64
 }
 
 /// The bins of a compare.
@@ -1359,32 +1377,8 @@ fn operand(ix: &Ix, contents: &[Vec<Vec<u64>>], row: usize, name: &str, ftz: boo
     }
     let v = *contents.get(i)?.get(row)?.get(k)?;
     Some(match x.kind {
-        Kind::Ieee { exp, man } => {
-            let neg = (v >> (exp + man)) & 1 == 1;
-            let e = (v >> man) & ((1 << exp) - 1);
-            let f = v & ((1 << man) - 1);
-            let bias = (1i64 << (exp - 1)) - 1;
-            let mag = if e == (1 << exp) - 1 {
-                if f != 0 {
-                    return Some(None);
-                }
-                f64::INFINITY
-            } else if e == 0 {
-                if ftz {
-                    0.0
-                } else {
-                    f as f64 * (2f64).powi((1 - bias - man as i64) as i32)
-                }
-            } else {
-                (f as f64 + (1u64 << man) as f64) * (2f64).powi((e as i64 - bias - man as i64) as i32)
-            };
-            Some(if neg { -mag } else { mag })
-        }
-        Kind::Fixed { .. } => {
-            let w = x.width;
-            let s = if w == 64 { v as i64 } else { ((v << (64 - w)) as i64) >> (64 - w) };
-            Some(s as f64)
-        }
+        Kind::Ieee { exp, man } => ieee_value(v, exp, man, ftz),
+        Kind::Fixed { .. } => Some(fixed_steps(v, x.width)),
         _ => Some(v as f64),
     })
 }
