@@ -155,22 +155,9 @@ pub fn scene_hash(scene: &crate::scene::Scene) -> String {
 /// Refuses an output path raypipe may not write, before any work: a directory, a missing
 /// parent directory, or an existing file that is not a raypipe partial.
 pub fn check_path(path: &Path) -> Result<(), String> {
-    let shown = path.display();
-    if path.is_dir() {
-        return Err(format!("--partial {shown} is a directory"));
-    }
-    let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    if !parent.is_dir() {
-        return Err(format!("--partial {shown}: no directory {}", parent.display()));
-    }
-    if path.exists() {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("--partial {shown}: {e}"))?;
-        let ours = serde_json::from_str::<serde_json::Value>(&text).is_ok_and(|v| v.get("raypipe_partial").is_some());
-        if !ours {
-            return Err(format!("--partial {shown} exists and is not a raypipe partial: not replacing it"));
-        }
-    }
-    Ok(())
+    let ours =
+        |text: &str| serde_json::from_str::<serde_json::Value>(text).is_ok_and(|v| v.get("raypipe_partial").is_some());
+    vectors::outdir::check_file_out("--partial", path, ours, "is not a raypipe partial")
 }
 
 /// Writes `p` to `path` atomically (a sibling temporary file renamed into place).

@@ -286,3 +286,10 @@ pub fn write_smt_set(
     let set = vectors::gen::generate(&req)?;
     vectors::write::write_set(&set, out)
 }
+
+/// Refuses an output file (`flag`) raypipe may not write, before any work: a directory, a
+/// missing parent directory, or an existing file whose first lines do not hold `marker`.
+pub fn check_written_path(flag: &str, path: &std::path::Path, marker: &str) -> Result<(), String> {
+    let ours = |text: &str| text.lines().take(4).any(|l| l.contains(marker));
+    vectors::outdir::check_file_out(flag, path, ours, "raypipe did not write it")
+}

@@ -141,24 +141,3 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         _ => Outcome::Pass,
     })
 }
-
-/// Refuses an output path (`flag`) raypipe may not write, before any work: a directory, a
-/// missing parent directory, or an existing file raypipe did not write (its first lines do not
-/// hold `marker`).
-pub fn check_written_path(flag: &str, path: &std::path::Path, marker: &str) -> Result<(), String> {
-    let shown = path.display();
-    if path.is_dir() {
-        return Err(format!("{flag} {shown} is a directory"));
-    }
-    let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-    if !parent.is_dir() {
-        return Err(format!("{flag} {shown}: no directory {}", parent.display()));
-    }
-    if path.exists() {
-        let text = std::fs::read_to_string(path).unwrap_or_default();
-        if !text.lines().take(4).any(|l| l.contains(marker)) {
-            return Err(format!("{flag} {shown} exists and raypipe did not write it: not replacing it"));
-        }
-    }
-    Ok(())
-}

@@ -39,7 +39,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     let sh = shard_of(sharding.shard.as_deref(), sharding.partial.as_deref())?;
     if let Some(c) = &cover {
         // before the work: a file raypipe did not write is never replaced
-        super::cover::check_written_path("--cover", c, vectors::cover_file::KIND)?;
+        check_written_path("--cover", c, vectors::cover_file::KIND)?;
     }
     let cfg = raypipe::ops::OpsConfig {
         format,

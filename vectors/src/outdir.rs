@@ -142,6 +142,27 @@ fn written_by_raypipe(dir: &Path) -> Vec<String> {
         .unwrap_or_default()
 }
 
+/// Refuses an output file `path` (given as option `flag`) raypipe may not write, before any
+/// work: a directory, a missing parent directory, or an existing file whose text `ours` does
+/// not recognise ("{flag} {path} exists and {not_ours}: not replacing it").
+pub fn check_file_out(flag: &str, path: &Path, ours: impl Fn(&str) -> bool, not_ours: &str) -> Result<(), String> {
+    let shown = path.display();
+    if path.is_dir() {
+        return Err(format!("{flag} {shown} is a directory"));
+    }
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        return Err(format!("{flag} {shown}: no directory {}", parent.display()));
+    }
+    if path.exists() {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{flag} {shown}: {e}"))?;
+        if !ours(&text) {
+            return Err(format!("{flag} {shown} exists and {not_ours}: not replacing it"));
+        }
+    }
+    Ok(())
+}
+
 /// Writes `path` through its temporary sibling and a rename.
 pub fn atomic_write(path: &Path, bytes: &[u8]) -> Result<(), String> {
     let tmp = partial_of(path)?;
