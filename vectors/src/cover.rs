@@ -691,7 +691,7 @@ pub const WHY_WIDEN_NEAR: &str = "t_near is tn_xyz stepped toward -inf (nextDown
 pub const WHY_WIDEN_FAR: &str = "t_far is tf_xyz stepped toward +inf (nextUp) at least once: nextUp never returns +0 or -inf, and from two steps on never -max (only nextUp(-inf) is -max)";
 
 /// Why a reciprocal never overflows under flush-to-zero.
-pub const WHY_FTZ_RECIP: &str = "flush-to-zero: every nonzero operand is normal, |x| >= 2^emin, so |1/x| <= 2^-emin = 2^(bias-1) < max: 1/x never overflows (+-inf only as 1/+-0, exactly); where RTI compares them det is nonzero, so 1/det and u, v (at most 2 x ... finite) are finite";
+pub const WHY_FTZ_RECIP: &str = "flush-to-zero: every nonzero operand is normal, |x| >= 2^emin, so |1/x| <= 2^-emin = 2^(bias-1) < max: 1/x never overflows (+-inf only as 1/+-0, exactly); where RTI compares them det is nonzero (so normal), so 1/det is finite and u, v are at most about 2";
 
 /// Whether the set's format is an IEEE-like float with flush-to-zero.
 fn ftz_float(m: &Manifest) -> bool {
