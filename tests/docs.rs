@@ -212,3 +212,34 @@ fn the_coverage_model_reference_is_generated() {
     let have = std::fs::read_to_string(&path).unwrap_or_default();
     assert!(have == want, "docs/coverage-model.md is stale: RAYPIPE_BLESS_DOCS=1 cargo test --release --test docs");
 }
+
+/// Text in prose that a markdown renderer reads as an HTML tag (`<x>`, `</x>`, `<x ...`), which
+/// mdBook warns about when it is left unclosed: the book's pages use none.
+fn raw_tags(text: &str) -> Vec<String> {
+    let p = prose(text);
+    let b = p.as_bytes();
+    let mut out = Vec::new();
+    for (i, &c) in b.iter().enumerate() {
+        if c != b'<' {
+            continue;
+        }
+        let j = if b.get(i + 1) == Some(&b'/') { i + 2 } else { i + 1 };
+        if b.get(j).is_some_and(|c| c.is_ascii_alphabetic()) {
+            let end = p[i..].find(['\n', '>']).map_or(p.len(), |k| i + k + 1);
+            out.push(p[i..end.min(i + 40)].to_string());
+        }
+    }
+    out
+}
+
+#[test]
+fn no_page_holds_a_raw_html_tag() {
+    assert_eq!(raw_tags("a q<I>.<F> b `<x>` c <= d"), ["<I>", "<F>"]);
+    let mut bad = Vec::new();
+    for f in markdown_files() {
+        for t in raw_tags(&std::fs::read_to_string(&f).unwrap()) {
+            bad.push(format!("{}: {t}", f.display()));
+        }
+    }
+    assert!(bad.is_empty(), "tag-like text outside code:\n{}", bad.join("\n"));
+}

@@ -680,7 +680,7 @@ pub const WHY_EMBREE_FIXED: &str = "embree preparation: |d| < delta becomes +-de
 pub const WHY_NO_CLASS_ROWS: &str =
     "the class has no vectors in this format (its manifest count is 0: a floats-only class in fixed point)";
 /// Why a fixed-point reciprocal is never 0 or one step.
-pub const WHY_FIXED_RECIP: &str = "every value x of q<I>.<F> has |x| < 2^(I-1), so |1/x| > 2^(F-I+1) steps >= 2 steps when F >= I (and 1/0 and a too large 1/x saturate): no rounding gives 0 or one step";
+pub const WHY_FIXED_RECIP: &str = "every value x of qI.F (I integer bits, F fraction bits) has |x| < 2^(I-1), so |1/x| > 2^(F-I+1) steps >= 2 steps when F >= I (and 1/0 and a too large 1/x saturate): no rounding gives 0 or one step";
 /// Why the RTI unit's fixed-point t, u and v are never negative where they are compared.
 pub const WHY_RTI_SIGN_FIXED: &str = "compared only when valid: then det is nonzero and u', v', t' are zero or of det's sign (u_ok, v_ok, t_ok), as is 1/det: the exact product (or quotient) is >= 0, and no rounding (floor, ceil, toward zero, nearest) of a value >= 0 is negative when the format saturates";
 /// Why the RTI unit's fixed-point u and v never saturate high.
