@@ -8,6 +8,7 @@ pub mod arch;
 pub mod bvh;
 pub mod camera;
 pub mod cover_reference;
+pub mod cover_run;
 pub mod explain;
 pub mod faults;
 pub mod field_reference;

@@ -235,16 +235,6 @@ fn pair_of(cfg: &OpsConfig, sp: &[u64], mask: u64, i: u64) -> (u64, u64) {
     }
 }
 
-/// Coverage counts as an engine accumulator.
-#[derive(Default)]
-struct CoverAcc(vectors::cover_file::CoverCounts);
-
-impl engine::Merge for CoverAcc {
-    fn merge(&mut self, other: Self) {
-        self.0.merge_counts(other.0);
-    }
-}
-
 /// The functional coverage of the engine's shard of the sweep (`raypipe ops --cover`): every
 /// item as a row of the op unit's coverage model (`vectors::cover`; the manifest of an op set
 /// of the format defines it). Rows: class `special` for the specials' pairs, `random` for the
@@ -254,25 +244,10 @@ pub fn cover(cfg: &OpsConfig) -> Result<(vectors::manifest::Manifest, vectors::c
     let n = items(cfg)?;
     let (of, _) = oracle_format(&cfg.format)?;
     let op = oracle_op_of(&cfg.op)?;
-    let set = vectors::gen::generate(&vectors::gen::Request {
-        unit: vectors::gen::Unit::Op,
-        format: cfg.format,
-        count: 1,
-        seed: 1,
-        level: 1,
-        threads: 1,
-        command: "raypipe ops --cover".into(),
-        rti: datapath::rti::RtiConfig::default(),
-        slab_variant: "plain".into(),
-        tree: None,
-        leaves: 8,
-        max_levels: 64,
-        explicit: None,
-        closure: None,
-    })?;
-    let m = set.manifest;
-    let model = vectors::cover::Coverage::model(&m);
-    let (offsets, total) = vectors::cover_file::offsets(&model);
+    let mut req = vectors::gen::Request::new(vectors::gen::Unit::Op, cfg.format);
+    req.command = "raypipe ops --cover".into();
+    // the op set's classes are the model's class bins (rows of class 0 `special`, 1 `random`)
+    let run = vectors::cover_file::RunModel::new(&req, None)?;
     let opcodes: &[u64] = match op {
         OracleOp::Add => &[0],
         OracleOp::Sub => &[1],
@@ -286,14 +261,14 @@ pub fn cover(cfg: &OpsConfig) -> Result<(vectors::manifest::Manifest, vectors::c
     let acc = datapath::with_format!(cfg.format, |f| {
         let (mask, sp) = sweep_operands(of, f.width());
         let one = f.to_bits(f.one());
-        let bins = vectors::cover::RowBins::new(&m);
+        let bins = vectors::cover::RowBins::new(&run.manifest);
         engine::run(
             &cfg.engine,
             n,
             &bar,
             || (vec![vec![vec![0u64; 4]], vec![vec![0u64; 2]]], Vec::new()),
             |(contents, hits), range| {
-                let mut acc = CoverAcc::default();
+                let mut acc = crate::cover_run::CoverAcc::new(1);
                 for i in range {
                     let (a, b) = pair_of(cfg, &sp, mask, i);
                     let a = if op == OracleOp::Recip { one } else { a };
@@ -302,10 +277,8 @@ pub fn cover(cfg: &OpsConfig) -> Result<(vectors::manifest::Manifest, vectors::c
                         let (res, cmp) = vectors::gen::op_eval(&f, code, f.from_bits(a), f.from_bits(b));
                         contents[0][0].copy_from_slice(&[class, code, a, b]);
                         contents[1][0].copy_from_slice(&[res, cmp]);
-                        hits.clear();
-                        if bins.hits(contents, 0, hits).is_ok() {
-                            acc.0.add(hits, &offsets, total);
-                        }
+                        // (a row of the op unit's own layout: every field is there)
+                        run.count(&bins, contents, hits, &mut acc.0[0]).expect("an op row");
                     }
                 }
                 acc
@@ -313,7 +286,7 @@ pub fn cover(cfg: &OpsConfig) -> Result<(vectors::manifest::Manifest, vectors::c
         )
     });
     bar.finish();
-    Ok((m, acc.0.into_coverage(&model)))
+    Ok(run.finish(acc.0.into_iter().next().unwrap_or_default()))
 }
 
 /// Runs the engine's shard of the sweep.

@@ -7,8 +7,8 @@ use super::prelude::*;
 /// The options of `raypipe cover`.
 #[derive(clap::Args, Clone)]
 pub struct Args {
-    /// Vector set directories or coverage files (`ops --cover`) of one unit, format and options
-    /// (their counts are added).
+    /// Vector set directories or coverage files (`--cover` of ops, verify, stress); the counts of
+    /// one unit, format and options are added, each such model reported on its own.
     #[arg(required = true)]
     pub sets: Vec<PathBuf>,
     /// Fail (exit 1) when fewer than this percentage of the bins are hit.
@@ -46,73 +46,153 @@ pub fn run(a: Args) -> Result<Outcome, String> {
             return Err("--html and --ucis name the same file".into());
         }
     }
-    let mut total: Option<vectors::cover::Coverage> = None;
+    // every input's models, merged by model (unit, format, options) in the order first met
+    let mut models: Vec<vectors::cover::Coverage> = Vec::new();
     for dir in &a.sets {
-        // a coverage file (`ops --cover`), or a vector set's directory
-        let c = if dir.is_file() {
+        // a coverage file (`--cover` of ops, verify, stress), or a vector set's directory
+        let found = if !dir.exists() {
+            return Err(format!("{}: no such coverage file or vector set", dir.display()));
+        } else if dir.is_file() {
             let text = std::fs::read_to_string(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-            vectors::cover_file::read(&text).map_err(|e| format!("{}: {e}", dir.display()))?.1
+            vectors::cover_file::read(&text)
+                .map_err(|e| format!("{}: {e}", dir.display()))?
+                .into_iter()
+                .map(|x| x.1)
+                .collect()
         } else {
             let path = dir.join("manifest.json");
             let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             let m: vectors::manifest::Manifest =
                 serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-            vectors::cover::Coverage::measure_dir(dir, &m).map_err(|e| format!("{}: {e}", dir.display()))?
+            vec![vectors::cover::Coverage::measure_dir(dir, &m).map_err(|e| format!("{}: {e}", dir.display()))?]
         };
-        match &mut total {
-            None => total = Some(c),
-            Some(t) => t.merge(&c).map_err(|e| format!("{}: {e}", dir.display()))?,
+        for c in found {
+            match models.iter_mut().find(|t| t.same_model(&c)) {
+                Some(t) => t.merge(&c).map_err(|e| format!("{}: {e}", dir.display()))?,
+                None => models.push(c),
+            }
         }
     }
-    let c = total.expect("at least one set");
-    let (hit, bins) = c.totals();
-    let pct = if bins == 0 { 0.0 } else { 100.0 * hit as f64 / bins as f64 };
-    let holes: Vec<String> = c
-        .coverpoints
-        .iter()
-        .flat_map(|p| {
-            p.bins.iter().filter(|b| b.count == 0 && b.unreachable.is_none()).map(move |b| {
-                let stage = p.stage.map_or(String::new(), |s| format!(" (stage {s})"));
-                format!("{} {}{stage}: {}", p.role, p.signal, b.name)
-            })
-        })
-        .collect();
-    let contradictions = c.contradictions();
-    if !contradictions.is_empty() {
-        return Err(format!(
-            "a bin marked unreachable was hit (the coverage model is wrong): {}",
-            contradictions.join("; ")
-        ));
+    for c in &models {
+        let contradictions = c.contradictions();
+        if !contradictions.is_empty() {
+            return Err(format!(
+                "{}: a bin marked unreachable was hit (the coverage model is wrong): {}",
+                c.title(),
+                contradictions.join("; ")
+            ));
+        }
     }
     let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
     if let Some(u) = &a.ucis {
-        vectors::outdir::atomic_write(u, c.ucis_xml(&vectors::cover::utc(now), &command_as_typed()).as_bytes())?;
+        let x = vectors::cover::ucis_xml_all(&models, &vectors::cover::utc(now), &command_as_typed());
+        vectors::outdir::atomic_write(u, x.as_bytes())?;
     }
     if let Some(h) = &a.html {
-        let page = vectors::cover_html::page(&c, &command_as_typed(), &vectors::cover::utc(now));
+        let page = vectors::cover_html::page_all(&models, &command_as_typed(), &vectors::cover::utc(now));
         vectors::outdir::atomic_write(h, page.as_bytes())?;
     }
-    let unreachable = c.coverpoints.iter().flat_map(|p| &p.bins).filter(|b| b.unreachable.is_some()).count();
-    let j = serde_json::json!({
+    let reports: Vec<Report> = models.iter().map(Report::of).collect();
+    let (hit, bins) = reports.iter().fold((0, 0), |(h, b), r| (h + r.hit, b + r.bins));
+    let pct = percent(hit, bins);
+    let mut j = serde_json::json!({
         "command": command_as_typed(),
         "sets": a.sets.iter().map(|d| d.display().to_string()).collect::<Vec<_>>(),
-        "unit": c.unit,
-        "format": c.format,
-        "vectors": c.vectors,
         "bins_hit": hit,
         "bins": bins,
-        "bins_unreachable": unreachable,
         "percent": pct,
-        "holes": holes,
-        "coverpoints": c.coverpoints,
+        "models": reports.iter().map(|r| r.json(r.cov)).collect::<Vec<_>>(),
     });
+    if let [r] = &reports[..] {
+        // one model: its fields at the top level too
+        for (k, v) in r.json(r.cov).as_object().expect("an object") {
+            j[k] = v.clone();
+        }
+    }
     emit(a.json, &j, |_| {
+        let mut s = String::new();
+        for r in &reports {
+            s += &r.text(a.sets.len(), a.holes);
+        }
+        if reports.len() > 1 {
+            s += &format!("{} models: {hit} of {bins} reachable bins hit ({pct:.1} %)\n", reports.len());
+        }
+        s
+    })?;
+    let under: Vec<String> = match a.fail_under {
+        Some(p) => reports.iter().filter(|r| r.pct < p).map(|r| format!("{} {:.1} %", r.cov.title(), r.pct)).collect(),
+        None => Vec::new(),
+    };
+    Ok(if under.is_empty() {
+        Outcome::Pass
+    } else {
+        eprintln!("coverage under --fail-under {}: {}", a.fail_under.unwrap_or(0.0), under.join(", "));
+        Outcome::Fail
+    })
+}
+
+fn percent(hit: u64, bins: u64) -> f64 {
+    if bins == 0 {
+        0.0
+    } else {
+        100.0 * hit as f64 / bins as f64
+    }
+}
+
+/// One model's numbers and holes.
+struct Report<'a> {
+    cov: &'a vectors::cover::Coverage,
+    hit: u64,
+    bins: u64,
+    pct: f64,
+    unreachable: usize,
+    holes: Vec<String>,
+}
+
+impl<'a> Report<'a> {
+    fn of(c: &'a vectors::cover::Coverage) -> Self {
+        let (hit, bins) = c.totals();
+        let holes = c
+            .coverpoints
+            .iter()
+            .flat_map(|p| {
+                p.bins.iter().filter(|b| b.count == 0 && b.unreachable.is_none()).map(move |b| {
+                    let stage = p.stage.map_or(String::new(), |s| format!(" (stage {s})"));
+                    format!("{} {}{stage}: {}", p.role, p.signal, b.name)
+                })
+            })
+            .collect();
+        Report {
+            cov: c,
+            hit,
+            bins,
+            pct: percent(hit, bins),
+            unreachable: c.coverpoints.iter().flat_map(|p| &p.bins).filter(|b| b.unreachable.is_some()).count(),
+            holes,
+        }
+    }
+
+    fn json(&self, c: &vectors::cover::Coverage) -> serde_json::Value {
+        serde_json::json!({
+            "unit": c.unit,
+            "format": c.format,
+            "variant": c.options.get("variant"),
+            "vectors": c.vectors,
+            "bins_hit": self.hit,
+            "bins": self.bins,
+            "bins_unreachable": self.unreachable,
+            "percent": self.pct,
+            "holes": self.holes,
+            "coverpoints": c.coverpoints,
+        })
+    }
+
+    fn text(&self, inputs: usize, show: usize) -> String {
+        let c = self.cov;
+        let variant = c.options.get("variant").map_or(String::new(), |v| format!(", variant {v}"));
         let mut s = format!(
-            "coverage of {} set(s), unit {}, format {}: {} vectors; {hit} of {bins} reachable bins hit ({pct:.1} %); {unreachable} bins unreachable (reasons in --json)\n",
-            a.sets.len(),
-            c.unit,
-            c.format,
-            c.vectors
+            "coverage of {inputs} set(s), unit {}, format {}{variant}: {} vectors; {} of {} reachable bins hit ({:.1} %); {} bins unreachable (reasons in --json)\n",
+            c.unit, c.format, c.vectors, self.hit, self.bins, self.pct, self.unreachable
         );
         let mut last = String::new();
         for p in &c.coverpoints {
@@ -124,20 +204,13 @@ pub fn run(a: Args) -> Result<Outcome, String> {
             let stage = p.stage.map_or(String::new(), |x| format!(" [{x}]"));
             s += &format!("    {}{stage} ({}): {h}/{}\n", p.signal, p.kind, p.bins.len());
         }
-        let shown = if a.holes == 0 { holes.len() } else { a.holes.min(holes.len()) };
-        if !holes.is_empty() {
-            s += &format!("empty bins ({} of {} shown):\n", shown, holes.len());
-            for h in &holes[..shown] {
+        let shown = if show == 0 { self.holes.len() } else { show.min(self.holes.len()) };
+        if !self.holes.is_empty() {
+            s += &format!("empty bins ({} of {} shown):\n", shown, self.holes.len());
+            for h in &self.holes[..shown] {
                 s += &format!("  {h}\n");
             }
         }
         s
-    })?;
-    Ok(match a.fail_under {
-        Some(p) if pct < p => {
-            eprintln!("coverage {pct:.1} % is under --fail-under {p}");
-            Outcome::Fail
-        }
-        _ => Outcome::Pass,
-    })
+    }
 }

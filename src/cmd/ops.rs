@@ -53,14 +53,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
     let data = raypipe::ops::accumulate(&cfg)?;
     if let Some(path) = &cover {
         let (m, c) = raypipe::ops::cover(&cfg)?;
-        vectors::outdir::atomic_write(path, vectors::cover_file::write(&c, &m, &command_as_typed()).as_bytes())?;
-        let (hit, bins) = c.totals();
-        eprintln!(
-            "coverage: {hit} of {bins} reachable bins of the op unit's model ({:.1} %), {} rows; written to {}",
-            100.0 * hit as f64 / bins.max(1) as f64,
-            c.vectors,
-            path.display()
-        );
+        raypipe::cover_run::write(path, &[(m, c)], &command_as_typed())?;
     }
     let id = Run { args: raypipe::ops::args(&cfg), scene_hash: String::new(), chunk: raypipe::ops::CHUNK, shard: sh };
     conclude(json, sharding.partial.as_deref(), id, data)

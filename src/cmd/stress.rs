@@ -20,6 +20,11 @@ pub struct Args {
     /// Print the results as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Also measure the functional coverage of the suite's cases (per format the RTI unit's and
+    /// each slab variant's coverage model, the stress classes as class bins; a pass of its own,
+    /// the report unchanged) and write it to FILE (`raypipe cover FILE…`; docs/coverage.md).
+    #[arg(long)]
+    pub cover: Option<PathBuf>,
     #[command(flatten)]
     pub run: EngineArgs,
     #[command(flatten)]
@@ -28,12 +33,20 @@ pub struct Args {
 
 /// Runs `raypipe stress`.
 pub fn run(a: Args) -> Result<Outcome, String> {
-    let Args { format, variant, count, seed, json, run, sharding } = a;
+    let Args { format, variant, count, seed, json, cover, run, sharding } = a;
     let sh = shard_of(sharding.shard.as_deref(), sharding.partial.as_deref())?;
+    if let Some(c) = &cover {
+        // before the work: a file raypipe did not write is never replaced
+        check_written_path("--cover", c, vectors::cover_file::KIND)?;
+    }
     let mut cfg = raypipe::stress::StressConfig::new(format, variant, count as usize, seed);
     cfg.engine = run.engine(raypipe::stress::CHUNK_CASES).with_shard(sh);
     cfg.progress = !run.quiet;
     let rep = raypipe::stress::stress(&cfg)?;
+    if let Some(path) = &cover {
+        let models = raypipe::stress::cover::cover(&cfg, &command_as_typed())?;
+        raypipe::cover_run::write(path, &models, &command_as_typed())?;
+    }
     let id = Run {
         args: raypipe::stress::args(&cfg),
         scene_hash: String::new(),

@@ -45,6 +45,11 @@ pub struct Args {
     pub inject: Option<String>,
     #[command(flatten)]
     pub rti: RtiArgs,
+    /// Also measure the functional coverage of the run's tests (per format the RTI unit's and
+    /// each slab variant's coverage model; a pass of its own, the report unchanged) and write it
+    /// to FILE (`raypipe cover FILE…` reports and merges it; docs/coverage.md).
+    #[arg(long)]
+    pub cover: Option<PathBuf>,
 }
 
 impl Args {
@@ -63,6 +68,7 @@ impl Args {
             sharding: ShardArgs { shard: None, partial: None },
             inject: None,
             rti: RtiArgs { cull: false, det_threshold: 0.0, tie: Tie::First },
+            cover: None,
         }
     }
 }
@@ -82,12 +88,20 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         (true, None) => DEFAULT_FORMATS.iter().map(|f| f.parse().expect("built-in format name")).collect(),
     };
     check_tests(a.rays, &scene, a.sample)?;
+    if let Some(c) = &a.cover {
+        // before the work: a file raypipe did not write is never replaced
+        check_written_path("--cover", c, vectors::cover_file::KIND)?;
+    }
     let shard = shard_of(a.sharding.shard.as_deref(), a.sharding.partial.as_deref())?;
     let mut cfg = VerifyConfig::new(formats, a.rays, a.seed, rti, a.sample as usize);
     cfg.engine = a.run.engine(a.chunk).with_shard(shard);
     cfg.progress = !a.run.quiet;
     cfg.inject = inject;
     let data = raypipe::verify::accumulate(&cfg, &scene);
+    if let Some(path) = &a.cover {
+        let models = raypipe::verify::cover::cover(&cfg, &scene, &command_as_typed())?;
+        raypipe::cover_run::write(path, &models, &command_as_typed())?;
+    }
     let id = Run {
         args: raypipe::verify::args(&cfg),
         scene_hash: raypipe::partial::scene_hash(&scene),

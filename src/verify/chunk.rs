@@ -599,6 +599,14 @@ impl FormatAcc {
     }
 }
 
+/// The bounding box (min x, y, z, max x, y, z) of a triangle's vertices: the box each slab test
+/// of `verify` tests.
+pub fn tri_box(v: &[[f64; 3]; 3]) -> [f64; 6] {
+    let lo = |a: usize| v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min);
+    let hi = |a: usize| v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max);
+    [lo(0), lo(1), lo(2), hi(0), hi(1), hi(2)]
+}
+
 /// One format's pass over every ray on the engine: the RTI report (when `with_rti`) and one
 /// slab report per variant the format accepts.
 pub fn run_format<F: Format + 'static>(
@@ -621,15 +629,7 @@ where
     let rti = Rti::new(fmt, cfg.rti);
     let f = &rti.fmt;
     let q = |x: f64| f.to_f64(f.from_f64(x));
-    let boxes: Vec<[f64; 6]> = scene
-        .tris
-        .iter()
-        .map(|t| {
-            let lo = |a: usize| t.v.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min);
-            let hi = |a: usize| t.v.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max);
-            [lo(0), lo(1), lo(2), hi(0), hi(1), hi(2)]
-        })
-        .collect();
+    let boxes: Vec<[f64; 6]> = scene.tris.iter().map(|t| tri_box(&t.v)).collect();
     // only the variants the format accepts (a conservative promise it cannot keep is refused)
     let variants: Vec<Variant<F>> = SlabConfig::variants_for(f)
         .into_iter()

@@ -6,6 +6,7 @@
 
 pub mod chunk;
 pub mod counts;
+pub mod cover;
 
 use crate::scene::Scene;
 use datapath::rti::RtiConfig;

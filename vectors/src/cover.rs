@@ -78,6 +78,10 @@ pub struct Coverage {
     pub unit: String,
     /// Format.
     pub format: String,
+    /// The options of the manifest that defines the model (a slab variant, the RTI's cull and
+    /// threshold, …): coverage merges only with coverage of the same unit, format and options.
+    #[serde(skip)]
+    pub options: std::collections::BTreeMap<String, String>,
     /// Vectors counted.
     pub vectors: u64,
     /// Coverpoints in file and field order.
@@ -281,7 +285,21 @@ impl Coverage {
                     .collect(),
             });
         }
-        Coverage { unit: m.unit.clone(), format: m.format.clone(), vectors: 0, coverpoints }
+        Coverage { unit: m.unit.clone(), format: m.format.clone(), options: m.options.clone(), vectors: 0, coverpoints }
+    }
+
+    /// Whether `other` is coverage of the same unit, format and options (the two merge).
+    pub fn same_model(&self, other: &Coverage) -> bool {
+        self.unit == other.unit && self.format == other.format && self.options == other.options
+    }
+
+    /// A name for the model among others of a run: unit, format and (when it has one) the slab
+    /// variant, e.g. `slab fp16 conservative`.
+    pub fn title(&self) -> String {
+        match self.options.get("variant") {
+            Some(v) => format!("{} {} {v}", self.unit, self.format),
+            None => format!("{} {}", self.unit, self.format),
+        }
     }
 
     /// The coverage of a set's rows (`contents`: every file's rows, unpacked, as
@@ -388,7 +406,9 @@ impl Coverage {
         Ok(())
     }
 
-    /// Adds `other`'s counts (the same unit, format and coverage model).
+    /// Adds `other`'s counts (the same unit, format, options and coverage model). The class
+    /// coverpoint merges by bin name: a class of either side is a bin of the sum (a closed set
+    /// adds `close`, a `verify` run `scene`), unreachable only when it is unreachable on both.
     pub fn merge(&mut self, other: &Coverage) -> Result<(), String> {
         if other.unit != self.unit || other.format != self.format {
             return Err(format!(
@@ -396,16 +416,46 @@ impl Coverage {
                 other.unit, other.format, self.unit, self.format
             ));
         }
+        if other.options != self.options {
+            let differ: Vec<&str> = self
+                .options
+                .keys()
+                .chain(other.options.keys())
+                .filter(|k| self.options.get(*k) != other.options.get(*k))
+                .map(|k| k.as_str())
+                .collect::<std::collections::BTreeSet<_>>()
+                .into_iter()
+                .collect();
+            return Err(format!("cannot merge coverage of different options ({} differ)", differ.join(", ")));
+        }
         let shape = |c: &Coverage| -> Vec<(String, String, Vec<String>)> {
             c.coverpoints
                 .iter()
-                .map(|p| (p.role.clone(), p.signal.clone(), p.bins.iter().map(|b| b.name.clone()).collect()))
+                .map(|p| {
+                    let bins =
+                        if p.kind == "class" { Vec::new() } else { p.bins.iter().map(|b| b.name.clone()).collect() };
+                    (p.role.clone(), p.signal.clone(), bins)
+                })
                 .collect()
         };
         if shape(self) != shape(other) {
             return Err("cannot merge: the sets have different coverage models (options or classes differ)".into());
         }
         for (p, q) in self.coverpoints.iter_mut().zip(&other.coverpoints) {
+            if p.kind == "class" {
+                for c in &q.bins {
+                    match p.bins.iter_mut().find(|b| b.name == c.name) {
+                        Some(b) => {
+                            b.count += c.count;
+                            if c.unreachable.is_none() {
+                                b.unreachable = None;
+                            }
+                        }
+                        None => p.bins.push(c.clone()),
+                    }
+                }
+                continue;
+            }
             for (b, c) in p.bins.iter_mut().zip(&q.bins) {
                 b.count += c.count;
             }
@@ -578,28 +628,47 @@ pub fn utc(secs: u64) -> String {
 impl Coverage {
     /// The coverage as UCIS 1.0 XML (the Accellera interchange format that pyucis and the
     /// simulators' coverage tools read): one instance `raypipe_<unit>`, one covergroup per file
-    /// role (`inputs`, `expected_outputs`, `stage_signals`), one coverpoint per signal, one bin
-    /// per bin (`type="ignore"`: unreachable). `written` is the writing time (UTC), `command` the
-    /// command that measured it (the history node's `cmd`).
+    /// role (`inputs`, `expected_outputs`, `stage_signals`, `events`), one coverpoint per
+    /// signal, one bin per bin (`type="ignore"`: unreachable). `written` is the writing time
+    /// (UTC), `command` the command that measured it (the history node's `cmd`).
     pub fn ucis_xml(&self, written: &str, command: &str) -> String {
-        let mut s = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+        ucis_xml_all(std::slice::from_ref(self), written, command)
+    }
+}
+
+/// Several models' coverage (a `verify` or `stress` run's: one per unit, format and variant) as
+/// one UCIS 1.0 document: one instance per model, named `raypipe_<unit>_<format>[_<variant>]`
+/// with `.`, `:` and `+` of the format as `_` (one model: `raypipe_<unit>`, as
+/// [`Coverage::ucis_xml`]), each as that method describes.
+pub fn ucis_xml_all(covs: &[Coverage], written: &str, command: &str) -> String {
+    let mut s = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    s += &format!(
+        "<UCIS xmlns:ucis=\"http://www.w3.org/2001/XMLSchema-instance\" writtenBy=\"raypipe {}\" writtenTime=\"{written}\" ucisVersion=\"1.0\">\n",
+        env!("CARGO_PKG_VERSION")
+    );
+    s += "  <sourceFiles fileName=\"manifest.json\" id=\"1\"/>\n";
+    s += &format!(
+        "  <historyNodes historyNodeId=\"0\" logicalName=\"raypipe cover\" physicalName=\"raypipe-cover.xml\" kind=\"1\" testStatus=\"true\" simtime=\"0.0\" timeunit=\"ns\" runCwd=\".\" cpuTime=\"0.0\" seed=\"0\" cmd=\"{}\" args=\"\" compulsory=\"0\" date=\"{written}\" userName=\"raypipe\" cost=\"0.0\" toolCategory=\"UCIS:simulator\" ucisVersion=\"1.0\" vendorId=\"raypipe\" vendorTool=\"raypipe\" vendorToolVersion=\"{}\"/>\n",
+        xml(command),
+        env!("CARGO_PKG_VERSION")
+    );
+    let ident = |x: &str| x.replace([':', '+', '.', ' ', '-'], "_");
+    for (key, c) in covs.iter().enumerate() {
+        let unit = xml(&c.unit);
+        let fmt = xml(&ident(&c.format));
+        let name = if covs.len() == 1 {
+            format!("raypipe_{unit}")
+        } else {
+            match c.options.get("variant") {
+                Some(v) => format!("raypipe_{unit}_{fmt}_{}", xml(&ident(v))),
+                None => format!("raypipe_{unit}_{fmt}"),
+            }
+        };
         s += &format!(
-            "<UCIS xmlns:ucis=\"http://www.w3.org/2001/XMLSchema-instance\" writtenBy=\"raypipe {}\" writtenTime=\"{written}\" ucisVersion=\"1.0\">\n",
-            env!("CARGO_PKG_VERSION")
-        );
-        s += "  <sourceFiles fileName=\"manifest.json\" id=\"1\"/>\n";
-        s += &format!(
-            "  <historyNodes historyNodeId=\"0\" logicalName=\"raypipe cover\" physicalName=\"raypipe-cover.xml\" kind=\"1\" testStatus=\"true\" simtime=\"0.0\" timeunit=\"ns\" runCwd=\".\" cpuTime=\"0.0\" seed=\"0\" cmd=\"{}\" args=\"\" compulsory=\"0\" date=\"{written}\" userName=\"raypipe\" cost=\"0.0\" toolCategory=\"UCIS:simulator\" ucisVersion=\"1.0\" vendorId=\"raypipe\" vendorTool=\"raypipe\" vendorToolVersion=\"{}\"/>\n",
-            xml(command),
-            env!("CARGO_PKG_VERSION")
-        );
-        let unit = xml(&self.unit);
-        s += &format!(
-            "  <instanceCoverages name=\"raypipe_{unit}\" key=\"0\" instanceId=\"0\" moduleName=\"raypipe_{unit}_{}\">\n    <id file=\"1\" line=\"1\" inlineCount=\"1\"/>\n    <covergroupCoverage>\n",
-            xml(&self.format.replace([':', '+', '.'], "_"))
+            "  <instanceCoverages name=\"{name}\" key=\"{key}\" instanceId=\"{key}\" moduleName=\"raypipe_{unit}_{fmt}\">\n    <id file=\"1\" line=\"1\" inlineCount=\"1\"/>\n    <covergroupCoverage>\n"
         );
         let mut roles: Vec<&str> = Vec::new();
-        for p in &self.coverpoints {
+        for p in &c.coverpoints {
             if !roles.contains(&p.role.as_str()) {
                 roles.push(&p.role);
             }
@@ -609,7 +678,7 @@ impl Coverage {
             s += &format!(
                 "      <cgInstance name=\"{cg}\" key=\"0\">\n        <options weight=\"1\" goal=\"100\" at_least=\"1\" per_instance=\"true\" merge_instances=\"true\"/>\n        <cgId cgName=\"{cg}\" moduleName=\"raypipe_{unit}\">\n          <cginstSourceId file=\"1\" line=\"1\" inlineCount=\"1\"/>\n          <cgSourceId file=\"1\" line=\"1\" inlineCount=\"1\"/>\n        </cgId>\n"
             );
-            for p in self.coverpoints.iter().filter(|p| p.role == role) {
+            for p in c.coverpoints.iter().filter(|p| p.role == role) {
                 s += &format!(
                     "        <coverpoint name=\"{}\" key=\"0\">\n          <options weight=\"1\" goal=\"100\" at_least=\"1\" auto_bin_max=\"64\" detect_overlap=\"false\"/>\n",
                     xml(&p.signal)
@@ -626,9 +695,10 @@ impl Coverage {
             }
             s += "      </cgInstance>\n";
         }
-        s += "    </covergroupCoverage>\n  </instanceCoverages>\n</UCIS>\n";
-        s
+        s += "    </covergroupCoverage>\n  </instanceCoverages>\n";
     }
+    s += "</UCIS>\n";
+    s
 }
 
 /// The traverse unit's counters and history registers: (kind, bins), for its fields `count`

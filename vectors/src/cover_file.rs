@@ -1,29 +1,31 @@
-//! A coverage file (`--cover FILE` of `raypipe ops`, read back by `raypipe cover`): the counts of
-//! a run's coverage with the manifest that defines its coverage model, so that runs and shards
-//! merge exactly (counts added bin by bin) with each other and with vector sets of the same
-//! unit, format and options.
+//! A coverage file (`--cover FILE` of `raypipe ops`, `verify` and `stress`, read back by
+//! `raypipe cover`): the counts of a run's coverage with the manifest that defines each coverage
+//! model the run measured (one per unit, format and options: `verify` measures the RTI unit and
+//! every slab variant of every format), so that runs and shards merge exactly (counts added bin
+//! by bin) with each other and with vector sets of the same unit, format and options.
 //!
-//! JSON: `{"kind": "raypipe coverage", "version": 1, "command": …, "manifest": {…},
-//! "vectors": N, "counts": [[bin counts of coverpoint 0], …]}`, the coverpoints in the order
-//! [`Coverage::model`] gives for that manifest.
+//! JSON: `{"kind": "raypipe coverage", "version": 2, "command": …, "models": [{"manifest":
+//! {…}, "vectors": N, "counts": [[bin counts of coverpoint 0], …]}, …]}`, the coverpoints in
+//! the order [`Coverage::model`] gives for that manifest. Version 1 (one model: `manifest`,
+//! `vectors` and `counts` at the top level) is read too.
 
-use crate::cover::Coverage;
-use crate::manifest::Manifest;
+use crate::cover::{Coverage, RowBins};
+use crate::manifest::{Class, Manifest};
 
 /// The `kind` of a coverage file.
 pub const KIND: &str = "raypipe coverage";
 
-/// The file's text for coverage `c` of model `m`, measured by `command`.
-pub fn write(c: &Coverage, m: &Manifest, command: &str) -> String {
-    let counts: Vec<Vec<u64>> = c.coverpoints.iter().map(|p| p.bins.iter().map(|b| b.count).collect()).collect();
-    let j = serde_json::json!({
-        "kind": KIND,
-        "version": 1,
-        "command": command,
-        "manifest": m,
-        "vectors": c.vectors,
-        "counts": counts,
-    });
+/// The file's text for the coverage `c` of each model `m` in `models`, measured by `command`.
+pub fn write(models: &[(Manifest, Coverage)], command: &str) -> String {
+    let models: Vec<serde_json::Value> = models
+        .iter()
+        .map(|(m, c)| {
+            let counts: Vec<Vec<u64>> =
+                c.coverpoints.iter().map(|p| p.bins.iter().map(|b| b.count).collect()).collect();
+            serde_json::json!({ "manifest": m, "vectors": c.vectors, "counts": counts })
+        })
+        .collect();
+    let j = serde_json::json!({ "kind": KIND, "version": 2, "command": command, "models": models });
     serde_json::to_string_pretty(&j).expect("coverage serialises") + "\n"
 }
 
@@ -32,13 +34,28 @@ pub fn is_coverage(text: &str) -> bool {
     text.lines().take(3).any(|l| l.contains(KIND))
 }
 
-/// The manifest and coverage a coverage file holds (checked against the model its manifest
-/// defines).
-pub fn read(text: &str) -> Result<(Manifest, Coverage), String> {
+/// The manifest and coverage of every model a coverage file holds (each checked against the
+/// model its manifest defines).
+pub fn read(text: &str) -> Result<Vec<(Manifest, Coverage)>, String> {
     let j: serde_json::Value = serde_json::from_str(text).map_err(|e| format!("not a coverage file: {e}"))?;
-    if j["kind"] != KIND || j["version"] != 1 {
-        return Err(format!("not a coverage file (kind \"{KIND}\", version 1)"));
+    if j["kind"] != KIND {
+        return Err(format!("not a coverage file (kind \"{KIND}\")"));
     }
+    match j["version"].as_u64() {
+        Some(1) => Ok(vec![model(&j)?]),
+        Some(2) => {
+            let ms = j["models"].as_array().ok_or("models: not a list")?;
+            if ms.is_empty() {
+                return Err("models: empty (the run measured nothing)".into());
+            }
+            ms.iter().enumerate().map(|(i, x)| model(x).map_err(|e| format!("model {}: {e}", i + 1))).collect()
+        }
+        _ => Err(format!("not a coverage file this raypipe reads (kind \"{KIND}\", version 1 or 2)")),
+    }
+}
+
+/// One model's manifest and counts.
+fn model(j: &serde_json::Value) -> Result<(Manifest, Coverage), String> {
     let m: Manifest = serde_json::from_value(j["manifest"].clone()).map_err(|e| format!("manifest: {e}"))?;
     let mut c = Coverage::model(&m);
     let counts: Vec<Vec<u64>> = serde_json::from_value(j["counts"].clone()).map_err(|e| format!("counts: {e}"))?;
@@ -115,4 +132,60 @@ pub fn offsets(c: &Coverage) -> (Vec<usize>, usize) {
         k += p.bins.len();
     }
     (v, k)
+}
+
+/// One coverage model of a run (`--cover` of `verify`, `stress`, `ops`): the manifest that
+/// defines it, its empty coverage and each coverpoint's place in the flat counts.
+pub struct RunModel {
+    /// The manifest (of a set of the run's unit, format and options, with the run's classes).
+    pub manifest: Manifest,
+    /// The model, every count 0.
+    pub model: Coverage,
+    offsets: Vec<usize>,
+    total: usize,
+}
+
+impl RunModel {
+    /// The model of the sets `req` describes; with `classes` (name, what it covers, tests of
+    /// the class in the run) in place of the set's classes: the class bins are then the run's
+    /// stimulus classes.
+    pub fn new(req: &crate::gen::Request, classes: Option<&[(&str, &str, usize)]>) -> Result<Self, String> {
+        let mut manifest = crate::gen::generate(req)?.manifest;
+        if let Some(classes) = classes {
+            manifest.classes = classes
+                .iter()
+                .enumerate()
+                .map(|(id, &(name, covers, count))| Class {
+                    id: id as u32,
+                    name: name.into(),
+                    covers: covers.into(),
+                    count,
+                })
+                .collect();
+        }
+        manifest.command = req.command.clone();
+        let model = Coverage::model(&manifest);
+        let (offsets, total) = offsets(&model);
+        Ok(RunModel { manifest, model, offsets, total })
+    }
+
+    /// Counts row 0 of `contents` (every file's row, unpacked) into `acc`; `bins` is this
+    /// model's lookup, `hits` scratch space.
+    pub fn count(
+        &self,
+        bins: &RowBins,
+        contents: &[Vec<Vec<u64>>],
+        hits: &mut Vec<(usize, usize)>,
+        acc: &mut CoverCounts,
+    ) -> Result<(), String> {
+        hits.clear();
+        bins.hits(contents, 0, hits)?;
+        acc.add(hits, &self.offsets, self.total);
+        Ok(())
+    }
+
+    /// The manifest and the coverage of counts `acc`.
+    pub fn finish(&self, acc: CoverCounts) -> (Manifest, Coverage) {
+        (self.manifest.clone(), acc.into_coverage(&self.model))
+    }
 }

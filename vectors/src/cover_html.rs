@@ -15,17 +15,34 @@ fn esc(s: &str) -> String {
 
 /// The page for coverage `c`, measured by `command` at `written` (UTC).
 pub fn page(c: &Coverage, command: &str, written: &str) -> String {
-    let (hit, bins) = c.totals();
-    let pct = if bins == 0 { 0.0 } else { 100.0 * hit as f64 / bins as f64 };
+    page_all(std::slice::from_ref(c), command, written)
+}
+
+/// One page for the coverage of several models (a `verify` or `stress` run's), one section per
+/// model as [`page`] draws it.
+pub fn page_all(covs: &[Coverage], command: &str, written: &str) -> String {
     let mut s = format!("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n{GENERATOR}\n<meta charset=\"utf-8\">\n");
-    s += &format!("<title>raypipe coverage: {} {}</title>\n", esc(&c.unit), esc(&c.format));
+    let titles: Vec<String> = covs.iter().map(|c| c.title()).collect();
+    s += &format!("<title>raypipe coverage: {}</title>\n", esc(&titles.join(", ")));
     s += "<style>\nbody{font:14px sans-serif;margin:1.5em}table{border-collapse:collapse;margin:.5em 0 1.5em}\
 td,th{border:1px solid #ccc;padding:2px 6px;vertical-align:top}th{background:#eee;text-align:left}\
 .bar{width:120px;height:10px;background:#f3c0c0;display:inline-block}.bar i{display:block;height:10px;background:#5a5}\
 .b{display:inline-block;margin:1px;padding:0 4px;border-radius:3px;font-size:12px}.hit{background:#cfc}\
 .hole{background:#f99;font-weight:bold}.un{background:#ddd;color:#777}\n</style>\n</head>\n<body>\n";
-    s += &format!(
-        "<h1>Coverage: unit {}, format {}</h1>\n<p>{} vectors; <b>{hit} of {bins} reachable bins hit ({pct:.1} %)</b>; {} bins unreachable (grey; the reason is the cell's title). Written {} UTC by <code>{}</code>.</p>\n",
+    for c in covs {
+        s += &section(c, command, written);
+    }
+    s += "</body>\n</html>\n";
+    s
+}
+
+/// One model's section: title, totals, holes, the coverpoints per file role.
+fn section(c: &Coverage, command: &str, written: &str) -> String {
+    let (hit, bins) = c.totals();
+    let pct = if bins == 0 { 0.0 } else { 100.0 * hit as f64 / bins as f64 };
+    let variant = c.options.get("variant").map_or(String::new(), |v| format!(", variant {}", esc(v)));
+    let mut s = format!(
+        "<h1>Coverage: unit {}, format {}{variant}</h1>\n<p>{} vectors; <b>{hit} of {bins} reachable bins hit ({pct:.1} %)</b>; {} bins unreachable (grey; the reason is the cell's title). Written {} UTC by <code>{}</code>.</p>\n",
         esc(&c.unit),
         esc(&c.format),
         c.vectors,
@@ -89,6 +106,5 @@ td,th{border:1px solid #ccc;padding:2px 6px;vertical-align:top}th{background:#ee
     if !role.is_empty() {
         s += "</table>\n";
     }
-    s += "</body>\n</html>\n";
     s
 }

@@ -103,6 +103,30 @@ pub struct Request {
     pub closure: Option<Explicit>,
 }
 
+impl Request {
+    /// A level-1 request of `unit` in `format`: one vector per class, seed 1, one thread, the
+    /// default RTI options and slab variant `plain`, no tree, 8 leaves, 64 level pipelines, no
+    /// given rows (set the fields that differ).
+    pub fn new(unit: Unit, format: AnyFormat) -> Self {
+        Request {
+            unit,
+            format,
+            count: 1,
+            seed: 1,
+            level: 1,
+            threads: 1,
+            command: String::new(),
+            rti: RtiConfig::default(),
+            slab_variant: "plain".into(),
+            tree: None,
+            leaves: 8,
+            max_levels: 64,
+            explicit: None,
+            closure: None,
+        }
+    }
+}
+
 /// A set's input rows given by their writer (e.g. `raypipe prove --out`), one class.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Explicit {

@@ -16,6 +16,8 @@ use golden::{Faces, Ray64, Tri64};
 use serde::Serialize;
 use vectors::gen::slab_rays;
 
+pub mod cover;
+
 /// What to run.
 #[derive(Clone, Debug)]
 pub struct StressConfig {
