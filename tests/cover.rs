@@ -56,9 +56,13 @@ fn cover_reports_merges_and_gates() {
     assert_eq!(o.status.code(), Some(1));
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("empty bins") && text.contains("reachable bins hit"), "{text}");
-    // bad input: other formats together, a percentage out of range, no set
+    // sets of two formats: two models, each reported on its own
+    let two = json(&[&sa, &f32set.display().to_string()]);
+    let formats: Vec<&str> = two["models"].as_array().unwrap().iter().map(|m| m["format"].as_str().unwrap()).collect();
+    assert_eq!(formats, ["fp16", "f32"]);
+    assert!(two.get("coverpoints").is_none(), "several models have no top-level coverpoints");
+    // bad input: a percentage out of range, no set
     for args in [
-        vec!["cover".to_string(), sa.clone(), f32set.display().to_string()],
         vec!["cover".to_string(), sa.clone(), "--fail-under".to_string(), "101".to_string()],
         vec!["cover".to_string(), tmp.join("none").display().to_string()],
     ] {
@@ -246,4 +250,128 @@ fn ops_cover_files_merge_like_one_pass() {
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(std::fs::read_to_string(tmp.join("mine.json")).unwrap(), "{}");
     let _ = std::fs::remove_dir_all(&tmp);
+}
+
+/// The count of bin `bin` of coverpoint `signal` in `role` of a `cover --json` model.
+fn bin_count(model: &serde_json::Value, role: &str, signal: &str, bin: &str) -> u64 {
+    let p = model["coverpoints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["role"] == role && p["signal"] == signal)
+        .unwrap_or_else(|| panic!("no coverpoint {role} {signal}"));
+    p["bins"].as_array().unwrap().iter().find(|b| b["name"] == bin).map_or(0, |b| b["count"].as_u64().unwrap())
+}
+
+/// `verify --cover` and `stress --cover`: one model per unit, format and slab variant; every test
+/// of the run counted once, its hit flag as the run's own (SIMD, judged) pass counted it; the
+/// shards' files merged equal the one-pass file; a run's file merges with a vector set of the
+/// same model (class bins by name); a file raypipe did not write is refused before the work.
+#[test]
+fn verify_and_stress_cover_count_every_test_and_merge_like_one_pass() {
+    let tmp = std::env::temp_dir().join(format!("raypipe-runcover-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).unwrap();
+    let p = |n: &str| tmp.join(n).display().to_string();
+    let run = |args: &[&str]| -> serde_json::Value {
+        let o = raypipe(args);
+        assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap_or(serde_json::Value::Null)
+    };
+    let cover = |files: &[&str]| -> serde_json::Value {
+        let mut v = vec!["cover", "--json"];
+        v.extend_from_slice(files);
+        run(&v)
+    };
+    let verify = ["verify", "--rays", "40", "--format", "fp16", "--quiet"];
+    let rep = run(&[&verify[..], &["--json", "--cover", &p("v.json")]].concat());
+    let c = cover(&[&p("v.json")]);
+    let models = c["models"].as_array().unwrap();
+    // rti and the slab variants with a coverage model (directed has none)
+    let names: Vec<String> = models
+        .iter()
+        .map(|m| format!("{} {}", m["unit"].as_str().unwrap(), m["variant"].as_str().unwrap_or("")))
+        .collect();
+    assert_eq!(names, ["rti ", "slab plain", "slab conservative", "slab take-on-false", "slab embree"]);
+    let f = &rep["formats"][0];
+    assert_eq!(models[0]["vectors"], f["tests"]);
+    assert_eq!(bin_count(&models[0], "expected outputs", "hit", "1"), f["model_hits"].as_u64().unwrap());
+    assert_eq!(bin_count(&models[0], "inputs", "class", "scene"), f["tests"].as_u64().unwrap());
+    for m in &models[1..] {
+        let r = rep["slab"].as_array().unwrap().iter().find(|r| r["variant"] == m["variant"]).unwrap();
+        let n = |k: &str| r[k].as_u64().unwrap();
+        assert_eq!(m["vectors"], r["tests"]);
+        assert_eq!(
+            bin_count(m, "expected outputs", "hit", "1"),
+            n("exact_hits") - n("false_misses") + n("false_hits"),
+            "{}",
+            m["variant"]
+        );
+    }
+    // two shards' files merged equal the one pass
+    run(&[&verify[..], &["--shard", "0/2", "--partial", &p("p0.json"), "--cover", &p("s0.json")]].concat());
+    run(&[&verify[..], &["--shard", "1/2", "--partial", &p("p1.json"), "--cover", &p("s1.json")]].concat());
+    let merged = cover(&[&p("s0.json"), &p("s1.json")]);
+    assert_eq!(merged["models"], c["models"]);
+    // with a vector set of the same model: the set's classes and `scene` side by side
+    let set = tmp.join("set");
+    rti_set(&set);
+    let both = cover(&[&p("v.json"), &set.display().to_string()]);
+    let rti = &both["models"][0];
+    assert_eq!(both["models"].as_array().unwrap().len(), 5);
+    assert_eq!(bin_count(rti, "inputs", "class", "scene"), f["tests"].as_u64().unwrap());
+    assert!(bin_count(rti, "inputs", "class", "random") > 0);
+    assert!(rti["vectors"].as_u64().unwrap() > f["tests"].as_u64().unwrap());
+    // stress: the stress classes are the class bins, each class's tests counted
+    let st = run(&[
+        "stress",
+        "--count",
+        "12",
+        "--format",
+        "fp16",
+        "--variant",
+        "plain,conservative,directed",
+        "--quiet",
+        "--json",
+        "--cover",
+        &p("st.json"),
+    ]);
+    let sc = cover(&[&p("st.json")]);
+    let sm = sc["models"].as_array().unwrap();
+    assert_eq!(sm.len(), 3, "rti, plain, conservative (directed has no model)");
+    for r in st["rti"].as_array().unwrap() {
+        assert_eq!(bin_count(&sm[0], "inputs", "class", r["class"].as_str().unwrap()), r["tests"].as_u64().unwrap());
+    }
+    for m in &sm[1..] {
+        for r in st["slab"].as_array().unwrap().iter().filter(|r| r["variant"] == m["variant"]) {
+            assert_eq!(bin_count(m, "inputs", "class", r["class"].as_str().unwrap()), r["tests"].as_u64().unwrap());
+        }
+        let hits: u64 = st["slab"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|r| r["variant"] == m["variant"])
+            .map(|r| {
+                let n = |k: &str| r[k].as_u64().unwrap();
+                n("exact_hits") - n("false_misses") + n("false_hits") + n("undecided_hits")
+            })
+            .sum();
+        assert_eq!(bin_count(m, "expected outputs", "hit", "1"), hits, "{}", m["variant"]);
+    }
+    // a stranger's file is refused before the work, and kept
+    std::fs::write(tmp.join("mine.json"), "{}").unwrap();
+    for args in [
+        vec!["verify", "--rays", "4", "--quiet", "--cover", &p("mine.json")],
+        vec!["stress", "--count", "2", "--quiet", "--cover", &p("mine.json")],
+    ] {
+        let o = raypipe(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert_eq!(std::fs::read_to_string(tmp.join("mine.json")).unwrap(), "{}");
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}
+
+/// The default rti fp16 set (one vector per class).
+fn rti_set(dir: &std::path::Path) {
+    set(dir, &["--unit", "rti", "--format", "fp16", "--count", "1"]);
 }

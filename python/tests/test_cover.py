@@ -63,6 +63,47 @@ def test_pyucis_reads_the_totals_raypipe_reports(unit, fmt, opts, tmp_path):
         assert 0 < hit <= total
 
 
+def ucis_instances(path):
+    """{instance name: (bins hit, bins, ignore bins)} as pyucis reads the file."""
+    db = XmlFactory.read(str(path))
+    out = {}
+    for inst in db.scopes(ScopeTypeT.INSTANCE):
+        hit = total = ignored = 0
+        for cg in inst.scopes(ScopeTypeT.COVERGROUP):
+            for cgi in cg.scopes(ScopeTypeT.COVERINSTANCE):
+                for cp in cgi.scopes(ScopeTypeT.COVERPOINT):
+                    for ci in cp.coverItems(CoverTypeT.CVGBIN):
+                        total += 1
+                        hit += ci.getCoverData().data > 0
+                    for ci in cp.coverItems(CoverTypeT.IGNOREBIN):
+                        ignored += 1
+        out[inst.getScopeName()] = (hit, total, ignored)
+    return out
+
+
+def test_pyucis_reads_every_model_of_a_verify_run(tmp_path):
+    """`verify --cover` measures one model per unit, format and slab variant; `cover --ucis`
+    writes one UCIS instance per model, and pyucis reads each with raypipe's totals."""
+    e = exe()
+    f = tmp_path / "verify.json"
+    subprocess.run([e, "verify", "--rays", "16", "--format", "fp16,q8.24", "--quiet", "--cover", str(f)],
+                   check=True, capture_output=True)
+    xml = tmp_path / "cov.xml"
+    p = subprocess.run([e, "cover", str(f), "--ucis", str(xml), "--json"], check=True, capture_output=True,
+                       text=True)
+    j = json.loads(p.stdout)
+    models = j["models"]
+    assert len(models) >= 4 and {m["unit"] for m in models} == {"rti", "slab"}
+    got = ucis_instances(xml)
+    assert len(got) == len(models)
+    for m in models:
+        name = "raypipe_%s_%s" % (m["unit"], m["format"].replace(".", "_").replace(":", "_"))
+        if m["variant"]:
+            name += "_" + m["variant"].replace("-", "_")
+        assert got[name] == (m["bins_hit"], m["bins"], m["bins_unreachable"]), name
+        assert 0 < m["bins_hit"] <= m["bins"]
+
+
 def _fp16(bits):
     """An fp16 encoding's exact value (a Fraction), ('inf', sign), or None for a NaN."""
     from fractions import Fraction as F

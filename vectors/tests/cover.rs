@@ -2,28 +2,17 @@
 //! model marks unreachable is ever hit by the default sets, and the op unit's default sets
 //! reach every reachable bin.
 
-use datapath::rti::RtiConfig;
 use vectors::cover::Coverage;
 use vectors::gen::{generate, Request, Unit};
 use vectors::read::set_rows;
 
 fn req(unit: Unit, format: &str) -> Request {
-    Request {
-        unit,
-        format: format.parse().unwrap(),
-        count: 4,
-        seed: 3,
-        level: 1,
-        command: "test".into(),
-        rti: RtiConfig::default(),
-        slab_variant: if format.contains("ftz") || format.starts_with('q') { "plain" } else { "conservative" }.into(),
-        tree: None,
-        leaves: 8,
-        max_levels: 64,
-        explicit: None,
-        closure: None,
-        threads: 1,
-    }
+    let mut r = Request::new(unit, format.parse().unwrap());
+    r.count = 4;
+    r.seed = 3;
+    r.command = "test".into();
+    r.slab_variant = if format.contains("ftz") || format.starts_with('q') { "plain" } else { "conservative" }.into();
+    r
 }
 
 #[test]
@@ -267,4 +256,60 @@ fn streaming_a_set_from_disk_equals_measuring_it_in_memory() {
         assert!(Coverage::measure_dir(&dir, &m).unwrap_err().contains("sha256"), "{unit:?}");
     }
     let _ = std::fs::remove_dir_all(&tmp);
+}
+
+/// Merging: another slab variant (same unit, format and shape of bins) is refused by its
+/// options; a closed set merges with an unclosed one, the class bins by name; a coverage file
+/// holds several models and reads back equal, and a version-1 file (one model) still reads.
+#[test]
+fn options_classes_and_coverage_files() {
+    let plain = generate(&Request { slab_variant: "plain".into(), ..req(Unit::Slab, "fp16") }).unwrap();
+    let tof = generate(&Request { slab_variant: "take-on-false".into(), ..req(Unit::Slab, "fp16") }).unwrap();
+    let cp = Coverage::measure(&plain.manifest, &set_rows(&plain).unwrap()).unwrap();
+    let ct = Coverage::measure(&tof.manifest, &set_rows(&tof).unwrap()).unwrap();
+    let err = cp.clone().merge(&ct).unwrap_err();
+    assert!(err.contains("variant"), "{err}");
+    // closed and unclosed: the sum has the class `close` with the closed set's count
+    let open = generate(&req(Unit::Rti, "fp16")).unwrap();
+    let row = vec![
+        0x3d00, 0, 0, 0, 0, 0x3c00, 0, 0x7c00, 0x3bff, 0xbc00, 0x3800, 0x3c00, 0x3c00, 0x4000, 0x3e00, 0xbc00, 0x4200,
+    ];
+    let ex = vectors::gen::Explicit { rows: vec![row], ..explicit_close() };
+    let closed = generate(&Request { closure: Some(ex), ..req(Unit::Rti, "fp16") }).unwrap();
+    let co = Coverage::measure(&open.manifest, &set_rows(&open).unwrap()).unwrap();
+    let cc = Coverage::measure(&closed.manifest, &set_rows(&closed).unwrap()).unwrap();
+    let mut sum = co.clone();
+    sum.merge(&cc).unwrap();
+    let class = |c: &Coverage, name: &str| {
+        let p = c.coverpoints.iter().find(|p| p.kind == "class").unwrap();
+        p.bins.iter().find(|b| b.name == name).map(|b| b.count)
+    };
+    assert_eq!(class(&co, "close"), None);
+    assert_eq!(class(&sum, "close"), class(&cc, "close"));
+    assert_eq!(class(&cc, "close"), Some(1));
+    assert_eq!(class(&sum, "random"), Some(class(&co, "random").unwrap() + class(&cc, "random").unwrap()));
+    assert_eq!(sum.vectors, co.vectors + cc.vectors);
+    // a file of two models reads back equal
+    let text = vectors::cover_file::write(
+        &[(plain.manifest.clone(), cp.clone()), (open.manifest.clone(), co.clone())],
+        "test",
+    );
+    let back = vectors::cover_file::read(&text).unwrap();
+    assert_eq!(back.len(), 2);
+    assert_eq!((back[0].1.clone(), back[1].1.clone()), (cp.clone(), co.clone()));
+    // version 1: manifest, vectors and counts at the top level
+    let mut j: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let one = j["models"][1].take();
+    let v1 = serde_json::json!({"kind": "raypipe coverage", "version": 1, "command": "t",
+        "manifest": one["manifest"], "vectors": one["vectors"], "counts": one["counts"]});
+    let back = vectors::cover_file::read(&v1.to_string()).unwrap();
+    assert_eq!(back.len(), 1);
+    assert_eq!(back[0].1, co);
+    // counts that do not fit the manifest's model, an unknown version: errors
+    let mut bad = v1.clone();
+    bad["counts"][0] = serde_json::json!([1]);
+    assert!(vectors::cover_file::read(&bad.to_string()).is_err());
+    bad = v1;
+    bad["version"] = 3.into();
+    assert!(vectors::cover_file::read(&bad.to_string()).is_err());
 }
