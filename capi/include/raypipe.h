@@ -30,6 +30,9 @@
 // An internal error (a bug in raypipe) caught at the boundary; the message says where.
 #define RP_ERR_INTERNAL 6
 
+// A coverage recorder (opaque; rows may be added from several threads).
+typedef struct RpCover RpCover;
+
 // A unit handle: one model in one format with its options (opaque; immutable, so it may be
 // shared by threads).
 typedef struct RpUnit RpUnit;
@@ -193,6 +196,45 @@ int32_t rp_eval_batch(const struct RpUnit *u,
                       size_t n_inputs,
                       uint64_t *outputs,
                       size_t n_outputs);
+
+// Creates a coverage recorder into `*out` for the unit `unit` ("rti", "slab" or "op") in
+// `format` with `options` (as [`rp_unit_new`]; the directed slab variant has no coverage
+// model): [`rp_cover_add`] counts each row a testbench drives into its DUT, [`rp_cover_write`]
+// writes the coverage file `raypipe cover` reads and merges (docs/coverage.md). Free it with
+// [`rp_cover_free`].
+//
+// # Safety
+// As [`rp_unit_new`].
+int32_t rp_cover_new(const char *unit,
+                     const char *format,
+                     const char *options,
+                     struct RpCover **out);
+
+// Counts one input row (`n_inputs` = the unit's [`rp_unit_inputs`] values, the row as
+// [`rp_eval`] takes it) into the recorder.
+//
+// # Safety
+// `c` is null or a recorder not yet freed; `inputs` null or `n_inputs` readable values.
+int32_t rp_cover_add(const struct RpCover *c, const uint64_t *inputs, size_t n_inputs);
+
+// Rows the recorder counted (0 for a null pointer).
+//
+// # Safety
+// `c` is null or a recorder not yet freed.
+uint64_t rp_cover_rows(const struct RpCover *c);
+
+// Writes the recorder's coverage to the file `path` (atomically; a file there that raypipe
+// did not write is never replaced: `RP_ERR_ARGUMENT`). May be called again (the counts so far).
+//
+// # Safety
+// `c` is null or a recorder not yet freed; `path` a NUL-terminated string or null.
+int32_t rp_cover_write(const struct RpCover *c, const char *path);
+
+// Frees a recorder (null: nothing happens); its counts are lost unless written first.
+//
+// # Safety
+// `c` is null or a recorder not yet freed; it is not used afterwards.
+void rp_cover_free(struct RpCover *c);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -16,6 +16,7 @@ use std::cell::RefCell;
 use std::ffi::{c_char, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
+pub mod cover;
 pub mod unit;
 
 /// The call succeeded.
@@ -37,6 +38,9 @@ pub const RP_ERR_INTERNAL: i32 = 6;
 /// A unit handle: one model in one format with its options (opaque; immutable, so it may be
 /// shared by threads).
 pub struct RpUnit(unit::Unit);
+
+/// A coverage recorder (opaque; rows may be added from several threads).
+pub struct RpCover(cover::Recorder);
 
 thread_local! {
     /// This thread's last error message.
@@ -475,4 +479,96 @@ pub unsafe extern "C" fn rp_eval_batch(
         let out = unsafe { slice_mut(outputs, want_out, "outputs")? };
         h.batch(input, out).map_err(arg)
     })
+}
+
+/// Creates a coverage recorder into `*out` for the unit `unit` ("rti", "slab" or "op") in
+/// `format` with `options` (as [`rp_unit_new`]; the directed slab variant has no coverage
+/// model): [`rp_cover_add`] counts each row a testbench drives into its DUT, [`rp_cover_write`]
+/// writes the coverage file `raypipe cover` reads and merges (docs/coverage.md). Free it with
+/// [`rp_cover_free`].
+///
+/// # Safety
+/// As [`rp_unit_new`].
+#[no_mangle]
+pub unsafe extern "C" fn rp_cover_new(
+    unit: *const c_char,
+    format: *const c_char,
+    options: *const c_char,
+    out: *mut *mut RpCover,
+) -> i32 {
+    guard(|| {
+        if out.is_null() {
+            return Err(Fail(RP_ERR_NULL, "out is a null pointer".into()));
+        }
+        // SAFETY: the caller's promise (null is checked)
+        let (u, f) = unsafe { (text(unit, "unit")?, text(format, "format")?) };
+        let o = if options.is_null() { "" } else { unsafe { text(options, "options")? } };
+        let r = cover::Recorder::new(u, f, o).map_err(arg)?;
+        // SAFETY: out is non-null and writable (the caller's promise)
+        unsafe { *out = Box::into_raw(Box::new(RpCover(r))) };
+        Ok(())
+    })
+}
+
+/// Counts one input row (`n_inputs` = the unit's [`rp_unit_inputs`] values, the row as
+/// [`rp_eval`] takes it) into the recorder.
+///
+/// # Safety
+/// `c` is null or a recorder not yet freed; `inputs` null or `n_inputs` readable values.
+#[no_mangle]
+pub unsafe extern "C" fn rp_cover_add(c: *const RpCover, inputs: *const u64, n_inputs: usize) -> i32 {
+    guard(|| {
+        if c.is_null() {
+            return Err(Fail(RP_ERR_NULL, "the recorder is a null pointer".into()));
+        }
+        // SAFETY: a live recorder; n_inputs readable values (the caller's promise)
+        let r = unsafe { &(*c).0 };
+        if n_inputs != r.inputs() {
+            return Err(Fail(RP_ERR_LENGTH, format!("{n_inputs} inputs for a unit that takes {}", r.inputs())));
+        }
+        let row = unsafe { slice(inputs, n_inputs, "inputs")? };
+        r.add(row).map_err(arg)
+    })
+}
+
+/// Rows the recorder counted (0 for a null pointer).
+///
+/// # Safety
+/// `c` is null or a recorder not yet freed.
+#[no_mangle]
+pub unsafe extern "C" fn rp_cover_rows(c: *const RpCover) -> u64 {
+    if c.is_null() {
+        return 0;
+    }
+    // SAFETY: a live recorder (the caller's promise)
+    unsafe { &(*c).0 }.rows()
+}
+
+/// Writes the recorder's coverage to the file `path` (atomically; a file there that raypipe
+/// did not write is never replaced: `RP_ERR_ARGUMENT`). May be called again (the counts so far).
+///
+/// # Safety
+/// `c` is null or a recorder not yet freed; `path` a NUL-terminated string or null.
+#[no_mangle]
+pub unsafe extern "C" fn rp_cover_write(c: *const RpCover, path: *const c_char) -> i32 {
+    guard(|| {
+        if c.is_null() {
+            return Err(Fail(RP_ERR_NULL, "the recorder is a null pointer".into()));
+        }
+        // SAFETY: the caller's promise
+        let (r, p) = unsafe { (&(*c).0, text(path, "path")?) };
+        r.write(std::path::Path::new(p)).map_err(arg)
+    })
+}
+
+/// Frees a recorder (null: nothing happens); its counts are lost unless written first.
+///
+/// # Safety
+/// `c` is null or a recorder not yet freed; it is not used afterwards.
+#[no_mangle]
+pub unsafe extern "C" fn rp_cover_free(c: *mut RpCover) {
+    if !c.is_null() {
+        // SAFETY: a recorder from rp_cover_new (the caller's promise)
+        drop(unsafe { Box::from_raw(c) });
+    }
 }

@@ -305,6 +305,9 @@ pub struct Unit {
     pub output_widths: Vec<u32>,
     /// Each output's name (the expected file's field names).
     pub output_names: Vec<String>,
+    /// The vector sets of this unit, format and options (`None`: the traverse unit, whose
+    /// sets depend on a tree): what defines its coverage model.
+    pub request: Option<vectors::gen::Request>,
     /// The format's conversions.
     codec: Box<dyn Codec>,
     eval: Box<dyn Eval>,
@@ -401,6 +404,16 @@ impl Unit {
             _ => (vec![width, 1], &["result", "cmp"]),
         };
         let output_names = names.iter().map(|n| n.to_string()).collect();
+        let mut request = vectors::gen::Request::new(
+            match kind {
+                Kind::Rti => vectors::gen::Unit::Rti,
+                Kind::Slab => vectors::gen::Unit::Slab,
+                _ => vectors::gen::Unit::Op,
+            },
+            any,
+        );
+        request.rti = cfg;
+        request.slab_variant = o.variant.clone().unwrap_or_else(|| "plain".into());
         let mut u = Unit {
             kind,
             format: name,
@@ -411,6 +424,7 @@ impl Unit {
             has_stages,
             output_widths,
             output_names,
+            request: Some(request),
             codec: with_format!(any, |f| Box::new(f) as Box<dyn Codec>),
             eval,
         };
@@ -502,6 +516,7 @@ impl Unit {
             has_stages: false,
             output_widths,
             output_names,
+            request: None,
             codec: with_format!(any, |f| Box::new(f) as Box<dyn Codec>),
             eval,
         };
