@@ -3,7 +3,7 @@
 through cocotb 2's Python runner:
 
     python3 hdl/cocotb/run.py [--unit rti|slab] [--format F] [--options "O"] [--n N] [--seed S]
-                              [--define NAME]...
+                              [--define NAME]... [--cover FILE]
 
 or hdl/cocotb/test_axis.py on a DUT with AXI4-Stream ports (cocotbext-axi's AxiStreamSource and
 AxiStreamSink, valid/ready on both sides, seeded output stalls, results in order or by tid):
@@ -15,7 +15,8 @@ AxiStreamSink, valid/ready on both sides, seeded output stalls, results in order
 --hardfloat is --axis raypipe_<unit>_hf_axis with the HardFloat datapath's sources
 (hdl/hardfloat/sources.txt) and its latency. --axis-map: the tdata layout of your DUT (an edited
 axis_map.json; default: the documented default map). --no-probes: your DUT has no m_axis_tuser
-(outputs only).
+(outputs only). --cover FILE: record the functional coverage of the rows driven into the DUT
+(raypipe.Cover) and write it to FILE for `raypipe cover` (docs/coverage.md).
 
 Needs `pip install cocotb ./python` and Icarus Verilog 11+. Writes the format's set (`raypipe
 vectors --count 1`, for its package and manifest) and prints the testbench's `N passed, M
@@ -53,6 +54,7 @@ def main():
     ap.add_argument("--ids", type=int, default=0, help="tid width: results matched by id, in any order")
     ap.add_argument("--no-probes", action="store_true", help="the DUT has no m_axis_tuser stage probes")
     ap.add_argument("--axis-map", help="your tdata layout (an edited axis_map.json)")
+    ap.add_argument("--cover", help="record the driven rows' functional coverage in this file (docs/coverage.md)")
     a = ap.parse_args()
     if a.hardfloat and a.axis:
         ap.error("--hardfloat names the DUT; drop --axis")
@@ -63,6 +65,11 @@ def main():
     if a.axis and not a.rtl:
         ap.error("--axis needs your DUT's sources (--rtl FILE)")
     axis = a.axis or (f"raypipe_{a.unit}_hf_axis" if a.hardfloat else None)
+    if a.cover and os.path.exists(a.cover):
+        # before the work: a file raypipe did not write is never replaced
+        with open(a.cover, errors="replace") as f:
+            if "raypipe coverage" not in f.read(4096):
+                ap.error(f"--cover {a.cover} exists and raypipe did not write it: not replacing it")
     exe = os.environ.get("RAYPIPE") or os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target")), "release", "raypipe")
     with tempfile.TemporaryDirectory() as work:
         set_dir = os.path.join(work, "set")
@@ -102,6 +109,7 @@ def main():
         env = {"RAYPIPE_SET": set_dir, "RAYPIPE_OPTIONS": a.options, "RAYPIPE_N": str(a.n), "RAYPIPE_SEED": str(a.seed),
                "RAYPIPE_STALL": str(a.stall), "RAYPIPE_IDS": str(a.ids), "RAYPIPE_LATENCY": str(latency),
                "RAYPIPE_PROBES": "0" if a.no_probes else "1",
+               "RAYPIPE_COVER": os.path.abspath(a.cover) if a.cover else "",
                "PYTHONPATH": os.pathsep.join([here] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])}
         # everything the run writes (results.xml, the simulator's files) stays in the temporary directory
         results = runner.test(hdl_toplevel=top, test_module=test_module, test_dir=work,

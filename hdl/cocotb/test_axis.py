@@ -61,6 +61,9 @@ async def axis_vectors(dut):
     probes = os.environ.get("RAYPIPE_PROBES", "1") == "1"
     lat = int(os.environ.get("RAYPIPE_LATENCY") or manifest["latency"])
     model = raypipe.Unit(manifest["unit"], manifest["format"], os.environ.get("RAYPIPE_OPTIONS", ""))
+    # RAYPIPE_COVER: record the driven rows' functional coverage there (docs/coverage.md)
+    cover_path = os.environ.get("RAYPIPE_COVER", "")
+    cover = raypipe.Cover(manifest["unit"], manifest["format"], os.environ.get("RAYPIPE_OPTIONS", "")) if cover_path else None
     in_f, out_f, stg_f = fields(manifest, "_inputs.hex"), fields(manifest, "_expected.hex"), fields(manifest, "_stages.hex")
     stg_w = [f["width"] for f in stg_f]
     in_names = [f["name"] for f in in_f if f["name"] != "class"]
@@ -170,6 +173,8 @@ async def axis_vectors(dut):
     for k in range(n):
         row, kind = stim.vector()
         r = model.eval(row, stages=True)
+        if cover:
+            cover.add(row)
         want[k] = (kind, [r[x] for x in model.outputs], list(r["stages"].values()))
         while idn and len(outstanding) >= idn and not state["done"]:
             await RisingEdge(dut.aclk)
@@ -194,5 +199,8 @@ async def axis_vectors(dut):
         print(f"out of order: ids of {ids} bits; at most {state['reorder']} earlier vector(s) still waiting when one came out",
               flush=True)
     print(f"{state['passed']} passed, {state['failed']} failed", flush=True)
+    if cover:
+        cover.write(cover_path)
+        print(f"coverage: {cover.rows} driven rows recorded in {cover_path} (raypipe cover {cover_path})", flush=True)
     assert state["proto"] == 0, f"{state['proto']} protocol violations"
     assert state["failed"] == 0, f"{state['failed']} of {n} vectors failed"

@@ -28,6 +28,9 @@ async def random_vectors(dut):
     n = int(os.environ.get("RAYPIPE_N", "1000"))
     seed = int(os.environ.get("RAYPIPE_SEED", "1"))
     model = raypipe.Unit(manifest["unit"], manifest["format"], os.environ.get("RAYPIPE_OPTIONS", ""))
+    # RAYPIPE_COVER: record the driven rows' functional coverage there (docs/coverage.md)
+    cover_path = os.environ.get("RAYPIPE_COVER", "")
+    cover = raypipe.Cover(manifest["unit"], manifest["format"], os.environ.get("RAYPIPE_OPTIONS", "")) if cover_path else None
     in_f, out_f, stg_f = fields(manifest, "_inputs.hex"), fields(manifest, "_expected.hex"), fields(manifest, "_stages.hex")
     in_w, out_w, stg_w = [f["width"] for f in in_f], [f["width"] for f in out_f], [f["width"] for f in stg_f]
     assert [f["name"] for f in stg_f] == model.stage_names, "the model's stage signals are not the set's"
@@ -77,6 +80,8 @@ async def random_vectors(dut):
     for _ in range(n):
         row, kind = stim.vector()
         r = model.eval(row, stages=True)
+        if cover:
+            cover.add(row)
         dut.in_row.value = pack([0] + row, in_w)
         dut.in_valid.value = 1
         # captured at the next rising edge, out LATENCY edges later
@@ -89,4 +94,7 @@ async def random_vectors(dut):
         results["failed"] += len(pending)
         dut._log.error(f"FAIL: {len(pending)} vectors never came out")
     print(f"{results['passed']} passed, {results['failed']} failed", flush=True)
+    if cover:
+        cover.write(cover_path)
+        print(f"coverage: {cover.rows} driven rows recorded in {cover_path} (raypipe cover {cover_path})", flush=True)
     assert results["failed"] == 0, f"{results['failed']} of {n} vectors failed"

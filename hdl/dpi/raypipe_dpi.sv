@@ -36,6 +36,16 @@ package raypipe_dpi;
                                       input longint unsigned n_inputs, output longint unsigned outputs[RP_MAX_OUT],
                                       input longint unsigned n_outputs, output longint unsigned stages[RP_MAX_STG],
                                       input longint unsigned n_stages);
+  // functional coverage of the driven rows (docs/coverage.md): a recorder of the unit, format and
+  // options; each input row counted with the model's outputs and stage signals; written as a
+  // coverage file `raypipe cover` reads and merges
+  import "DPI-C" function int rp_cover_new(input string unit, input string format, input string options,
+                                           output chandle c);
+  import "DPI-C" function int rp_cover_add(input chandle c, input longint unsigned inputs[RP_MAX_IN],
+                                           input longint unsigned n_inputs);
+  import "DPI-C" function longint unsigned rp_cover_rows(input chandle c);
+  import "DPI-C" function int rp_cover_write(input chandle c, input string path);
+  import "DPI-C" function void rp_cover_free(input chandle c);
   // the format's encoding of a real (to nearest, ties to even), and back
   import "DPI-C" function int rp_encode(input chandle u, input real x, output longint unsigned bits);
   import "DPI-C" function int rp_decode(input chandle u, input longint unsigned bits, output real x);

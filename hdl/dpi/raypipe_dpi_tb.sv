@@ -177,6 +177,7 @@ module raypipe_dpi_tb;
     logic [STG_W-1:0] rs;
     int pos;
     if (rp_eval(u, v, longint'(NI), out, no, stg, ns) != RP_OK) $fatal(1, "rp_eval: %s", rp_last_error());
+    if (cov != null && rp_cover_add(cov, v, longint'(NI)) != RP_OK) $fatal(1, "rp_cover_add: %s", rp_last_error());
     ro = '0;
     pos = OUT_W;
     for (int i = 0; i < int'(no); i++)
@@ -196,6 +197,10 @@ module raypipe_dpi_tb;
     kind_of.push_back(kind);
   endtask
 
+  // +cover=FILE: the driven rows' functional coverage, written to FILE at the end
+  chandle cov = null;
+  string cover_path;
+
   initial begin
     string fmt, opts, o;
     int n = 2000, seed = 1, rc, bits;
@@ -211,6 +216,10 @@ module raypipe_dpi_tb;
     void'($urandom(seed));
     rc = rp_unit_new(UNIT, fmt, opts, u);
     if (rc != RP_OK) $fatal(1, "rp_unit_new(%s, %s, \"%s\") = %0d: %s", UNIT, fmt, opts, rc, rp_last_error());
+    if ($value$plusargs("cover=%s", cover_path)) begin
+      rc = rp_cover_new(UNIT, fmt, opts, cov);
+      if (rc != RP_OK) $fatal(1, "rp_cover_new(%s, %s, \"%s\") = %0d: %s", UNIT, fmt, opts, rc, rp_last_error());
+    end
     if (rp_unit_width(u) != W || rp_unit_inputs(u) != longint'(NI))
       $fatal(1, "the live model (%s, %0d bits, %0d inputs) is not the package's format (%0d bits, %0d inputs)", fmt,
              rp_unit_width(u), rp_unit_inputs(u), W, NI);
@@ -284,6 +293,11 @@ module raypipe_dpi_tb;
     end
 `endif
     $display("%0d passed, %0d failed", passed, failed);
+    if (cov != null) begin
+      if (rp_cover_write(cov, cover_path) != RP_OK) $fatal(1, "rp_cover_write(%s): %s", cover_path, rp_last_error());
+      $display("coverage: %0d driven rows recorded in %s (raypipe cover %s)", rp_cover_rows(cov), cover_path, cover_path);
+      rp_cover_free(cov);
+    end
     rp_unit_free(u);
     if (failed > 0) $fatal(1, "raypipe_dpi_tb: %0d of %0d vectors failed", failed, n);
     $finish;

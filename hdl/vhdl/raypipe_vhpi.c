@@ -13,6 +13,7 @@
 
 #define MAX_UNITS 64
 static RpUnit *units[MAX_UNITS];
+static RpCover *covers[MAX_UNITS];
 
 static void name(char *dst, const char *src) {
     memcpy(dst, src, 64);
@@ -96,4 +97,60 @@ void rp_vhpi_eval(int32_t h, const int32_t *in, int32_t *out, int32_t *stg, int3
     for (size_t k = 0; k < no; k++) out[k] = (int32_t)(uint32_t)o64[k];
     for (size_t k = 0; k < ns; k++) stg[k] = (int32_t)(uint32_t)s64[k];
     *rc = 0;
+}
+
+/* a coverage recorder of the unit u, format f, options o (docs/coverage.md): its handle, or
+ * a negative code */
+int32_t rp_vhpi_cover_new(const char *u, const char *f, const char *o) {
+    char un[65], fm[65], op[65];
+    name(un, u);
+    name(fm, f);
+    name(op, o);
+    for (int32_t c = 0; c < MAX_UNITS; c++) {
+        if (covers[c] != NULL) continue;
+        int rc = rp_cover_new(un, fm, op, &covers[c]);
+        if (rc != RP_OK) {
+            fprintf(stderr, "rp_cover_new(%s, %s, \"%s\") = %d: %s\n", un, fm, op, rc, rp_last_error());
+            return -rc;
+        }
+        return c;
+    }
+    fprintf(stderr, "rp_vhpi_cover_new: more than %d recorders\n", MAX_UNITS);
+    return -RP_ERR_ARGUMENT;
+}
+
+/* counts the input row in[0 .. inputs of unit h - 1] into recorder c; *rc 0 or -code */
+void rp_vhpi_cover_add(int32_t c, int32_t h, const int32_t *in, int32_t *rc) {
+    RpUnit *u = unit(h);
+    RpCover *r = c >= 0 && c < MAX_UNITS ? covers[c] : NULL;
+    uint64_t i64[64];
+    size_t ni = rp_unit_inputs(u);
+    uint32_t w = rp_unit_width(u);
+    uint64_t mask = w >= 64 ? ~0ull : (1ull << w) - 1;
+    if (ni > 64) {
+        *rc = -RP_ERR_LENGTH;
+        return;
+    }
+    for (size_t k = 0; k < ni; k++) i64[k] = (uint64_t)(uint32_t)in[k] & mask;
+    int e = rp_cover_add(r, i64, ni);
+    if (e != RP_OK) fprintf(stderr, "rp_cover_add: %s\n", rp_last_error());
+    *rc = -e;
+}
+
+/* writes recorder c's coverage file to the path p (NUL-padded string(1 to 256)) and frees the
+ * recorder; the rows recorded, or a negative code */
+int32_t rp_vhpi_cover_write(int32_t c, const char *p) {
+    char path[257];
+    RpCover *r = c >= 0 && c < MAX_UNITS ? covers[c] : NULL;
+    memcpy(path, p, 256);
+    path[256] = '\0';
+    int e = rp_cover_write(r, path);
+    if (e != RP_OK) {
+        fprintf(stderr, "rp_cover_write(%s): %s\n", path, rp_last_error());
+        return -e;
+    }
+    int32_t rows = (int32_t)rp_cover_rows(r);
+    rp_cover_free(r);
+    covers[c] = NULL;
+    return rows;
 }

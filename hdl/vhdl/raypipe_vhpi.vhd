@@ -27,8 +27,22 @@ package raypipe_vhpi is
   procedure rp_vhpi_eval(h : integer; i : rp_in_t; o : out rp_out_t; s : out rp_stg_t; rc : out integer);
   attribute foreign of rp_vhpi_eval : procedure is "VHPIDIRECT RAYPIPE_VHPI_LIB rp_vhpi_eval";
 
+  -- functional coverage of the driven rows (docs/coverage.md): a recorder of the unit, format
+  -- and options (its handle, or a negative code); each input row of unit h counted (rc 0 or a
+  -- negative code); the coverage file written to a path (NUL-padded) and the recorder freed
+  -- (the rows recorded, or a negative code)
+  subtype rp_path_t is string(1 to 256);
+  function rp_vhpi_cover_new(u, f, o : rp_name_t) return integer;
+  attribute foreign of rp_vhpi_cover_new : function is "VHPIDIRECT RAYPIPE_VHPI_LIB rp_vhpi_cover_new";
+  procedure rp_vhpi_cover_add(c, h : integer; i : rp_in_t; rc : out integer);
+  attribute foreign of rp_vhpi_cover_add : procedure is "VHPIDIRECT RAYPIPE_VHPI_LIB rp_vhpi_cover_add";
+  function rp_vhpi_cover_write(c : integer; p : rp_path_t) return integer;
+  attribute foreign of rp_vhpi_cover_write : function is "VHPIDIRECT RAYPIPE_VHPI_LIB rp_vhpi_cover_write";
+
   -- s padded with NULs to an rp_name_t
   function rp_name(s : string) return rp_name_t;
+  -- s padded with NULs to an rp_path_t
+  function rp_path(s : string) return rp_path_t;
 end package;
 
 package body raypipe_vhpi is
@@ -61,6 +75,28 @@ package body raypipe_vhpi is
   begin
     assert false report "raypipe_vhpi: the foreign library is not loaded" severity failure;
   end procedure;
+  function rp_vhpi_cover_new(u, f, o : rp_name_t) return integer is
+  begin
+    assert false report "raypipe_vhpi: the foreign library is not loaded" severity failure;
+    return -1;
+  end function;
+  procedure rp_vhpi_cover_add(c, h : integer; i : rp_in_t; rc : out integer) is
+  begin
+    assert false report "raypipe_vhpi: the foreign library is not loaded" severity failure;
+  end procedure;
+  function rp_vhpi_cover_write(c : integer; p : rp_path_t) return integer is
+  begin
+    assert false report "raypipe_vhpi: the foreign library is not loaded" severity failure;
+    return -1;
+  end function;
+  function rp_path(s : string) return rp_path_t is
+    variable r : rp_path_t := (others => character'val(0));
+  begin
+    for k in 1 to s'length loop
+      r(k) := s(s'low + k - 1);
+    end loop;
+    return r;
+  end function;
   function rp_name(s : string) return rp_name_t is
     variable r : rp_name_t := (others => character'val(0));
   begin

@@ -28,7 +28,9 @@ entity raypipe_vhpi_tb is
     SEED    : positive := 1;
     HANDSHAKE : boolean := false;
     STALL   : natural := 0;
-    DROP    : boolean := false
+    DROP    : boolean := false;
+    -- a path: record the driven rows' functional coverage there (docs/coverage.md)
+    COVER_FILE : string := ""
   );
 end entity;
 
@@ -67,6 +69,7 @@ begin
 
   main : process
     variable h, rc, pos, k, sent, got, passed, failed, cycle : integer := 0;
+    variable cov : integer := -1;
     variable vin : rp_in_t := (others => 0);
     variable vout : rp_out_t;
     variable vstg : rp_stg_t;
@@ -149,6 +152,10 @@ begin
       end if;
       rp_vhpi_eval(h, vin, vout, vstg, rc);
       assert rc = 0 report "rp_vhpi_eval failed (see stderr)" severity failure;
+      if cov >= 0 then
+        rp_vhpi_cover_add(cov, h, vin, rc);
+        assert rc = 0 report "rp_vhpi_cover_add failed (see stderr)" severity failure;
+      end if;
       pos := SLAB_EXPECTED_W;
       for i in 0 to rp_vhpi_count(h, 1) - 1 loop
         word := std_logic_vector(to_signed(vout(i), 32));
@@ -180,6 +187,10 @@ begin
   begin
     h := rp_vhpi_new(rp_name("slab"), rp_name(FORMAT), rp_name(OPTIONS));
     assert h >= 0 report "rp_vhpi_new failed (see stderr)" severity failure;
+    if COVER_FILE'length > 0 then
+      cov := rp_vhpi_cover_new(rp_name("slab"), rp_name(FORMAT), rp_name(OPTIONS));
+      assert cov >= 0 report "rp_vhpi_cover_new failed (see stderr)" severity failure;
+    end if;
     assert rp_vhpi_count(h, 3) = W and rp_vhpi_count(h, 0) = 14
       report "the live model is not the package's format" severity failure;
     bits := 0;
@@ -310,6 +321,12 @@ begin
       fail(integer'image(N - got) & " vectors never came out");
     end if;
     report integer'image(passed) & " passed, " & integer'image(failed) & " failed" severity note;
+    if cov >= 0 then
+      rc := rp_vhpi_cover_write(cov, rp_path(COVER_FILE));
+      assert rc >= 0 report "rp_vhpi_cover_write failed (see stderr)" severity failure;
+      report "coverage: " & integer'image(rc) & " driven rows recorded in " & COVER_FILE & " (raypipe cover " & COVER_FILE & ")"
+        severity note;
+    end if;
     done <= true;
     assert failed = 0 report "raypipe_vhpi_tb: " & integer'image(failed) & " vectors failed" severity failure;
     wait;

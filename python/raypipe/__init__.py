@@ -8,8 +8,10 @@ Python and cocotb testbenches.
 
 Rows are the vector files' rows: encodings in uint64 (flags 0 or 1). `Unit.eval_batch` takes a
 (n, inputs) uint64 array and runs the SIMD kernels with the GIL released.
+
+`Cover` records the functional coverage of the rows a testbench drives (docs/coverage.md).
 """
 
-from ._raypipe import Unit, parse_format, read_set, version
+from ._raypipe import Cover, Unit, parse_format, read_set, version
 
-__all__ = ["Unit", "parse_format", "read_set", "version"]
+__all__ = ["Cover", "Unit", "parse_format", "read_set", "version"]

@@ -285,6 +285,43 @@ fn read_set<'py>(py: Python<'py>, dir: std::path::PathBuf) -> PyResult<Bound<'py
     Ok(d)
 }
 
+/// A functional-coverage recorder of one unit (rti, slab or op), format and options: each row a
+/// testbench drives into its DUT counted into the unit's coverage model (docs/coverage.md), then
+/// written as a coverage file `raypipe cover` reports and merges. Rows may be added from
+/// several threads.
+#[pyclass(frozen, module = "raypipe._raypipe")]
+struct Cover(raypipe_capi::cover::Recorder);
+
+#[pymethods]
+impl Cover {
+    /// `Cover("slab", "fp16", "--variant conservative")`: names and options as `Unit` takes
+    /// them (the traverse unit and the directed slab variant have no coverage model:
+    /// ValueError).
+    #[new]
+    #[pyo3(signature = (unit, format, options = ""))]
+    fn new(unit: &str, format: &str, options: &str) -> PyResult<Self> {
+        Ok(Cover(raypipe_capi::cover::Recorder::new(unit, format, options).map_err(PyValueError::new_err)?))
+    }
+
+    /// Counts one input row (as `Unit.eval` takes it: encodings, no class column); a bad row
+    /// raises ValueError and is not counted.
+    fn add(&self, row: Vec<u64>) -> PyResult<()> {
+        self.0.add(&row).map_err(PyValueError::new_err)
+    }
+
+    /// Rows counted so far.
+    #[getter]
+    fn rows(&self) -> u64 {
+        self.0.rows()
+    }
+
+    /// Writes the coverage file `path` (atomically; a file there raypipe did not write is never
+    /// replaced: OSError).
+    fn write(&self, path: std::path::PathBuf) -> PyResult<()> {
+        self.0.write(&path).map_err(PyIOError::new_err)
+    }
+}
+
 /// raypipe's version.
 #[pyfunction]
 fn version() -> &'static str {
@@ -294,6 +331,7 @@ fn version() -> &'static str {
 #[pymodule]
 fn _raypipe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Unit>()?;
+    m.add_class::<Cover>()?;
     m.add_function(wrap_pyfunction!(parse_format, m)?)?;
     m.add_function(wrap_pyfunction!(read_set, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
