@@ -206,3 +206,44 @@ def test_eval_columns_equals_eval_batch_and_reuses_out():
     f = u.eval_columns(np.asfortranarray(cols))
     assert np.array_equal(f["t"].view(np.uint32), want[:, 2].astype(np.uint32))
     assert np.array_equal(u.eval_batch(np.asfortranarray(rows)), want)
+
+
+@pytest.mark.parametrize("unit,fmt,opts", [("rti", "fp16", []), ("slab", "bf16", ["--variant", "conservative"]), ("op", "f32", [])])
+def test_cover_records_a_sets_rows_as_the_set_measures(unit, fmt, opts):
+    """raypipe.Cover over a written set's input rows: `raypipe cover` of the file equals its
+    coverage of the set, bin for bin, apart from the class bins (the file's hold `live`)."""
+    import json
+    exe = raypipe_binary()
+    if exe is None:
+        pytest.skip("no raypipe binary (cargo build --release, or set RAYPIPE)")
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "set")
+        subprocess.run([exe, "vectors", "--unit", unit, "--format", fmt, *opts, "--count", "3", "--out", out], check=True,
+                       capture_output=True)
+        s = raypipe.read_set(out)
+        ins = s["files"][s["manifest"]["files"][0]["name"]]
+        c = raypipe.Cover(unit, fmt, " ".join(opts))
+        for r in ins:
+            c.add([int(x) for x in r[1:]])
+        assert c.rows == len(ins)
+        path = os.path.join(d, "live.json")
+        c.write(path)
+
+        def cov(p):
+            j = json.loads(subprocess.run([exe, "cover", p, "--json"], check=True, capture_output=True, text=True).stdout)
+            return {(p["role"], p["signal"]): [b["count"] for b in p["bins"]] for p in j["coverpoints"] if p["kind"] != "class"}, j
+
+        live, jl = cov(path)
+        want, jw = cov(out)
+        assert live == want
+        assert jl["vectors"] == jw["vectors"] == len(ins)
+        with pytest.raises(ValueError):
+            c.add([0])
+        with pytest.raises(ValueError):
+            raypipe.Cover("slab", fmt, "--variant directed")
+        mine = os.path.join(d, "mine.json")
+        with open(mine, "w") as f:
+            f.write("mine")
+        with pytest.raises(OSError):
+            c.write(mine)
+        assert open(mine).read() == "mine"
