@@ -942,7 +942,7 @@ fn rounding_event(
         return Some(3);
     }
     let bias = (1i32 << (exp - 1)) - 1;
-    let min_normal = (2f64).powi(1 - bias);
+    let min_normal = pow2(i64::from(1 - bias));
     // the exact result as an unevaluated sum s + e (quotients: the sign of a - r*b instead)
     let (s, e) = match op {
         "add" | "sub" => {
@@ -994,7 +994,7 @@ fn rounding_event(
 /// The format value next to `r` (up: toward +inf), as binary64.
 fn neighbour(r: f64, up: bool, exp: u32, man: u32) -> f64 {
     let bias = (1i32 << (exp - 1)) - 1;
-    let min_sub = (2f64).powi(1 - bias - man as i32);
+    let min_sub = pow2(i64::from(1 - bias - man as i32));
     if r == 0.0 {
         return if up { min_sub } else { -min_sub };
     }
@@ -1002,10 +1002,10 @@ fn neighbour(r: f64, up: bool, exp: u32, man: u32) -> f64 {
     let away = (r > 0.0) == up;
     let a = r.abs();
     let e = ((a.to_bits() >> 52) & 0x7ff) as i32 - 1023; // a is a binary64 normal
-    let step_at = |e: i32| (2f64).powi(e.max(1 - bias) - man as i32);
+    let step_at = |e: i32| pow2(i64::from(e.max(1 - bias) - man as i32));
     let step = if away {
         step_at(e)
-    } else if a == (2f64).powi(e) {
+    } else if a == pow2(i64::from(e)) {
         step_at(e - 1)
     } else {
         step_at(e)
@@ -1107,7 +1107,7 @@ fn cross_class(v: Option<f64>, min_normal: f64) -> usize {
 /// The smallest normal of the set's float format (0 for fixed point).
 fn min_normal(m: &Manifest) -> f64 {
     match (m.params.get("float"), m.params.get("exp")) {
-        (Some(1), Some(&e)) => (2f64).powi(2 - (1i32 << (e - 1))),
+        (Some(1), Some(&e)) => pow2(i64::from(2 - (1i32 << (e - 1)))),
         _ => 0.0,
     }
 }
@@ -1266,9 +1266,7 @@ impl Event {
                 }]
             }
             Event::SlabOrigin(a) => {
-                let (Some(o), Some(lo), Some(hi)) =
-                    (num(&format!("o{}", AXES[a])), num(&format!("min{}", AXES[a])), num(&format!("max{}", AXES[a])))
-                else {
+                let (Some(o), Some(lo), Some(hi)) = (num(["ox", "oy", "oz"][a]), num(MINS[a]), num(MAXS[a])) else {
                     return Vec::new();
                 };
                 let (Some(o), Some(lo), Some(hi)) = (o, lo, hi) else { return vec![5] };
@@ -1285,7 +1283,7 @@ impl Event {
                 }]
             }
             Event::SlabExtent(a) => {
-                let (Some(lo), Some(hi)) = (num(&format!("min{}", AXES[a])), num(&format!("max{}", AXES[a]))) else {
+                let (Some(lo), Some(hi)) = (num(MINS[a]), num(MAXS[a])) else {
                     return Vec::new();
                 };
                 vec![match (lo, hi) {
@@ -1299,19 +1297,16 @@ impl Event {
                 let finite = |x: Option<Option<f64>>| matches!(x, Some(Some(x)) if x.is_finite());
                 let nan = |x: Option<Option<f64>>| matches!(x, Some(None));
                 let mut out = Vec::new();
-                for a in AXES {
-                    let d = num(&format!("pd{a}"));
-                    if finite(d) && d != Some(Some(0.0)) && nan(num(&format!("inv_d{a}"))) {
+                for (pd, inv) in [("pdx", "inv_dx"), ("pdy", "inv_dy"), ("pdz", "inv_dz")] {
+                    let d = num(pd);
+                    if finite(d) && d != Some(Some(0.0)) && nan(num(inv)) {
                         out.push(1);
                         break;
                     }
                 }
-                'sub: for a in AXES {
-                    for (r, b) in [("lo", "min"), ("hi", "max")] {
-                        if finite(num(&format!("{b}{a}")))
-                            && finite(num(&format!("o{a}")))
-                            && nan(num(&format!("{r}{a}")))
-                        {
+                'sub: for a in 0..3 {
+                    for (r, b) in [(["lox", "loy", "loz"][a], MINS[a]), (["hix", "hiy", "hiz"][a], MAXS[a])] {
+                        if finite(num(b)) && finite(num(["ox", "oy", "oz"][a])) && nan(num(r)) {
                             out.push(2);
                             break 'sub;
                         }
@@ -1334,6 +1329,11 @@ impl Event {
         }
     }
 }
+
+/// The box planes' input names per axis.
+const MINS: [&str; 3] = ["minx", "miny", "minz"];
+/// The box planes' input names per axis.
+const MAXS: [&str; 3] = ["maxx", "maxy", "maxz"];
 
 /// The value of encoding `b` in the set's format (a NaN as NaN).
 fn decode(m: &Manifest, b: u64) -> f64 {
@@ -1362,12 +1362,21 @@ fn ieee_value(v: u64, exp: u32, man: u32, ftz: bool) -> Option<f64> {
         if ftz {
             0.0
         } else {
-            f as f64 * (2f64).powi((1 - bias - man as i64) as i32)
+            f as f64 * pow2(1 - bias - man as i64)
         }
     } else {
-        (f as f64 + (1u64 << man) as f64) * (2f64).powi((e as i64 - bias - man as i64) as i32)
+        (f as f64 + (1u64 << man) as f64) * pow2(e as i64 - bias - man as i64)
     };
     Some(if neg { -mag } else { mag })
+}
+
+/// 2^k, exactly (a binary64 normal built from its exponent; `powi` outside that range).
+fn pow2(k: i64) -> f64 {
+    if (-1022..=1023).contains(&k) {
+        f64::from_bits(((k + 1023) as u64) << 52)
+    } else {
+        2f64.powi(k as i32)
+    }
 }
 
 /// A `w`-bit two's-complement encoding as a signed integer (fixed point in steps).
@@ -1408,20 +1417,46 @@ fn field<'a>(m: &'a Manifest, name: &str) -> Option<(usize, &'a Field, usize)> {
 /// Field positions by name, found once per set for the per-row paths ([`field`]'s answers).
 struct Ix<'a> {
     m: &'a Manifest,
-    fields: std::collections::HashMap<&'a str, (usize, &'a Field, usize)>,
+    fields: std::collections::HashMap<&'a str, (usize, &'a Field, usize), Fnv>,
     /// The expected-output file's fields (what a care_when names).
-    outs: std::collections::HashMap<&'a str, usize>,
+    outs: std::collections::HashMap<&'a str, usize, Fnv>,
+}
+
+/// FNV-1a: the field-name lookups of every row hash short names (SipHash's set-up cost would
+/// dominate the count).
+#[derive(Clone, Copy, Default)]
+struct Fnv;
+
+/// [`Fnv`]'s state.
+struct FnvHasher(u64);
+
+impl std::hash::BuildHasher for Fnv {
+    type Hasher = FnvHasher;
+    fn build_hasher(&self) -> FnvHasher {
+        FnvHasher(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl std::hash::Hasher for FnvHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
 }
 
 impl<'a> Ix<'a> {
     fn new(m: &'a Manifest) -> Self {
-        let mut fields = std::collections::HashMap::new();
+        let mut fields = std::collections::HashMap::with_hasher(Fnv);
         for (i, f) in m.files.iter().enumerate().filter(|(i, _)| per_vector(m, *i)) {
             for (k, x) in f.fields.iter().enumerate() {
                 fields.entry(x.name.as_str()).or_insert((i, x, k));
             }
         }
-        let mut outs = std::collections::HashMap::new();
+        let mut outs = std::collections::HashMap::with_hasher(Fnv);
         if let Some(f) = m.files.get(1) {
             for (k, x) in f.fields.iter().enumerate() {
                 outs.entry(x.name.as_str()).or_insert(k);
@@ -1538,7 +1573,7 @@ mod tests {
         }
         let f: datapath::AnyFormat = "e5m6".parse().unwrap();
         datapath::with_format!(f, |f| {
-            let min_normal = (2f64).powi(-14);
+            let min_normal = pow2(i64::from(-14));
             let n = 1u64 << f.width();
             let mut tiny = 0u64;
             for a in 0..n {
