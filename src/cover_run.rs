@@ -78,11 +78,10 @@ impl Default for Rows {
 
 impl Rows {
     /// Counts one RTI test of class `class` (the ray and triangle as the format holds them) into
-    /// `acc` under model `run` (`bins`: its lookup).
+    /// `acc` under model `run` with its lookup `bins`.
     pub fn rti<F: Format>(
         &mut self,
-        run: &RunModel,
-        bins: &RowBins,
+        (run, bins): (&RunModel, &RowBins),
         rti: &Rti<F>,
         class: u64,
         ray: &Ray<F::V>,
@@ -104,11 +103,9 @@ impl Rows {
 
     /// Counts one slab test of class `class` (the ray's inputs as the format holds them and the
     /// stored box) into `acc` under model `run`.
-    #[allow(clippy::too_many_arguments)]
     pub fn slab<F: Format>(
         &mut self,
-        run: &RunModel,
-        bins: &RowBins,
+        (run, bins): (&RunModel, &RowBins),
         slab: &Slab<F>,
         class: u64,
         ray: [F::V; 8],

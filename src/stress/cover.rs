@@ -84,7 +84,7 @@ fn cover_rti<F: Format>(
         let case = rti_case(class, r, &sphere, min_normal, em.max);
         let mray = rti.ray(case.ray.o, case.ray.d, case.ray.tmin, case.ray.tmax);
         for t in &case.tris {
-            rows.rti(&run, &bins, &rti, class as u64, &mray, &rti.tri(t.v), &mut acc.0[0]);
+            rows.rti((&run, &bins), &rti, class as u64, &mray, &rti.tri(t.v), &mut acc.0[0]);
         }
     });
     Ok(crate::cover_run::finish(std::slice::from_ref(&run), acc).remove(0))
@@ -110,7 +110,7 @@ fn cover_slab<F: Format>(
         // as the suite: the box corners as the format holds them, stored
         let (x, lo, hi) = slab_case(class, r, edges);
         let Ok(b) = s.store_box(lo.map(q), hi.map(q)) else { return };
-        rows.slab(&run, &bins, &s, class as u64, x.map(|v| f.from_f64(v)), &b, &mut acc.0[0]);
+        rows.slab((&run, &bins), &s, class as u64, x.map(|v| f.from_f64(v)), &b, &mut acc.0[0]);
     });
     Ok(Some(crate::cover_run::finish(std::slice::from_ref(&run), acc).remove(0)))
 }

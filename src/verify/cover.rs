@@ -91,9 +91,9 @@ where
                 let sray = [ray.o[0], ray.o[1], ray.o[2], ray.d[0], ray.d[1], ray.d[2], ray.tmin, ray.tmax]
                     .map(|x| f.from_f64(x));
                 for &t in list.iter() {
-                    rows.rti(&models[0], &bins[0], &rti, 0, &mray, &tris[t as usize], &mut acc.0[0]);
+                    rows.rti((&models[0], &bins[0]), &rti, 0, &mray, &tris[t as usize], &mut acc.0[0]);
                     for (k, (_, s)) in variants.iter().enumerate() {
-                        rows.slab(&models[k + 1], &bins[k + 1], s, 0, sray, &boxes[t as usize], &mut acc.0[k + 1]);
+                        rows.slab((&models[k + 1], &bins[k + 1]), s, 0, sray, &boxes[t as usize], &mut acc.0[k + 1]);
                     }
                 }
             }
