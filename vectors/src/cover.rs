@@ -1159,6 +1159,13 @@ enum Event {
     SlabGuard,
     /// Capture: a hit whose t equals the held hit's.
     CaptureTie,
+    /// RTI, a valid hit: where its barycentric `u` (0) or `v` (1) is: at 0, at 1, between or
+    /// past (rounding).
+    RtiBary(usize),
+    /// RTI, a valid hit: its `t` at the interval's ends.
+    RtiT,
+    /// Slab, a hit: the entry distance against the exit distance before widening.
+    SlabTouch,
 }
 
 const AXES: [&str; 3] = ["x", "y", "z"];
@@ -1167,11 +1174,14 @@ const AXES: [&str; 3] = ["x", "y", "z"];
 fn events(m: &Manifest) -> Vec<Event> {
     let float = m.params.get("float") == Some(&1);
     match m.unit.as_str() {
-        "rti" if field(m, "det").is_some() => vec![Event::RtiDet],
+        "rti" if field(m, "det").is_some() => vec![Event::RtiDet, Event::RtiBary(0), Event::RtiBary(1), Event::RtiT],
         "slab" => {
             let mut v: Vec<Event> = (0..3).map(Event::SlabOrigin).chain((0..3).map(Event::SlabExtent)).collect();
             if m.params.get("slab_guard") == Some(&1) && float {
                 v.push(Event::SlabGuard);
+            }
+            if field(m, "tn_xyz").is_some() {
+                v.push(Event::SlabTouch);
             }
             v
         }
@@ -1182,6 +1192,12 @@ fn events(m: &Manifest) -> Vec<Event> {
 
 /// Why an event bin of a fixed-point set is never reached.
 pub const WHY_EVENT_FIXED_NAN: &str = "fixed point has no NaN";
+/// Why a hit's t is never outside [tmin, tmax].
+pub const WHY_HIT_T_IN_RANGE: &str =
+    "hit = valid & tmin_ok & tmax_ok, the compares tmin <= t and t <= tmax of the final (divided) t at stage 10: a hit's t is in [tmin, tmax], never NaN";
+/// Why a slab without widening never hits with its entry past its exit.
+pub const WHY_NO_WIDENING: &str =
+    "without widening (slab_widen_ulps 0) t_near = tn_xyz and t_far = tf_xyz, and a hit needs t_near <= t_far";
 /// Why a zero threshold leaves a bin empty.
 pub const WHY_ZERO_THRESHOLD: &str = "the det threshold is 0: no nonzero det is at or below it in magnitude";
 
@@ -1193,6 +1209,9 @@ impl Event {
             Event::SlabExtent(a) => format!("box extent, axis {}", AXES[a]),
             Event::SlabGuard => "conservative guard fired".into(),
             Event::CaptureTie => "a hit's t equals the held hit's t".into(),
+            Event::RtiBary(k) => format!("{} of a valid hit", ["u", "v"][k]),
+            Event::RtiT => "t of a valid hit against tmin and tmax".into(),
+            Event::SlabTouch => "a hit's entry against its exit (tn_xyz vs tf_xyz)".into(),
         }
     }
 
@@ -1217,6 +1236,18 @@ impl Event {
             Event::SlabExtent(_) => &["min < max", "min = max (zero extent)", "min > max (empty)", "NaN"],
             Event::SlabGuard => &["no guard", "reciprocal guarded", "difference guarded"],
             Event::CaptureTie => &["no tie", "tie (the tie rule decides)"],
+            Event::RtiBary(0) => {
+                &["u = 0 (on the edge v0-v2)", "0 < u < 1", "u = 1 (at the vertex v1)", "other (past 1, inf, NaN)"]
+            }
+            Event::RtiBary(_) => {
+                &["v = 0 (on the edge v0-v1)", "0 < v < 1", "v = 1 (at the vertex v2)", "other (past 1, inf, NaN)"]
+            }
+            Event::RtiT => &["t = tmin", "tmin < t < tmax", "t = tmax", "other (past an end, NaN)"],
+            Event::SlabTouch => &[
+                "entry < exit",
+                "entry = exit (touching: an edge, a corner or a zero-extent box)",
+                "entry > exit (a hit by widening)",
+            ],
         }
     }
 
@@ -1233,8 +1264,11 @@ impl Event {
                 b == 0
             }
         });
+        let widen = m.params.get("slab_widen_ulps").copied().unwrap_or(0);
         match (self, bin) {
             (Event::RtiDet, "0 < det <= threshold" | "-threshold <= det < 0") if zero_thr => Some(WHY_ZERO_THRESHOLD),
+            (Event::SlabTouch, "entry > exit (a hit by widening)") if widen == 0 => Some(WHY_NO_WIDENING),
+            (Event::RtiT, "other (past an end, NaN)") => Some(WHY_HIT_T_IN_RANGE),
             _ => None,
         }
     }
@@ -1316,6 +1350,44 @@ impl Event {
                     out.push(0);
                 }
                 out
+            }
+            Event::RtiBary(_) | Event::RtiT if !(flag("valid") == Some(true) && flag("hit") == Some(true)) => {
+                Vec::new()
+            }
+            Event::RtiBary(k) => {
+                let Some(x) = num(["u", "v"][k]) else { return Vec::new() };
+                // 1 in the set's units (fixed point: steps)
+                let one = m.params.get("fx_frac").map_or(1.0, |&f| pow2(f as i64));
+                vec![match x {
+                    Some(x) if x == 0.0 => 0,
+                    Some(x) if x > 0.0 && x < one => 1,
+                    Some(x) if x == one => 2,
+                    _ => 3,
+                }]
+            }
+            Event::RtiT => {
+                let (Some(t), Some(lo), Some(hi)) = (num("t"), num("tmin"), num("tmax")) else { return Vec::new() };
+                vec![match (t, lo, hi) {
+                    (Some(t), Some(lo), _) if t == lo => 0,
+                    (Some(t), _, Some(hi)) if t == hi => 2,
+                    (Some(t), Some(lo), Some(hi)) if lo < t && t < hi => 1,
+                    _ => 3,
+                }]
+            }
+            Event::SlabTouch => {
+                if flag("hit") != Some(true) {
+                    return Vec::new();
+                }
+                match (num("tn_xyz"), num("tf_xyz")) {
+                    (Some(Some(n)), Some(Some(f))) => vec![if n < f {
+                        0
+                    } else if n == f {
+                        1
+                    } else {
+                        2
+                    }],
+                    _ => Vec::new(),
+                }
             }
             Event::CaptureTie => {
                 let slots = m.params.get("slots").copied().unwrap_or(0) as usize;

@@ -231,6 +231,30 @@ fn cancellation_and_events_by_hand() {
     assert_eq!(counts("origin against the box, axis x"), [3, 1, 0, 0, 0, 0]);
     assert_eq!(counts("box extent, axis x"), [2, 1, 1, 0]);
     assert_eq!(counts("origin against the box, axis y"), [0, 0, 4, 0, 0, 0]);
+    // hits on [1, 2] and [0, 2] enter before they leave, [1, 1] touches, [2, 1] misses
+    assert_eq!(counts("a hit's entry against its exit (tn_xyz vs tf_xyz)"), [2, 1, 0]);
+    // RTI fp16, the triangle v0 = 0, v1 = (1, 0, 0), v2 = (0, 0, 1) and a ray along +y from
+    // o: u = o.x, v = o.z, t = -o.y. A: o = 0 (the vertex v0, t = tmin = 0); B: o = (0.25, -2,
+    // 0.5); C: o = (1, -2, 0) (the vertex v1); D: B with tmax = 2
+    let rrow = |o: [u64; 3], tmax: u64| vec![o[0], o[1], o[2], 0, one, 0, 0, tmax, 0, 0, 0, one, 0, 0, 0, 0, one];
+    let (q, h, m2) = (0x3400u64, 0x3800u64, 0xc000u64);
+    let ex = vectors::gen::Explicit {
+        class: "hand".into(),
+        covers: String::new(),
+        origin: "test".into(),
+        rows: vec![rrow([0, 0, 0], inf), rrow([q, m2, h], inf), rrow([one, m2, 0], inf), rrow([q, m2, h], two)],
+    };
+    let set = generate(&Request { closure: Some(ex), ..req(Unit::Rti, "fp16") }).unwrap();
+    let rows = set_rows(&set).unwrap();
+    let n = rows[0].len();
+    let mut c = Coverage::model(&set.manifest);
+    c.add_rows(&set.manifest, &rows, n - 4..n).unwrap();
+    let counts = |sig: &str| -> Vec<u64> {
+        c.coverpoints.iter().find(|p| p.signal == sig).unwrap().bins.iter().map(|b| b.count).collect()
+    };
+    assert_eq!(counts("u of a valid hit"), [1, 2, 1, 0]);
+    assert_eq!(counts("v of a valid hit"), [2, 2, 0, 0]);
+    assert_eq!(counts("t of a valid hit against tmin and tmax"), [1, 2, 1, 0]);
 }
 
 /// Reading a written set row by row (`measure_dir`, what `raypipe cover` does) gives the
