@@ -380,6 +380,20 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         push(row("error bound f64 block (widest here)", n, 0.0, 3, || {
             datapath::bound::verdict_block(Kernel::Avx512Fp16, opts, bray, c9(), &mut dec, &mut hit, &mut te)
         }));
+        // the same block with the static filter in front (datapath::bound_filter; verify's path)
+        let mut cert = vec![false; n];
+        push(row("error bound f64 block, static filter first (widest here)", n, 0.0, 3, || {
+            datapath::bound_filter::verdict_block_filtered(
+                Kernel::Avx512Fp16,
+                opts,
+                bray,
+                c9(),
+                &mut dec,
+                &mut hit,
+                &mut te,
+                &mut cert,
+            );
+        }));
     }
     // a batch far beyond the caches: one pass over 1 M-pair columns against the same pairs
     // streamed through L1-sized chunks gathered from the scene (gather included)

@@ -5,6 +5,7 @@
 
 pub mod alloc;
 pub mod bound;
+pub mod bound_filter;
 pub mod bvh;
 pub mod fault;
 pub mod format;

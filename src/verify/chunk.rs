@@ -21,7 +21,8 @@
 use super::counts::{RtiCounts, SlabCounts};
 use super::{FormatReport, SlabReport, VerifyConfig};
 use crate::scene::Scene;
-use datapath::bound::{verdict_block, BlockOpts, BlockRay};
+use datapath::bound::{BlockOpts, BlockRay};
+use datapath::bound_filter::verdict_block_filtered;
 use datapath::rng::SplitMix64;
 use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
 use datapath::simd::{self, Kernel};
@@ -155,6 +156,8 @@ struct Scratch<V> {
     sfar: Vec<f64>,
     /// Lanes whose golden f64 interval is within 1e-9 (relative) of empty: exact decides.
     sclose: Vec<bool>,
+    /// Lanes the static filter certified.
+    cert: Vec<bool>,
     exact: Vec<u8>,
     prepared: Vec<datapath::slab::SlabRay<V>>,
     boxes: BoxesSoa<V>,
@@ -181,6 +184,7 @@ impl<V: Copy + Default> Scratch<V> {
             snear: f(),
             sfar: f(),
             sclose: b(),
+            cert: b(),
             exact: vec![0; BLOCK],
             prepared: Vec::new(),
             boxes: BoxesSoa::default(),
@@ -292,7 +296,9 @@ where
         acc.model_ns += t0.elapsed().as_nanos() as u64;
         intersect_block(self.level, rq, self.faces, cols(&s.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
         let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
-        verdict_block(
+        // the static filter first: a lane its block constants certify gets the per-test
+        // bound's verdict without running it (datapath::bound_filter)
+        verdict_block_filtered(
             Kernel::Avx512Fp16,
             self.opts,
             bray,
@@ -300,6 +306,7 @@ where
             &mut s.dec[..n],
             &mut s.ehit[..n],
             &mut s.terr[..n],
+            &mut s.cert[..n],
         );
         let c = &mut acc.counts;
         let mut c_exact = 0;

@@ -1359,7 +1359,7 @@ impl Event {
                 // 1 in the set's units (fixed point: steps)
                 let one = m.params.get("fx_frac").map_or(1.0, |&f| pow2(f as i64));
                 vec![match x {
-                    Some(x) if x == 0.0 => 0,
+                    Some(0.0) => 0, // ±0
                     Some(x) if x > 0.0 && x < one => 1,
                     Some(x) if x == one => 2,
                     _ => 3,

@@ -1,0 +1,422 @@
+//! A static filter in front of the per-test error bound ([`crate::bound`]), in the manner of
+//! CGAL's static filters and Shewchuk's stage-A bounds: one error constant per block of tests
+//! (one ray against a block of triangles), computed from the block's largest magnitudes, decides
+//! the tests whose compared quantities clear it; only the rest run the per-test bound.
+//!
+//! **What it certifies, and why that is the per-test verdict.** The per-test bound
+//! ([`RtiBound::new`]) carries for each signal its f64 value `v`, its monomial sum `a` and its
+//! error bound `e` through sums `e = e₀ + u·(|v| + e₀) + add_eta` (e₀ = ex + ey) and products
+//! `e = e₀ + u·(|v| + e₀) + eta` (e₀ = |x|·ey + |y|·ex + ex·ey), `a` adding and multiplying. Every
+//! term is non-negative and non-decreasing in |x|, |y|, ex, ey, ax, ay; binary64 rounding to
+//! nearest is monotone; and |x ± y| <= |x| + |y|, |x·y| = |x|·|y|. So the same recurrences run on
+//! *magnitudes* — inputs `V = A =` the block's largest |coordinate| per column, sums `V = X + Y`,
+//! products `V = X·Y` — give, for every signal, `E = e + 2⁻⁴⁵·a` no smaller than any lane's
+//! `err()`, and a range check (`V + E <= max` at every step) that implies every lane's. A lane is
+//! certified when (1) the block's range check holds and no input is NaN, (2) the lane is not
+//! valid (its exact decision is a miss: the per-test verdict's `hit` is false), (3) every
+//! quantity the verdict compares clears the static constant (|det_q| > E_det, |det| > E_det,
+//! |u'| > E_u', |v'| > E_v', |det − (u'+v')| > E_det + E_uv, |t'| > E_t'), which implies it
+//! clears its per-test bound, and (4) none of the three quotients (t, u, v) can raise the
+//! per-test overflow flag: with `D = |det| − E_det` (> 0 by (3), and no larger than the
+//! per-test `|det| − err_det`), the per-test `|q| + Δ₁` is at most (|num|·D + E_num·D +
+//! |num|·E_det)/D², and a division-free check with a 2⁻⁴⁰ margin bounds its `1/denom <= max`
+//! (reciprocal mode) and `mag + extra <= max` (`quot_may_overflow`). Then the
+//! per-test verdict is decisive with `hit` false, and that is what a certified lane gets; its
+//! `t_err` is +∞ (no t to bound: the lane misses). Every other lane runs [`RtiBound::new`] and
+//! [`RtiBound::verdict`] itself. The lane values (det, u', v', t', u'+v') are the per-test
+//! bound's own (`RtiBound::new`'s `v`, the same operations in the same order).
+//!
+//! `tests` (here and `datapath/tests/bound_filter.rs`) check the implication lane by lane
+//! against the per-test bound on random and edge blocks (subnormal, huge, ±0, ±∞, NaN inputs).
+
+use crate::bound::{BlockOpts, BlockRay, RtiBound, F64_SLACK};
+use crate::format::DivMode;
+use crate::rti::Cull;
+
+/// A magnitude bound of a signal: `v` >= |value|, `a` >= the monomial sum, `e` >= the error
+/// bound of every lane of the block.
+#[derive(Clone, Copy, Debug, Default)]
+struct Mag {
+    v: f64,
+    a: f64,
+    e: f64,
+}
+
+impl Mag {
+    /// The bound used in decisions: `e + 2⁻⁴⁵·a` (as `Bnd::err`).
+    fn err(self) -> f64 {
+        self.e + F64_SLACK * self.a
+    }
+}
+
+/// The magnitude recurrences of `crate::bound`'s `Ctx` (the same formulas, on upper bounds).
+struct MagCtx {
+    u: f64,
+    eta: f64,
+    add_eta: f64,
+    max: f64,
+    /// Some magnitude may exceed the format's range (or an input is NaN): certify nothing.
+    overflow: bool,
+}
+
+impl MagCtx {
+    fn check(&mut self, b: Mag) -> Mag {
+        let m = b.v + b.e;
+        // NaN or above the largest magnitude
+        self.overflow |= m.partial_cmp(&self.max).is_none_or(|o| o.is_gt());
+        b
+    }
+    fn input(&mut self, x: f64) -> Mag {
+        self.check(Mag { v: x, a: x, e: 0.0 })
+    }
+    fn addsub(&mut self, x: Mag, y: Mag) -> Mag {
+        let v = x.v + y.v;
+        let e0 = x.e + y.e;
+        let e = e0 + self.u * (v + e0) + self.add_eta;
+        self.check(Mag { v, a: x.a + y.a, e })
+    }
+    fn mul(&mut self, x: Mag, y: Mag) -> Mag {
+        let v = x.v * y.v;
+        let e0 = x.v * y.e + y.v * x.e + x.e * y.e;
+        let e = e0 + self.u * (v + e0) + self.eta;
+        self.check(Mag { v, a: x.a * y.a, e })
+    }
+    fn cross(&mut self, a: [Mag; 3], b: [Mag; 3]) -> [Mag; 3] {
+        let xa = self.mul(a[1], b[2]);
+        let xb = self.mul(a[2], b[1]);
+        let ya = self.mul(a[2], b[0]);
+        let yb = self.mul(a[0], b[2]);
+        let za = self.mul(a[0], b[1]);
+        let zb = self.mul(a[1], b[0]);
+        [self.addsub(xa, xb), self.addsub(ya, yb), self.addsub(za, zb)]
+    }
+    fn dot(&mut self, a: [Mag; 3], b: [Mag; 3]) -> Mag {
+        let x = self.mul(a[0], b[0]);
+        let y = self.mul(a[1], b[1]);
+        let z = self.mul(a[2], b[2]);
+        let xy = self.addsub(x, y);
+        self.addsub(xy, z)
+    }
+}
+
+/// The block's static constants: each compared signal's `E`, or `None` when the block's range
+/// check fails or an input is NaN (then no lane is certified).
+#[derive(Clone, Copy, Debug)]
+struct Static {
+    det: f64,
+    up: f64,
+    vp: f64,
+    tp: f64,
+    uv: f64,
+}
+
+/// The block's largest magnitudes: per first-difference component (e1 = v1 − v0, e2 = v2 − v0,
+/// s = o − v0, as each lane computes them) its largest |value| and largest monomial sum
+/// |x| + |y|, the largest |input|, and whether an input is NaN. Column by column, branch-free.
+#[inline(always)]
+fn maxima(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
+    let (mut ve, mut ae) = ([0.0f64; 9], [0.0f64; 9]);
+    let (mut big, mut bad) = (0.0f64, false);
+    for a in 0..3 {
+        let y = c[a];
+        for k in 0..3 {
+            let (vm, am, bm, nf) = if k < 2 { column_maxima(c[3 * (k + 1) + a], y) } else { origin_maxima(r.o[a], y) };
+            ve[3 * k + a] = vm;
+            ae[3 * k + a] = am;
+            big = big.max(bm);
+            bad |= nf;
+        }
+    }
+    (ve, ae, big, bad)
+}
+
+/// Over the lanes of columns x and y: the largest |x − y|, |x| + |y| and max(|x|, |y|), and
+/// whether a value is not finite (x·0 is NaN exactly then). Eight independent accumulators
+/// per quantity, so the loop vectorises.
+#[inline(always)]
+fn column_maxima(x: &[f64], y: &[f64]) -> (f64, f64, f64, bool) {
+    const W: usize = 8;
+    let (mut vm, mut am, mut bm, mut nf) = ([0.0f64; W], [0.0f64; W], [0.0f64; W], [0.0f64; W]);
+    let mut step = |j: usize, xi: f64, yi: f64| {
+        let (dv, sv) = ((xi - yi).abs(), xi.abs() + yi.abs());
+        let mb = if xi.abs() > yi.abs() { xi.abs() } else { yi.abs() };
+        vm[j] = if dv > vm[j] { dv } else { vm[j] };
+        am[j] = if sv > am[j] { sv } else { am[j] };
+        bm[j] = if mb > bm[j] { mb } else { bm[j] };
+        nf[j] += xi * 0.0 + yi * 0.0;
+    };
+    let (xc, yc) = (x.chunks_exact(W), y.chunks_exact(W));
+    let (xr, yr) = (xc.remainder(), yc.remainder());
+    for (xs, ys) in xc.zip(yc) {
+        for j in 0..W {
+            step(j, xs[j], ys[j]);
+        }
+    }
+    for (&xi, &yi) in xr.iter().zip(yr) {
+        step(0, xi, yi);
+    }
+    fold(vm, am, bm, nf)
+}
+
+/// [`column_maxima`] with x one value (the ray's origin on an axis).
+#[inline(always)]
+fn origin_maxima(xi: f64, y: &[f64]) -> (f64, f64, f64, bool) {
+    const W: usize = 8;
+    let (mut vm, mut am, mut bm, mut nf) = ([0.0f64; W], [0.0f64; W], [0.0f64; W], [0.0f64; W]);
+    let mut step = |j: usize, yi: f64| {
+        let (dv, sv) = ((xi - yi).abs(), xi.abs() + yi.abs());
+        vm[j] = if dv > vm[j] { dv } else { vm[j] };
+        am[j] = if sv > am[j] { sv } else { am[j] };
+        bm[j] = if yi.abs() > bm[j] { yi.abs() } else { bm[j] };
+        nf[j] += yi * 0.0;
+    };
+    let yc = y.chunks_exact(W);
+    let yr = yc.remainder();
+    for ys in yc {
+        for (j, &yi) in ys.iter().enumerate() {
+            step(j, yi);
+        }
+    }
+    for &yi in yr {
+        step(0, yi);
+    }
+    let (v, a, b, n) = fold(vm, am, bm, nf);
+    (v, a, b.max(xi.abs()), n | !xi.is_finite())
+}
+
+/// The accumulators folded (the non-finite flag: a NaN sum).
+fn fold<const W: usize>(vm: [f64; W], am: [f64; W], bm: [f64; W], nf: [f64; W]) -> (f64, f64, f64, bool) {
+    let m = |x: [f64; W]| x.iter().fold(0.0f64, |m, &v| m.max(v));
+    (m(vm), m(am), m(bm), nf.iter().any(|v| v.is_nan()))
+}
+
+fn statics(o: BlockOpts, r: BlockRay, (ve, ae, big, nan): ([f64; 9], [f64; 9], f64, bool)) -> Option<Static> {
+    let mut m = MagCtx { u: o.em.u, eta: o.em.eta, add_eta: o.em.add_eta, max: o.em.max, overflow: false };
+    if nan || r.o.iter().chain(&r.d).any(|x| x.is_nan()) {
+        return None;
+    }
+    // the first differences taken lane by lane (translation does not loosen the constants)
+    m.input(big);
+    for x in r.o.iter().chain(&r.d) {
+        m.input(x.abs());
+    }
+    // a first difference: e = 0 + 0 + u·(|v| + 0) + add_eta, as the per-test sum of two inputs
+    let mut diff = |k: usize| {
+        let e = m.u * ve[k] + m.add_eta;
+        m.check(Mag { v: ve[k], a: ae[k], e })
+    };
+    let e1 = [diff(0), diff(1), diff(2)];
+    let e2 = [diff(3), diff(4), diff(5)];
+    let s = [diff(6), diff(7), diff(8)];
+    let d3 = [r.d[0].abs(), r.d[1].abs(), r.d[2].abs()].map(|x| Mag { v: x, a: x, e: 0.0 });
+    let p = m.cross(d3, e2);
+    let q = m.cross(s, e1);
+    let det = m.dot(e1, p);
+    let up = m.dot(s, p);
+    let vp = m.dot(d3, q);
+    let tp = m.dot(e2, q);
+    let uv = m.addsub(up, vp);
+    (!m.overflow).then(|| Static { det: det.err(), up: up.err(), vp: vp.err(), tp: tp.err(), uv: uv.err() })
+}
+
+/// Relative margin of the quotient check below: it absorbs the per-test bound's roundings of
+/// `q`, `Δ₁`, `mag` and `extra` (at most about ten binary64 roundings, a factor below
+/// 1 + 2⁻⁴⁹) and this check's own (a dozen more).
+const QUOT_MARGIN: f64 = 1.0 / (1u64 << 40) as f64;
+
+/// Whether the per-test quotient `num / det` can raise the overflow flag, bounded from the
+/// static constants without a division (`d`: |det| − E_det, > 0, no larger than the per-test
+/// `|det| − err_det`): false certifies it cannot. With X = |num|, the per-test
+/// `mag = |q| + (err_num + |q|·err_det)/denom` is at most (X·d + E_num·d + X·E_det)/d², so
+/// `mag + extra <= max` follows from `(X·d + E_num·d + X·E_det)·(1 + 2u + u²) +
+/// (eta·(X + E_num)·(1 + u) + eta)·d² <= max·d²·(1 − 2⁻⁴⁰)` (reciprocal mode; divide mode:
+/// `·(1 + u) + eta·d²`), and
+/// `1/denom <= max` from `max·d·(1 − 2⁻⁴⁰) >= 1`. Every term is finite (the block's range check
+/// bounds X, d and the constants by the format's largest value); a NaN fails the check.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn quot_may_overflow(recip: bool, u: f64, eta: f64, max: f64, num: f64, e_num: f64, e_det: f64, d: f64) -> bool {
+    let x = num.abs();
+    let d2 = d * d;
+    let m = x * d + e_num * d + x * e_det;
+    let lhs_recip = m * (1.0 + (2.0 * u + u * u)) + (eta * (x + e_num) * (1.0 + u) + eta) * d2;
+    let lhs_div = m * (1.0 + u) + eta * d2;
+    let lhs = if recip { lhs_recip } else { lhs_div };
+    let fits = lhs <= max * d2 * (1.0 - QUOT_MARGIN);
+    let recip_fits = !recip | (max * d * (1.0 - QUOT_MARGIN) >= 1.0);
+    !(fits & recip_fits)
+}
+
+/// As [`crate::bound::verdict_block`] — per lane the verdict's `decisive` and `hit`, and
+/// `t_err` — with the static filter in front: a certified lane gets `decisive` true, `hit`
+/// false and `t_err` +∞ (it misses: no t to bound), which is the per-test verdict (module
+/// documentation); every other lane is the per-test bound's. Returns the number of certified
+/// lanes. `certified` is scratch space (its length is the block's).
+///
+/// # Panics
+/// If the column lengths differ.
+#[allow(clippy::too_many_arguments)]
+pub fn verdict_block_filtered(
+    cap: crate::simd::Kernel,
+    opts: BlockOpts,
+    ray: BlockRay,
+    tris: [&[f64]; 9],
+    decisive: &mut [bool],
+    hit: &mut [bool],
+    t_err: &mut [f64],
+    certified: &mut [bool],
+) -> usize {
+    use crate::simd::Kernel;
+    let n = hit.len();
+    assert!(
+        decisive.len() == n && t_err.len() == n && certified.len() == n && tris.iter().all(|c| c.len() == n),
+        "column lengths differ"
+    );
+    let cap = crate::simd::best_kernel(true, cap);
+    #[cfg(target_arch = "x86_64")]
+    let ok = {
+        use std::arch::is_x86_feature_detected as has;
+        if cap >= Kernel::Avx512 && has!("avx512f") {
+            // SAFETY: AVX-512F is present (checked above)
+            unsafe { filter_avx512(opts, ray, tris, certified) }
+        } else if cap >= Kernel::Avx2 && has!("avx2") {
+            // SAFETY: AVX2 is present (checked above)
+            unsafe { filter_avx2(opts, ray, tris, certified) }
+        } else {
+            filter(opts, ray, tris, certified)
+        }
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let ok = filter(opts, ray, tris, certified);
+    if !ok {
+        crate::bound::verdict_block(cap, opts, ray, tris, decisive, hit, t_err);
+        certified.fill(false);
+        return 0;
+    }
+    let mut k = 0;
+    for i in 0..n {
+        if certified[i] {
+            decisive[i] = true;
+            hit[i] = false;
+            t_err[i] = f64::INFINITY;
+            k += 1;
+        } else {
+            let v = [
+                [tris[0][i], tris[1][i], tris[2][i]],
+                [tris[3][i], tris[4][i], tris[5][i]],
+                [tris[6][i], tris[7][i], tris[8][i]],
+            ];
+            let b = RtiBound::<f64>::new(opts.em, opts.div, ray.o, ray.d, v);
+            let vd = b.verdict(opts.cull, opts.det_threshold, ray.tmin, ray.tmax);
+            decisive[i] = vd.decisive;
+            hit[i] = vd.hit;
+            t_err[i] = b.t_err;
+        }
+    }
+    k
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn filter_avx512(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool]) -> bool {
+    filter(o, r, c, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn filter_avx2(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool]) -> bool {
+    filter(o, r, c, out)
+}
+
+/// The block's constants and each lane's certificate; false when the block has none (range
+/// check, NaN): then no lane is certified.
+#[inline(always)]
+fn filter(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool]) -> bool {
+    match statics(o, r, maxima(r, c)) {
+        Some(st) => {
+            certify(o, r, st, c, out);
+            true
+        }
+        None => false,
+    }
+}
+
+/// The values `RtiBound::new` carries for det, u', v', t' and u' + v' (its `v`): the same
+/// binary64 operations in the same order (no error terms; `tests::values_are_the_bounds`).
+#[inline(always)]
+pub fn values(o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5] {
+    let [v0, v1, v2] = v;
+    let e1 = [v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]];
+    let e2 = [v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]];
+    let s = [o[0] - v0[0], o[1] - v0[1], o[2] - v0[2]];
+    let cross =
+        |a: [f64; 3], b: [f64; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let p = cross(d, e2);
+    let q = cross(s, e1);
+    let (det, up, vp, tp) = (dot(e1, p), dot(s, p), dot(d, q), dot(e2, q));
+    [det, up, vp, tp, up + vp]
+}
+
+/// Per lane, whether the static constants certify it (conditions (2) to (4) of the module
+/// documentation; (1) is the caller's). Branch-free per lane.
+#[inline(always)]
+fn certify(o: BlockOpts, r: BlockRay, st: Static, c: [&[f64]; 9], out: &mut [bool]) {
+    let (u, eta, max) = (o.em.u, o.em.eta, o.em.max);
+    let recip = o.div == DivMode::RecipMul;
+    let backface = o.cull == Cull::Backface;
+    for i in 0..out.len() {
+        let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
+        let [det, up, vp, tp, uv] = values(r.o, r.d, v);
+        let det_q = if backface { det - o.det_threshold } else { det.abs() - o.det_threshold };
+        let pos = det > 0.0;
+        let sgn = |x: f64| if pos { x } else { -x };
+        let valid = (det_q > 0.0) & (sgn(up) >= 0.0) & (sgn(vp) >= 0.0) & (sgn(det - uv) >= 0.0) & (sgn(tp) >= 0.0);
+        let clear = |x: f64, e: f64| x.abs() > e;
+        let cleared = clear(det_q, st.det)
+            & clear(det, st.det)
+            & clear(up, st.up)
+            & clear(vp, st.vp)
+            & clear(det - uv, st.det + st.uv)
+            & clear(tp, st.tp);
+        let d = det.abs() - st.det;
+        let over = quot_may_overflow(recip, u, eta, max, tp, st.tp, st.det, d)
+            | quot_may_overflow(recip, u, eta, max, up, st.up, st.det, d)
+            | quot_may_overflow(recip, u, eta, max, vp, st.vp, st.det, d);
+        out[i] = !valid & cleared & !over;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+
+    /// `values` is `RtiBound::new`'s `v` bit for bit (the filter's lane values are the per-test
+    /// bound's own), on ordinary, tiny, huge, zero and non-finite inputs.
+    #[test]
+    fn values_are_the_bounds() {
+        let mut r = SplitMix64::new(7);
+        let em = crate::format::ErrorModel { u: 0.0, eta: 0.0, add_eta: 0.0, max: f64::MAX };
+        let x = |r: &mut SplitMix64| match r.below(8) {
+            0 => 0.0,
+            1 => -0.0,
+            2 => f64::INFINITY,
+            3 => f64::NAN,
+            4 => r.range(-1.0, 1.0) * 1e-300,
+            5 => r.range(-1.0, 1.0) * 1e300,
+            _ => r.range(-4.0, 4.0),
+        };
+        for _ in 0..20000 {
+            let o = std::array::from_fn(|_| x(&mut r));
+            let d = std::array::from_fn(|_| x(&mut r));
+            let v = std::array::from_fn(|_| std::array::from_fn(|_| x(&mut r)));
+            let b = RtiBound::<f64>::new(em, DivMode::Divide, o, d, v);
+            let want = [b.det.v, b.up.v, b.vp.v, b.tp.v, b.uv.v];
+            let got = values(o, d, v);
+            for k in 0..5 {
+                assert!(got[k].to_bits() == want[k].to_bits() || (got[k].is_nan() && want[k].is_nan()), "{k}");
+            }
+        }
+    }
+}
