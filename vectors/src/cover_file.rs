@@ -60,7 +60,12 @@ fn model(j: &serde_json::Value) -> Result<(Manifest, Coverage), String> {
     let mut c = Coverage::model(&m);
     let counts: Vec<Vec<u64>> = serde_json::from_value(j["counts"].clone()).map_err(|e| format!("counts: {e}"))?;
     if counts.len() != c.coverpoints.len() || counts.iter().zip(&c.coverpoints).any(|(k, p)| k.len() != p.bins.len()) {
-        return Err("counts do not fit the coverage model of the file's manifest".into());
+        return Err(format!(
+            "counts do not fit the coverage model of the file's manifest (written by raypipe {} at git {}, read by raypipe {}: a file from another build, whose model differs, or an edited one)",
+            m.raypipe_version,
+            m.git,
+            env!("CARGO_PKG_VERSION")
+        ));
     }
     for (p, k) in c.coverpoints.iter_mut().zip(counts) {
         for (b, n) in p.bins.iter_mut().zip(k) {
