@@ -59,6 +59,9 @@ pub struct SpeedReport {
     pub cap: Option<String>,
     /// The machine: CPU model, cores, instruction-set extensions.
     pub machine: String,
+    /// The engine's end-to-end rate (verify f32) over the rti f32 kernel's rate of the same
+    /// run, per thread count measured: (threads, fraction).
+    pub engine_over_f32_kernel: Vec<(usize, f64)>,
 }
 
 /// The RTI batch path of each format family (the SIMD kernels of `datapath::simd`).
@@ -510,7 +513,18 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         let p = if r.peak == "binary16" { peak16 } else { peak };
         r.fraction_of_peak = r.mtests_per_s * 1e6 * r.ops / p;
     }
+    let rate = |name: &str| rows.iter().find(|r| r.name == name).map_or(0.0, |r| r.mtests_per_s);
+    let f32k = rate("rti f32 kernel (dispatch)");
+    let engine_over_f32_kernel = rows
+        .iter()
+        .filter_map(|r| {
+            let t = r.name.strip_prefix("engine: verify f32 end to end")?.rsplit(", ").next()?;
+            let threads = t.strip_suffix(" thread(s)")?.parse().ok()?;
+            (f32k > 0.0).then(|| (threads, r.mtests_per_s / f32k))
+        })
+        .collect();
     SpeedReport {
+        engine_over_f32_kernel,
         batch_paths: BATCH_PATHS.iter().map(|s| s.to_string()).collect(),
         pairs,
         seed,
@@ -579,6 +593,10 @@ pub fn render(s: &SpeedReport) -> String {
             .filter_map(|f| rate(&format!("rti {f} kernel (dispatch)")).map(|r| format!("{f} {:.3}", r / f32k)))
             .collect();
         out += &format!("\nRTI batch path / f32 kernel, this run: {}\n", ratios.join(", "));
+    }
+    if !s.engine_over_f32_kernel.is_empty() {
+        let e: Vec<String> = s.engine_over_f32_kernel.iter().map(|(t, f)| format!("{t} thread(s) {f:.4}")).collect();
+        out += &format!("engine (verify f32 end to end, judged tests) / rti f32 kernel, this run: {}\n", e.join(", "));
     }
     out += "\nRTI batch paths:\n";
     for p in &s.batch_paths {

@@ -662,6 +662,19 @@ fn speed_fractions_are_each_rows_rate_over_the_one_peak_it_prints() {
     for row in ["golden mt f64 block", "error bound f64 block", "engine: verify f32 end to end"] {
         assert!(names.iter().any(|n| n.starts_with(row)), "{row} missing from {names:?}");
     }
+    // the engine's rate over the f32 kernel's, per thread count, from the rows of this run
+    let rate = |name: &str| rows.iter().find(|r| r["name"] == name).unwrap()["mtests_per_s"].as_f64().unwrap();
+    let f32k = rate("rti f32 kernel (dispatch)");
+    let e = v["engine_over_f32_kernel"].as_array().unwrap();
+    assert!(!e.is_empty());
+    for pair in e {
+        let (t, f) = (pair[0].as_u64().unwrap(), pair[1].as_f64().unwrap());
+        let row = names
+            .iter()
+            .find(|n| n.starts_with("engine: verify f32") && n.ends_with(&format!(", {t} thread(s)")))
+            .unwrap();
+        assert_eq!(f, rate(row) / f32k, "{t} threads");
+    }
     for kernel in ["rti", "slab"] {
         for place in ["staggered columns", "columns at one page offset"] {
             let want = format!("{kernel} f32 kernel, 128 Ki pairs, {place}");
