@@ -700,6 +700,32 @@ fn speed_cap_limits_every_kernel_it_names() {
     assert_clear_error(&raypipe(&["speed", "--cap", "avx3"]), "--cap");
 }
 
+/// `verify --cap` changes the instructions, not the report: the same counts, errors and
+/// explain lines under every cap (timing fields aside).
+#[test]
+fn verify_cap_changes_no_result() {
+    let untimed = |args: &[&str]| -> serde_json::Value {
+        let mut v = vec!["verify", "--rays", "48", "--format", "f32,fp16,e8m16", "--json", "--quiet"];
+        v.extend_from_slice(args);
+        let o = raypipe(&v);
+        assert!(o.status.success(), "{:?}", text(&o));
+        let mut j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        for part in ["formats", "slab"] {
+            for f in j[part].as_array_mut().unwrap() {
+                let f = f.as_object_mut().unwrap();
+                f.remove("mtests_per_s");
+                f.remove("judged_mtests_per_s");
+            }
+        }
+        j
+    };
+    let wide = untimed(&[]);
+    for cap in ["scalar", "avx2"] {
+        assert_eq!(untimed(&["--cap", cap]), wide, "--cap {cap}");
+    }
+    assert_clear_error(&raypipe(&["verify", "--cap", "avx3"]), "--cap");
+}
+
 /// Shell completions and man pages come from the same clap definitions as the parser: every
 /// command is in them, and the scripts parse in the shells installed here.
 #[test]

@@ -293,3 +293,18 @@ pub fn check_written_path(flag: &str, path: &std::path::Path, marker: &str) -> R
     let ours = |text: &str| text.lines().take(4).any(|l| l.contains(marker));
     vectors::outdir::check_file_out(flag, path, ours, "raypipe did not write it")
 }
+
+/// Limits every kernel dispatch of the process to `cap` (`--cap`: scalar, avx2, avx512 or
+/// avx512fp16; the bits do not change, only the instructions): a narrower machine's speed.
+pub fn apply_cap(cap: Option<&str>) {
+    use datapath::simd::Kernel;
+    if let Some(c) = cap {
+        let k = match c {
+            "scalar" => Kernel::Scalar,
+            "avx2" => Kernel::Avx2,
+            "avx512" => Kernel::Avx512,
+            _ => Kernel::Avx512Fp16,
+        };
+        datapath::simd::cap_process(k);
+    }
+}

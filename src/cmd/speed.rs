@@ -23,16 +23,7 @@ pub struct Args {
 pub fn run(a: Args) -> Result<Outcome, String> {
     let Args { pairs, seed, cap, json } = a;
     limit("--pairs", pairs, MAX_SPEED_PAIRS, "the columns are held in memory")?;
-    if let Some(c) = &cap {
-        use datapath::simd::Kernel;
-        let k = match c.as_str() {
-            "scalar" => Kernel::Scalar,
-            "avx2" => Kernel::Avx2,
-            "avx512" => Kernel::Avx512,
-            _ => Kernel::Avx512Fp16,
-        };
-        datapath::simd::cap_process(k);
-    }
+    apply_cap(cap.as_deref());
     let mut rep = raypipe::speed::speed(pairs as usize, seed);
     rep.cap = cap;
     emit(json, &rep, raypipe::speed::render)?;

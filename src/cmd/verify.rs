@@ -50,6 +50,10 @@ pub struct Args {
     /// to FILE (`raypipe cover FILE…` reports and merges it; docs/coverage.md).
     #[arg(long)]
     pub cover: Option<PathBuf>,
+    /// Use no kernel wider than this (as a machine without the wider ones would; the bits and
+    /// the report are the same, only the speed changes): scalar, avx2, avx512 or avx512fp16.
+    #[arg(long, value_parser = ["scalar", "avx2", "avx512", "avx512fp16"])]
+    pub cap: Option<String>,
 }
 
 impl Args {
@@ -69,6 +73,7 @@ impl Args {
             inject: None,
             rti: RtiArgs { cull: false, det_threshold: 0.0, tie: Tie::First },
             cover: None,
+            cap: None,
         }
     }
 }
@@ -93,6 +98,7 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         check_written_path("--cover", c, vectors::cover_file::KIND)?;
     }
     let shard = shard_of(a.sharding.shard.as_deref(), a.sharding.partial.as_deref())?;
+    apply_cap(a.cap.as_deref());
     let mut cfg = VerifyConfig::new(formats, a.rays, a.seed, rti, a.sample as usize);
     cfg.engine = a.run.engine(a.chunk).with_shard(shard);
     cfg.progress = !a.run.quiet;
