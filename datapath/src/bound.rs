@@ -47,42 +47,66 @@ impl<T: Lane> Bnd<T> {
 }
 
 /// The error model's constants as lanes, and the running overflow flag.
-struct Ctx<T: Lane> {
+pub(crate) struct Ctx<T: Lane> {
     u: T,
     eta: T,
     add_eta: T,
     max: T,
-    overflow: T::M,
+    pub(crate) overflow: T::M,
+    /// Magnitude mode (the static filter, `crate::bound_filter`): every value is an upper bound
+    /// on a magnitude, so a difference adds (|x − y| <= |x| + |y|); the error terms and the
+    /// range check are the same formulas.
+    magnitudes: bool,
 }
 
 // Every step is branch-free (flags or-ed, results selected): the same code serves one case
 // and vectorises when a loop runs it over columns (`verdict_block`).
 impl<T: Lane> Ctx<T> {
+    /// The constants of `em`, no overflow yet; `magnitudes`: see the field.
     #[inline(always)]
-    fn check(&mut self, b: Bnd<T>) -> Bnd<T> {
+    pub(crate) fn new(em: ErrorModel, magnitudes: bool) -> Self {
+        Ctx {
+            u: T::splat(em.u),
+            eta: T::splat(em.eta),
+            add_eta: T::splat(em.add_eta),
+            max: T::splat(em.max),
+            overflow: T::mask(false),
+            magnitudes,
+        }
+    }
+    #[inline(always)]
+    pub(crate) fn check(&mut self, b: Bnd<T>) -> Bnd<T> {
         let m = b.v.abs() + b.e;
         // NaN or above the largest magnitude
         self.overflow = self.overflow | !m.le(self.max);
         b
     }
     #[inline(always)]
-    fn input(&mut self, x: T) -> Bnd<T> {
+    pub(crate) fn input(&mut self, x: T) -> Bnd<T> {
         self.check(Bnd { v: x, a: x.abs(), e: T::splat(0.0) })
     }
     #[inline(always)]
     fn addsub(&mut self, x: Bnd<T>, y: Bnd<T>, sub: bool) -> Bnd<T> {
-        let v = if sub { x.v - y.v } else { x.v + y.v };
+        let v = if sub && !self.magnitudes { x.v - y.v } else { x.v + y.v };
         let e0 = x.e + y.e;
         let e = e0 + self.u * (v.abs() + e0) + self.add_eta;
         self.check(Bnd { v, a: x.a + y.a, e })
     }
     #[inline(always)]
-    fn add(&mut self, x: Bnd<T>, y: Bnd<T>) -> Bnd<T> {
+    pub(crate) fn add(&mut self, x: Bnd<T>, y: Bnd<T>) -> Bnd<T> {
         self.addsub(x, y, false)
     }
     #[inline(always)]
     fn sub(&mut self, x: Bnd<T>, y: Bnd<T>) -> Bnd<T> {
         self.addsub(x, y, true)
+    }
+    /// The difference of two inputs whose value is `v` and monomial sum `a`, as [`Self::sub`]
+    /// of two inputs bounds it (magnitude mode: `v` the largest |x − y| over a block's lanes).
+    #[inline(always)]
+    pub(crate) fn input_difference(&mut self, v: T, a: T) -> Bnd<T> {
+        let e0 = T::splat(0.0);
+        let e = e0 + self.u * (v.abs() + e0) + self.add_eta;
+        self.check(Bnd { v, a, e })
     }
     #[inline(always)]
     fn mul(&mut self, x: Bnd<T>, y: Bnd<T>) -> Bnd<T> {
@@ -92,7 +116,7 @@ impl<T: Lane> Ctx<T> {
         self.check(Bnd { v, a: x.a * y.a, e })
     }
     #[inline(always)]
-    fn cross(&mut self, a: [Bnd<T>; 3], b: [Bnd<T>; 3]) -> [Bnd<T>; 3] {
+    pub(crate) fn cross(&mut self, a: [Bnd<T>; 3], b: [Bnd<T>; 3]) -> [Bnd<T>; 3] {
         let xa = self.mul(a[1], b[2]);
         let xb = self.mul(a[2], b[1]);
         let ya = self.mul(a[2], b[0]);
@@ -102,7 +126,7 @@ impl<T: Lane> Ctx<T> {
         [self.sub(xa, xb), self.sub(ya, yb), self.sub(za, zb)]
     }
     #[inline(always)]
-    fn dot(&mut self, a: [Bnd<T>; 3], b: [Bnd<T>; 3]) -> Bnd<T> {
+    pub(crate) fn dot(&mut self, a: [Bnd<T>; 3], b: [Bnd<T>; 3]) -> Bnd<T> {
         let x = self.mul(a[0], b[0]);
         let y = self.mul(a[1], b[1]);
         let z = self.mul(a[2], b[2]);
@@ -166,13 +190,7 @@ impl<T: Lane> RtiBound<T> {
     /// Bounds for one ray (origin, direction) and triangle given as the format's values in f64.
     #[inline(always)]
     pub fn new(em: ErrorModel, div: DivMode, o: [T; 3], d: [T; 3], v: [[T; 3]; 3]) -> Self {
-        let mut c = Ctx {
-            u: T::splat(em.u),
-            eta: T::splat(em.eta),
-            add_eta: T::splat(em.add_eta),
-            max: T::splat(em.max),
-            overflow: T::mask(false),
-        };
+        let mut c = Ctx::new(em, false);
         // written out (no array::map / from_fn): the lanes stay in registers
         let o = [c.input(o[0]), c.input(o[1]), c.input(o[2])];
         let d = [c.input(d[0]), c.input(d[1]), c.input(d[2])];
@@ -323,13 +341,18 @@ fn block_body(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: 
     // one case per iteration, branch-free: the loop vectoriser carries 8 (AVX-512F) or 4
     // (AVX2) iterations per instruction
     for i in 0..n {
-        let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
-        let b = RtiBound::<f64>::new(o.em, o.div, r.o, r.d, v);
-        let vd = b.verdict(o.cull, o.det_threshold, r.tmin, r.tmax);
-        dec[i] = vd.decisive;
-        hit[i] = vd.hit;
-        te[i] = b.t_err;
+        (dec[i], hit[i], te[i]) = lane(o, r, c, i);
     }
+}
+
+/// Lane `i` of a block: the verdict's `decisive` and `hit`, and `t_err` ([`RtiBound::new`] and
+/// [`RtiBound::verdict`] of that triangle).
+#[inline(always)]
+pub(crate) fn lane(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], i: usize) -> (bool, bool, f64) {
+    let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
+    let b = RtiBound::<f64>::new(o.em, o.div, r.o, r.d, v);
+    let vd = b.verdict(o.cull, o.det_threshold, r.tmin, r.tmax);
+    (vd.decisive, vd.hit, b.t_err)
 }
 
 #[cfg(test)]
@@ -338,7 +361,14 @@ mod tests {
 
     fn ctx() -> Ctx<f64> {
         // binary32's unit roundoff, and error floors large enough to show in every sum
-        Ctx { u: 2f64.powi(-24), eta: 2f64.powi(-20), add_eta: 2f64.powi(-21), max: 1e30, overflow: false }
+        Ctx {
+            u: 2f64.powi(-24),
+            eta: 2f64.powi(-20),
+            add_eta: 2f64.powi(-21),
+            max: 1e30,
+            overflow: false,
+            magnitudes: false,
+        }
     }
 
     /// Each step adds exactly the error terms the module documentation states, worked by hand:

@@ -4,14 +4,15 @@
 //! the tests whose compared quantities clear it; only the rest run the per-test bound.
 //!
 //! **What it certifies, and why that is the per-test verdict.** The per-test bound
-//! ([`RtiBound::new`]) carries for each signal its f64 value `v`, its monomial sum `a` and its
+//! ([`RtiBound::new`](crate::bound::RtiBound::new)) carries for each signal its f64 value `v`, its monomial sum `a` and its
 //! error bound `e` through sums `e = e₀ + u·(|v| + e₀) + add_eta` (e₀ = ex + ey) and products
 //! `e = e₀ + u·(|v| + e₀) + eta` (e₀ = |x|·ey + |y|·ex + ex·ey), `a` adding and multiplying. Every
 //! term is non-negative and non-decreasing in |x|, |y|, ex, ey, ax, ay; binary64 rounding to
 //! nearest is monotone; and |x ± y| <= |x| + |y|, |x·y| = |x|·|y|. So the same recurrences run on
-//! *magnitudes* — inputs `V = A =` the block's largest |coordinate| per column, sums `V = X + Y`,
-//! products `V = X·Y` — give, for every signal, `E = e + 2⁻⁴⁵·a` no smaller than any lane's
-//! `err()`, and a range check (`V + E <= max` at every step) that implies every lane's. A lane is
+//! *magnitudes* — the bound's own recurrences (`Ctx` in magnitude mode, where a difference adds),
+//! from the inputs' largest |value| and the block's largest first differences |v1 − v0|,
+//! |v2 − v0|, |o − v0| per component — give, for every signal, `E = e + 2⁻⁴⁵·a` no smaller than
+//! any lane's `err()`, and a range check (`V + E <= max` at every step) that implies every lane's. A lane is
 //! certified when (1) the block's range check holds and no input is NaN, (2) the lane is not
 //! valid (its exact decision is a miss: the per-test verdict's `hit` is false), (3) every
 //! quantity the verdict compares clears the static constant (|det_q| > E_det, |det| > E_det,
@@ -22,82 +23,16 @@
 //! |num|·E_det)/D², and a division-free check with a 2⁻⁴⁰ margin bounds its `1/denom <= max`
 //! (reciprocal mode) and `mag + extra <= max` (`quot_may_overflow`). Then the
 //! per-test verdict is decisive with `hit` false, and that is what a certified lane gets; its
-//! `t_err` is +∞ (no t to bound: the lane misses). Every other lane runs [`RtiBound::new`] and
-//! [`RtiBound::verdict`] itself. The lane values (det, u', v', t', u'+v') are the per-test
+//! `t_err` is +∞ (no t to bound: the lane misses). Every other lane runs [`RtiBound::new`](crate::bound::RtiBound::new) and
+//! [`RtiBound::verdict`](crate::bound::RtiBound::verdict) itself. The lane values (det, u', v', t', u'+v') are the per-test
 //! bound's own (`RtiBound::new`'s `v`, the same operations in the same order).
 //!
 //! `tests` (here and `datapath/tests/bound_filter.rs`) check the implication lane by lane
 //! against the per-test bound on random and edge blocks (subnormal, huge, ±0, ±∞, NaN inputs).
 
-use crate::bound::{BlockOpts, BlockRay, RtiBound, F64_SLACK};
+use crate::bound::{BlockOpts, BlockRay, Bnd, Ctx};
 use crate::format::DivMode;
 use crate::rti::Cull;
-
-/// A magnitude bound of a signal: `v` >= |value|, `a` >= the monomial sum, `e` >= the error
-/// bound of every lane of the block.
-#[derive(Clone, Copy, Debug, Default)]
-struct Mag {
-    v: f64,
-    a: f64,
-    e: f64,
-}
-
-impl Mag {
-    /// The bound used in decisions: `e + 2⁻⁴⁵·a` (as `Bnd::err`).
-    fn err(self) -> f64 {
-        self.e + F64_SLACK * self.a
-    }
-}
-
-/// The magnitude recurrences of `crate::bound`'s `Ctx` (the same formulas, on upper bounds).
-struct MagCtx {
-    u: f64,
-    eta: f64,
-    add_eta: f64,
-    max: f64,
-    /// Some magnitude may exceed the format's range (or an input is NaN): certify nothing.
-    overflow: bool,
-}
-
-impl MagCtx {
-    fn check(&mut self, b: Mag) -> Mag {
-        let m = b.v + b.e;
-        // NaN or above the largest magnitude
-        self.overflow |= m.partial_cmp(&self.max).is_none_or(|o| o.is_gt());
-        b
-    }
-    fn input(&mut self, x: f64) -> Mag {
-        self.check(Mag { v: x, a: x, e: 0.0 })
-    }
-    fn addsub(&mut self, x: Mag, y: Mag) -> Mag {
-        let v = x.v + y.v;
-        let e0 = x.e + y.e;
-        let e = e0 + self.u * (v + e0) + self.add_eta;
-        self.check(Mag { v, a: x.a + y.a, e })
-    }
-    fn mul(&mut self, x: Mag, y: Mag) -> Mag {
-        let v = x.v * y.v;
-        let e0 = x.v * y.e + y.v * x.e + x.e * y.e;
-        let e = e0 + self.u * (v + e0) + self.eta;
-        self.check(Mag { v, a: x.a * y.a, e })
-    }
-    fn cross(&mut self, a: [Mag; 3], b: [Mag; 3]) -> [Mag; 3] {
-        let xa = self.mul(a[1], b[2]);
-        let xb = self.mul(a[2], b[1]);
-        let ya = self.mul(a[2], b[0]);
-        let yb = self.mul(a[0], b[2]);
-        let za = self.mul(a[0], b[1]);
-        let zb = self.mul(a[1], b[0]);
-        [self.addsub(xa, xb), self.addsub(ya, yb), self.addsub(za, zb)]
-    }
-    fn dot(&mut self, a: [Mag; 3], b: [Mag; 3]) -> Mag {
-        let x = self.mul(a[0], b[0]);
-        let y = self.mul(a[1], b[1]);
-        let z = self.mul(a[2], b[2]);
-        let xy = self.addsub(x, y);
-        self.addsub(xy, z)
-    }
-}
 
 /// The block's static constants: each compared signal's `E`, or `None` when the block's range
 /// check fails or an input is NaN (then no lane is certified).
@@ -191,31 +126,28 @@ fn fold<const W: usize>(vm: [f64; W], am: [f64; W], bm: [f64; W], nf: [f64; W]) 
 }
 
 fn statics(o: BlockOpts, r: BlockRay, (ve, ae, big, nan): ([f64; 9], [f64; 9], f64, bool)) -> Option<Static> {
-    let mut m = MagCtx { u: o.em.u, eta: o.em.eta, add_eta: o.em.add_eta, max: o.em.max, overflow: false };
     if nan || r.o.iter().chain(&r.d).any(|x| x.is_nan()) {
         return None;
     }
-    // the first differences taken lane by lane (translation does not loosen the constants)
+    // the per-test recurrences on magnitudes (`Ctx` in magnitude mode: a difference adds)
+    let mut m = Ctx::<f64>::new(o.em, true);
     m.input(big);
-    for x in r.o.iter().chain(&r.d) {
+    for x in r.o {
         m.input(x.abs());
     }
-    // a first difference: e = 0 + 0 + u·(|v| + 0) + add_eta, as the per-test sum of two inputs
-    let mut diff = |k: usize| {
-        let e = m.u * ve[k] + m.add_eta;
-        m.check(Mag { v: ve[k], a: ae[k], e })
-    };
-    let e1 = [diff(0), diff(1), diff(2)];
-    let e2 = [diff(3), diff(4), diff(5)];
-    let s = [diff(6), diff(7), diff(8)];
-    let d3 = [r.d[0].abs(), r.d[1].abs(), r.d[2].abs()].map(|x| Mag { v: x, a: x, e: 0.0 });
+    let d3 = r.d.map(|x| m.input(x.abs()));
+    // the first differences taken lane by lane (translation does not loosen the constants)
+    let diff: [Bnd<f64>; 9] = std::array::from_fn(|k| m.input_difference(ve[k], ae[k]));
+    let e1 = [diff[0], diff[1], diff[2]];
+    let e2 = [diff[3], diff[4], diff[5]];
+    let s = [diff[6], diff[7], diff[8]];
     let p = m.cross(d3, e2);
     let q = m.cross(s, e1);
     let det = m.dot(e1, p);
     let up = m.dot(s, p);
     let vp = m.dot(d3, q);
     let tp = m.dot(e2, q);
-    let uv = m.addsub(up, vp);
+    let uv = m.add(up, vp);
     (!m.overflow).then(|| Static { det: det.err(), up: up.err(), vp: vp.err(), tp: tp.err(), uv: uv.err() })
 }
 
@@ -296,21 +228,10 @@ pub fn verdict_block_filtered(
     let mut k = 0;
     for i in 0..n {
         if certified[i] {
-            decisive[i] = true;
-            hit[i] = false;
-            t_err[i] = f64::INFINITY;
+            (decisive[i], hit[i], t_err[i]) = (true, false, f64::INFINITY);
             k += 1;
         } else {
-            let v = [
-                [tris[0][i], tris[1][i], tris[2][i]],
-                [tris[3][i], tris[4][i], tris[5][i]],
-                [tris[6][i], tris[7][i], tris[8][i]],
-            ];
-            let b = RtiBound::<f64>::new(opts.em, opts.div, ray.o, ray.d, v);
-            let vd = b.verdict(opts.cull, opts.det_threshold, ray.tmin, ray.tmax);
-            decisive[i] = vd.decisive;
-            hit[i] = vd.hit;
-            t_err[i] = b.t_err;
+            (decisive[i], hit[i], t_err[i]) = crate::bound::lane(opts, ray, tris, i);
         }
     }
     k
@@ -390,6 +311,7 @@ fn certify(o: BlockOpts, r: BlockRay, st: Static, c: [&[f64]; 9], out: &mut [boo
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bound::RtiBound;
     use crate::rng::SplitMix64;
 
     /// `values` is `RtiBound::new`'s `v` bit for bit (the filter's lane values are the per-test
