@@ -136,6 +136,32 @@ unsafe fn slice_mut<'a>(p: *mut u64, n: usize, what: &str) -> Result<&'a mut [u6
     Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
 }
 
+/// The body of the `*_new` calls that take a unit, a format and options: the strings read
+/// (options null: none), `make` run on them, its result boxed into `*out`.
+///
+/// # Safety
+/// As [`rp_unit_new`].
+unsafe fn create<T>(
+    unit: *const c_char,
+    format: *const c_char,
+    options: *const c_char,
+    out: *mut *mut T,
+    make: impl FnOnce(&str, &str, &str) -> Result<T, String>,
+) -> i32 {
+    guard(|| {
+        if out.is_null() {
+            return Err(Fail(RP_ERR_NULL, "out is a null pointer".into()));
+        }
+        // SAFETY: the caller's promise (null is checked)
+        let (u, f) = unsafe { (text(unit, "unit")?, text(format, "format")?) };
+        let o = if options.is_null() { "" } else { unsafe { text(options, "options")? } };
+        let x = make(u, f, o).map_err(arg)?;
+        // SAFETY: out is non-null and writable (the caller's promise)
+        unsafe { *out = Box::into_raw(Box::new(x)) };
+        Ok(())
+    })
+}
+
 /// raypipe's version, a NUL-terminated string (static).
 #[no_mangle]
 pub extern "C" fn rp_version() -> *const c_char {
@@ -165,18 +191,8 @@ pub unsafe extern "C" fn rp_unit_new(
     options: *const c_char,
     out: *mut *mut RpUnit,
 ) -> i32 {
-    guard(|| {
-        if out.is_null() {
-            return Err(Fail(RP_ERR_NULL, "out is a null pointer".into()));
-        }
-        // SAFETY: the caller's promise (null is checked)
-        let (u, f) = unsafe { (text(unit, "unit")?, text(format, "format")?) };
-        let o = if options.is_null() { "" } else { unsafe { text(options, "options")? } };
-        let h = unit::Unit::new(u, f, o).map_err(arg)?;
-        // SAFETY: out is non-null and writable (the caller's promise)
-        unsafe { *out = Box::into_raw(Box::new(RpUnit(h))) };
-        Ok(())
-    })
+    // SAFETY: the caller's promise (as this function's)
+    unsafe { create(unit, format, options, out, |u, f, o| unit::Unit::new(u, f, o).map(RpUnit)) }
 }
 
 /// Creates a traverse unit handle into `*out` from the vector set in directory `set_dir`
@@ -496,18 +512,8 @@ pub unsafe extern "C" fn rp_cover_new(
     options: *const c_char,
     out: *mut *mut RpCover,
 ) -> i32 {
-    guard(|| {
-        if out.is_null() {
-            return Err(Fail(RP_ERR_NULL, "out is a null pointer".into()));
-        }
-        // SAFETY: the caller's promise (null is checked)
-        let (u, f) = unsafe { (text(unit, "unit")?, text(format, "format")?) };
-        let o = if options.is_null() { "" } else { unsafe { text(options, "options")? } };
-        let r = cover::Recorder::new(u, f, o).map_err(arg)?;
-        // SAFETY: out is non-null and writable (the caller's promise)
-        unsafe { *out = Box::into_raw(Box::new(RpCover(r))) };
-        Ok(())
-    })
+    // SAFETY: the caller's promise (as rp_unit_new's)
+    unsafe { create(unit, format, options, out, |u, f, o| cover::Recorder::new(u, f, o).map(RpCover)) }
 }
 
 /// Counts one input row (`n_inputs` = the unit's [`rp_unit_inputs`] values, the row as
