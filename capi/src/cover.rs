@@ -16,6 +16,8 @@ pub const CLASS: (&str, &str) = ("live", "rows a live testbench drove into its D
 pub struct Recorder {
     unit: Unit,
     run: RunModel,
+    /// The model's row lookup, built once.
+    bins: RowBins,
     state: Mutex<State>,
 }
 
@@ -38,7 +40,8 @@ impl Recorder {
         let mut req = req;
         req.command = "live testbench (raypipe C ABI)".into();
         let run = RunModel::new(&req, Some(&[(CLASS.0, CLASS.1, 1)]))?;
-        Ok(Recorder { unit, run, state: Mutex::new(State::default()) })
+        let bins = RowBins::new(&run.manifest);
+        Ok(Recorder { unit, run, bins, state: Mutex::new(State::default()) })
     }
 
     /// Counts one input row (the C ABI's row: no class column).
@@ -58,8 +61,7 @@ impl Recorder {
         contents[0][0].extend_from_slice(row);
         contents[1][0] = out;
         contents[2][0].clone_from(stages);
-        let bins = RowBins::new(&self.run.manifest);
-        self.run.count(&bins, contents, hits, counts)
+        self.run.count(&self.bins, contents, hits, counts)
     }
 
     /// Values in one input row of the recorder's unit.

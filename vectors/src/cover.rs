@@ -486,10 +486,10 @@ impl Coverage {
 
 /// The bins one row hits, as (coverpoint, bin) indices into [`Coverage::model`]'s order: what
 /// counting and the coverage closure's search share (the compares and operations of the set's
-/// unit found once).
-pub struct RowBins<'a> {
-    m: &'a Manifest,
-    ix: Ix<'a>,
+/// unit found once). It holds what it needs of the manifest, so a long-lived owner (a live
+/// recorder) keeps one.
+pub struct RowBins {
+    ix: Ix,
     ftz: bool,
     cmps: Vec<(u8, &'static str, &'static str, &'static str)>,
     ariths: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
@@ -500,11 +500,10 @@ pub struct RowBins<'a> {
     events: Vec<Event>,
 }
 
-impl<'a> RowBins<'a> {
+impl RowBins {
     /// The lookup for sets with manifest `m`.
-    pub fn new(m: &'a Manifest) -> Self {
+    pub fn new(m: &Manifest) -> Self {
         RowBins {
-            m,
             ix: Ix::new(m),
             ftz: m.format.contains("ftz"),
             cmps: compares(m),
@@ -519,7 +518,7 @@ impl<'a> RowBins<'a> {
 
     /// Appends to `out` the (coverpoint, bin) of every bin row `row` of `contents` hits.
     pub fn hits(&self, contents: &[Vec<Vec<u64>>], row: usize, out: &mut Vec<(usize, usize)>) -> Result<(), String> {
-        let (m, ftz) = (self.m, self.ftz);
+        let (m, ftz) = (&self.ix.m, self.ftz);
         // the expected-output row's flag named by a care_when
         let ix = &self.ix;
         let out_flag = |name: &str| -> Option<bool> {
@@ -1056,7 +1055,7 @@ fn cancellation(
     b: &str,
     ftz: bool,
 ) -> Option<usize> {
-    let m = ix.m;
+    let m = &ix.m;
     let man = m.params.get("man").copied()? as i64;
     let r = operand(ix, contents, row, name, false)??;
     let x = operand(ix, contents, row, a, ftz)??;
@@ -1487,11 +1486,12 @@ fn field<'a>(m: &'a Manifest, name: &str) -> Option<(usize, &'a Field, usize)> {
 }
 
 /// Field positions by name, found once per set for the per-row paths ([`field`]'s answers).
-struct Ix<'a> {
-    m: &'a Manifest,
-    fields: std::collections::HashMap<&'a str, (usize, &'a Field, usize), Fnv>,
+struct Ix {
+    /// The manifest (a copy).
+    m: Manifest,
+    fields: std::collections::HashMap<String, (usize, Field, usize), Fnv>,
     /// The expected-output file's fields (what a care_when names).
-    outs: std::collections::HashMap<&'a str, usize, Fnv>,
+    outs: std::collections::HashMap<String, usize, Fnv>,
 }
 
 /// FNV-1a: the field-name lookups of every row hash short names (SipHash's set-up cost would
@@ -1520,25 +1520,25 @@ impl std::hash::Hasher for FnvHasher {
     }
 }
 
-impl<'a> Ix<'a> {
-    fn new(m: &'a Manifest) -> Self {
+impl Ix {
+    fn new(m: &Manifest) -> Self {
         let mut fields = std::collections::HashMap::with_hasher(Fnv);
         for (i, f) in m.files.iter().enumerate().filter(|(i, _)| per_vector(m, *i)) {
             for (k, x) in f.fields.iter().enumerate() {
-                fields.entry(x.name.as_str()).or_insert((i, x, k));
+                fields.entry(x.name.clone()).or_insert((i, x.clone(), k));
             }
         }
         let mut outs = std::collections::HashMap::with_hasher(Fnv);
         if let Some(f) = m.files.get(1) {
             for (k, x) in f.fields.iter().enumerate() {
-                outs.entry(x.name.as_str()).or_insert(k);
+                outs.entry(x.name.clone()).or_insert(k);
             }
         }
-        Ix { m, fields, outs }
+        Ix { m: m.clone(), fields, outs }
     }
 
-    fn field(&self, name: &str) -> Option<(usize, &'a Field, usize)> {
-        self.fields.get(name).copied()
+    fn field(&self, name: &str) -> Option<(usize, &Field, usize)> {
+        self.fields.get(name).map(|(i, x, k)| (*i, x, *k))
     }
 }
 
