@@ -83,20 +83,9 @@ fn bench_export(c: &mut Criterion) {
     let mut g = c.benchmark_group("vectors");
     let dir = std::env::temp_dir().join(format!("raypipe-bench-vectors-{}", std::process::id()));
     let req = vectors::gen::Request {
-        unit: vectors::gen::Unit::Rti,
-        format: "f32".parse().expect("format"),
         count: 64,
-        seed: 1,
-        level: 1,
-        threads: 1,
         command: "bench".into(),
-        rti: Default::default(),
-        slab_variant: "plain".into(),
-        tree: None,
-        leaves: 8,
-        max_levels: 64,
-        explicit: None,
-        closure: None,
+        ..vectors::gen::Request::new(vectors::gen::Unit::Rti, "f32".parse().expect("format"))
     };
     g.throughput(Throughput::Elements(12 * 64));
     g.bench_function("rti_f32_generate_and_write", |bch| {

@@ -13,6 +13,15 @@ fn set(dir: &std::path::Path, args: &[&str]) {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
+/// `raypipe cover --json ARGS…`, which must succeed.
+fn cover_json(args: &[&str]) -> serde_json::Value {
+    let mut v = vec!["cover", "--json"];
+    v.extend_from_slice(args);
+    let o = raypipe(&v);
+    assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
 #[test]
 fn cover_reports_merges_and_gates() {
     let tmp = std::env::temp_dir().join(format!("raypipe-cover-{}", std::process::id()));
@@ -22,13 +31,7 @@ fn cover_reports_merges_and_gates() {
     set(&a, &["--unit", "op", "--format", "fp16", "--count", "2", "--seed", "1"]);
     set(&b, &["--unit", "op", "--format", "fp16", "--count", "2", "--seed", "2"]);
     set(&f32set, &["--unit", "op", "--format", "f32", "--count", "2"]);
-    let json = |args: &[&str]| -> serde_json::Value {
-        let mut v = vec!["cover", "--json"];
-        v.extend_from_slice(args);
-        let o = raypipe(&v);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        serde_json::from_slice(&o.stdout).unwrap()
-    };
+    let json = cover_json;
     let (sa, sb) = (a.display().to_string(), b.display().to_string());
     let ja = json(&[&sa]);
     let jb = json(&[&sb]);
@@ -221,13 +224,7 @@ fn ops_cover_files_merge_like_one_pass() {
     ops(&["--cover", &p("whole.json")]);
     ops(&["--cover", &p("s0.json"), "--shard", "0/2", "--partial", &p("p0.json")]);
     ops(&["--cover", &p("s1.json"), "--shard", "1/2", "--partial", &p("p1.json")]);
-    let json = |args: &[&str]| -> serde_json::Value {
-        let mut v = vec!["cover", "--json"];
-        v.extend_from_slice(args);
-        let o = raypipe(&v);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        serde_json::from_slice(&o.stdout).unwrap()
-    };
+    let json = cover_json;
     let whole = json(&[&p("whole.json")]);
     let merged = json(&[&p("s0.json"), &p("s1.json")]);
     assert_eq!(whole["vectors"], 30000);
@@ -278,11 +275,7 @@ fn verify_and_stress_cover_count_every_test_and_merge_like_one_pass() {
         assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
         serde_json::from_slice(&o.stdout).unwrap_or(serde_json::Value::Null)
     };
-    let cover = |files: &[&str]| -> serde_json::Value {
-        let mut v = vec!["cover", "--json"];
-        v.extend_from_slice(files);
-        run(&v)
-    };
+    let cover = cover_json;
     let verify = ["verify", "--rays", "40", "--format", "fp16", "--quiet"];
     let rep = run(&[&verify[..], &["--json", "--cover", &p("v.json")]].concat());
     let c = cover(&[&p("v.json")]);
