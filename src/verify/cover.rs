@@ -74,6 +74,7 @@ where
         None => Vec::new(),
     };
     let gen = scene.ray_gen(cfg.seed);
+    let bins: Vec<RowBins> = models.iter().map(|m| RowBins::new(&m.manifest)).collect();
     let progress = engine::Progress::new(cfg.engine.shard_items(cfg.rays), "rays (coverage)", !cfg.progress);
     progress.message(format!("{} coverage", f.name()));
     let acc = engine::run(
@@ -82,7 +83,6 @@ where
         &progress,
         || (Rows::default(), Vec::new()),
         |(rows, list), range| {
-            let bins: Vec<RowBins> = models.iter().map(|m| RowBins::new(&m.manifest)).collect();
             let mut acc = CoverAcc::new(models.len());
             for i in range {
                 let (ray, target) = gen.ray(scene, i);
