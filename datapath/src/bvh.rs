@@ -196,6 +196,11 @@ pub struct StacklessResult {
     /// and the level where the next one turns to the farther child (the thesis's back-traversal
     /// distance, fig. 3-5).
     pub back_distances: Vec<u32>,
+    /// Pairs where both children hit with equal entry t (a tie; compared as numbers, so -0 =
+    /// +0), counted per choice made there: `[the nearer (left) child taken, the farther (right)
+    /// child taken]`. Ties go left first; the right is taken on resuming the pair (10 → 11) or
+    /// passing through it in 11 (the trail: its bit set).
+    pub ties: [u64; 2],
     /// The final per-level state (2-bit history or 1-bit trail).
     pub state: Vec<u8>,
 }
@@ -338,12 +343,19 @@ pub fn history_pass_faulty<B, X: crate::fault::Logic>(
     if let (Some(end), Some(k)) = (*prev_end, resume) {
         r.back_distances.push(end.abs_diff(k) as u32);
     }
+    let ties = &mut r.ties;
+    let mut tie = |a: f64, b: f64, far: bool| {
+        if a == b {
+            ties[far as usize] += 1;
+        }
+    };
     let end = pass(t, &mut test, &mut r.box_tests, &mut r.leaves, |level, el, er| {
         match (h[level], el, er) {
             (hist::NEW, Some(a), Some(b)) => {
                 if x.flag("mark_split", true) {
                     h[level] = hist::SPLIT;
                 }
+                tie(a, b, false);
                 Some(near_far(a, b).0)
             }
             (hist::NEW, Some(_), None) | (hist::PASS, Some(_), None) => {
@@ -363,10 +375,17 @@ pub fn history_pass_faulty<B, X: crate::fault::Logic>(
                 if x.flag("reset_deeper", true) {
                     h[level + 1..].fill(hist::NEW);
                 }
+                tie(a, b, true);
                 Some(near_far(a, b).1)
             }
-            (hist::SPLIT, Some(a), Some(b)) => Some(near_far(a, b).0),
-            (hist::DONE, Some(a), Some(b)) => Some(near_far(a, b).1),
+            (hist::SPLIT, Some(a), Some(b)) => {
+                tie(a, b, false);
+                Some(near_far(a, b).0)
+            }
+            (hist::DONE, Some(a), Some(b)) => {
+                tie(a, b, true);
+                Some(near_far(a, b).1)
+            }
             // NEW with no hit: dead end. Other combinations cannot occur with a
             // deterministic tester; they end the pass as a dead end too.
             _ => None,
@@ -391,6 +410,9 @@ pub fn trail_traverse<B>(t: &HwTree<B>, n: usize, mut test: impl FnMut(&B) -> Op
         let end = pass(t, &mut test, &mut r.box_tests, &mut r.leaves, |level, el, er| match (el, er) {
             (Some(a), Some(b)) => {
                 let (near, far) = near_far(a, b);
+                if a == b {
+                    r.ties[trail[level] as usize] += 1;
+                }
                 Some(if trail[level] == 0 { near } else { far })
             }
             (Some(_), None) => {

@@ -111,11 +111,11 @@ fn check_all_n(nodes: &[NodeDesc], outcome: &dyn Fn(u32) -> Option<f64>) -> Resu
                 return Err(format!("{name} N={n}: back distance {d} deeper than the tree ({})", hw.depth()));
             }
         }
-        // the 1-bit trail retraces the 2-bit history's passes
-        if (t.passes, &t.back_distances) != (h.passes, &h.back_distances) {
+        // the 1-bit trail retraces the 2-bit history's passes (and so its choices at ties)
+        if (t.passes, &t.back_distances, t.ties) != (h.passes, &h.back_distances, h.ties) {
             return Err(format!(
-                "trail N={n}: passes {} back distances {:?}, history {} {:?}",
-                t.passes, t.back_distances, h.passes, h.back_distances
+                "trail N={n}: passes {} back distances {:?} ties {:?}, history {} {:?} {:?}",
+                t.passes, t.back_distances, t.ties, h.passes, h.back_distances, h.ties
             ));
         }
     }
@@ -229,6 +229,13 @@ fn history_states_are_the_thesis_encoding() {
     assert_eq!(h.state, [hist::SPLIT, hist::SPLIT]);
     let h = history_traverse(&hw, 4, |_| Some(0.0));
     assert_eq!(h.state, [hist::DONE, hist::DONE]);
+    // every pair a tie: passes 1-4 take near, near | near, far | far, near | far, far
+    assert_eq!(h.ties, [4, 4]);
+    assert_eq!(trail_traverse(&hw, 4, |_| Some(0.0)).ties, [4, 4]);
+    // distinct entries (node index as t): no tie
+    assert_eq!(history_traverse(&hw, 4, |&i| Some(i as f64)).ties, [0, 0]);
+    // -0 and +0 are equal entries: a tie
+    assert_eq!(history_traverse(&hw, 1, |&i| Some(if i % 2 == 0 { -0.0 } else { 0.0 })).ties, [2, 0]);
     // only the right child of the root hit: 01 at level 0
     let right = nodes[0].children.unwrap()[1];
     let h = history_traverse(&hw, 4, |&i| if i == nodes[0].children.unwrap()[0] { None } else { Some(0.0) });

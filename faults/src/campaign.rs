@@ -252,7 +252,7 @@ pub fn run(m: &Manifest, rows: &[Vec<Vec<u64>>], outputs_only: bool) -> Result<C
     })?;
     // which coverage mattered: the first detecting vector's rarest bins in this set
     let cov = vectors::cover::Coverage::measure(m, rows)?;
-    let row_bins = vectors::cover::RowBins::new(m);
+    let row_bins = vectors::cover::RowBins::new(m).with_set(rows)?;
     let mut hits = Vec::new();
     for o in &mut outcomes {
         let Some(i) = o.first_vector else { continue };

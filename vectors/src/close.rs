@@ -155,7 +155,7 @@ pub fn close(req: &Request, budget: u64) -> Result<Closed, String> {
             .collect();
         let set = generate(&Request { closure: Some(explicit(batch.clone())), ..req.clone() })?;
         let rows = set_rows(&set)?;
-        let bins = RowBins::new(&set.manifest);
+        let bins = RowBins::new(&set.manifest).with_set(&rows)?;
         for (i, cand) in batch.into_iter().enumerate() {
             candidates += 1;
             since += 1;

@@ -15,7 +15,11 @@
 //! - a flag: `0`, `1`;
 //! - the class column: one bin per class of the manifest;
 //! - traverse: the leaves returned (`0`, `1 to N-1`, `N`: the N-limit reached), the passes
-//!   (`0`, `1`, `2`, `3 or more`) and each level's final history state (`00` … `11`);
+//!   (`0`, `1`, `2`, `3 or more`) and each level's final history state (`00` … `11`); and, from
+//!   the ray re-run on the set's own tree (the rows do not hold them), the back-traversal
+//!   distance of each restart (`0`, `1`, `2`, `3 or more` levels) and the ties between siblings
+//!   on the path (`no tie`; a tie where the nearer, left, child is taken; one where the farther,
+//!   right, child is taken: on resuming the pair or passing it in `11`);
 //! - every compare of the stage table (rti `tmin_ok`, `tmax_ok`; slab `hit` and the
 //!   compare-select chain `tn_*`, `tf_*`): the outcome of its operands as the datapath reads
 //!   them (FTZ: a subnormal as zero) — `<`, `=`, `>`, `unordered` (a NaN operand);
@@ -318,7 +322,20 @@ impl Coverage {
         use sha2::{Digest, Sha256};
         use std::io::BufRead;
         let mut c = Self::model(m);
-        let bins = RowBins::new(m);
+        let mut bins = RowBins::new(m);
+        if m.unit == "traverse" {
+            // the tree images (small, read whole; their hashes are checked with the rest below)
+            let mut images = Vec::new();
+            for (i, fm) in m.files.iter().enumerate() {
+                images.push(if per_vector(m, i) {
+                    Vec::new()
+                } else {
+                    let t = std::fs::read_to_string(dir.join(&fm.name)).map_err(|e| format!("{}: {e}", fm.name))?;
+                    crate::read::parse_rows(fm, &t)?
+                });
+            }
+            bins = bins.with_set(&images)?;
+        }
         let mut readers = Vec::new();
         for (i, fm) in m.files.iter().enumerate() {
             let file = std::fs::File::open(dir.join(&fm.name)).map_err(|e| format!("{}: {e}", fm.name))?;
@@ -391,7 +408,7 @@ impl Coverage {
         contents: &[Vec<Vec<u64>>],
         range: std::ops::Range<usize>,
     ) -> Result<(), String> {
-        let bins = RowBins::new(m);
+        let bins = RowBins::new(m).with_set(contents)?;
         let mut hits = Vec::new();
         for row in range {
             hits.clear();
@@ -498,6 +515,8 @@ pub struct RowBins {
     crossed: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
     min_normal: f64,
     events: Vec<Event>,
+    /// The traverse unit: the set's tree, to re-run each ray for its path events.
+    path: Option<crate::traverse::PathReplay>,
 }
 
 impl RowBins {
@@ -513,7 +532,19 @@ impl RowBins {
             crossed: crossed_rows(m),
             min_normal: min_normal(m),
             events: events(m),
+            path: None,
         }
+    }
+
+    /// The lookup with what a unit's rows alone do not give, taken from the set's `contents`
+    /// (its files in manifest order): for the traverse unit, the tree from its BRAM images (the
+    /// per-vector files may be empty), whose re-run of each ray gives the back-traversal
+    /// distances and ties. Other units: unchanged.
+    pub fn with_set(mut self, contents: &[Vec<Vec<u64>>]) -> Result<Self, String> {
+        if self.ix.m.unit == "traverse" {
+            self.path = Some(crate::traverse::PathReplay::from_set(&self.ix.m, contents)?);
+        }
+        Ok(self)
     }
 
     /// Appends to `out` the (coverpoint, bin) of every bin row `row` of `contents` hits.
@@ -589,7 +620,35 @@ impl RowBins {
             }
             cp += 1;
         }
+        let path = match (&self.path, self.events.contains(&Event::TraverseBack)) {
+            (Some(p), _) => {
+                let ray = contents.first().and_then(|c| c.get(row)).ok_or(format!("no input row {}", row + 1))?;
+                Some(p.events(ray))
+            }
+            (None, true) => {
+                return Err("the traverse unit's path coverage re-runs each ray on the set's tree: the lookup needs the set's tree images (RowBins::with_set)".into())
+            }
+            (None, false) => None,
+        };
         for e in &self.events {
+            if let (Some(p), Event::TraverseBack) = (&path, e) {
+                // each restart's distance, once per ray per bin
+                let mut seen = [false; BACK_BINS.len()];
+                for &d in &p.back_distances {
+                    seen[(d as usize).min(BACK_BINS.len() - 1)] = true;
+                }
+                out.extend(seen.iter().enumerate().filter(|x| *x.1).map(|(b, _)| (cp, b)));
+                cp += 1;
+                continue;
+            }
+            if let (Some(p), Event::TraverseTie) = (&path, e) {
+                if p.ties == [0, 0] {
+                    out.push((cp, 0));
+                }
+                out.extend((0..2).filter(|&k| p.ties[k] > 0).map(|k| (cp, k + 1)));
+                cp += 1;
+                continue;
+            }
             let v = |n: &str| operand(ix, contents, row, n, ftz);
             let flag = |n: &str| {
                 ix.field(n).and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied()).map(|b| b & 1 == 1)
@@ -748,6 +807,10 @@ pub const WHY_EMBREE_FIXED: &str = "embree preparation: |d| < delta becomes +-de
 /// Why a class bin stays empty.
 pub const WHY_NO_CLASS_ROWS: &str =
     "the class has no vectors in this format (its manifest count is 0: a floats-only class in fixed point)";
+/// The bins of the traverse unit's back-traversal distance (levels per restart).
+pub const BACK_BINS: [&str; 4] = ["0", "1", "2", "3 or more"];
+/// Why a back-traversal distance exceeds what the tree allows.
+pub const WHY_BACK_DEPTH: &str = "a restart resumes at a level of the tree from a pass that ended at one: with L levels (params.levels) the distance is at most L - 1";
 /// Why a fixed-point reciprocal is never 0 or one step.
 pub const WHY_FIXED_RECIP: &str = "every value x of qI.F (I integer bits, F fraction bits) has |x| < 2^(I-1), so |1/x| > 2^(F-I+1) steps >= 2 steps when F >= I (and 1/0 and a too large 1/x saturate): no rounding gives 0 or one step";
 /// Why the RTI unit's fixed-point t, u and v are never negative where they are compared.
@@ -1146,7 +1209,7 @@ fn cross_reason(m: &Manifest, b: &str, bin: &str) -> Option<&'static str> {
 }
 
 /// A per-unit event coverpoint.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Event {
     /// RTI: det against the threshold (and its sign).
     RtiDet,
@@ -1156,6 +1219,9 @@ enum Event {
     SlabExtent(usize),
     /// Slab, conservative: which guard fired.
     SlabGuard,
+    /// Slab, a variant without the guard: where the conservative guard would fire (the cross
+    /// guard × variant, read across the variants' models).
+    SlabGuardCondition,
     /// Capture: a hit whose t equals the held hit's.
     CaptureTie,
     /// RTI, a valid hit: where its barycentric `u` (0) or `v` (1) is: at 0, at 1, between or
@@ -1165,6 +1231,10 @@ enum Event {
     RtiT,
     /// Slab, a hit: the entry distance against the exit distance before widening.
     SlabTouch,
+    /// Traverse: the back-traversal distance of each restart (the ray re-run on the set's tree).
+    TraverseBack,
+    /// Traverse: ties between siblings on the ray's path and the child taken at each.
+    TraverseTie,
 }
 
 const AXES: [&str; 3] = ["x", "y", "z"];
@@ -1176,8 +1246,12 @@ fn events(m: &Manifest) -> Vec<Event> {
         "rti" if field(m, "det").is_some() => vec![Event::RtiDet, Event::RtiBary(0), Event::RtiBary(1), Event::RtiT],
         "slab" => {
             let mut v: Vec<Event> = (0..3).map(Event::SlabOrigin).chain((0..3).map(Event::SlabExtent)).collect();
-            if m.params.get("slab_guard") == Some(&1) && float {
-                v.push(Event::SlabGuard);
+            if float {
+                v.push(if m.params.get("slab_guard") == Some(&1) {
+                    Event::SlabGuard
+                } else {
+                    Event::SlabGuardCondition
+                });
             }
             if field(m, "tn_xyz").is_some() {
                 v.push(Event::SlabTouch);
@@ -1185,6 +1259,7 @@ fn events(m: &Manifest) -> Vec<Event> {
             v
         }
         "capture" => vec![Event::CaptureTie],
+        "traverse" => vec![Event::TraverseBack, Event::TraverseTie],
         _ => Vec::new(),
     }
 }
@@ -1207,10 +1282,13 @@ impl Event {
             Event::SlabOrigin(a) => format!("origin against the box, axis {}", AXES[a]),
             Event::SlabExtent(a) => format!("box extent, axis {}", AXES[a]),
             Event::SlabGuard => "conservative guard fired".into(),
+            Event::SlabGuardCondition => "the conservative guard's condition (this variant has no guard)".into(),
             Event::CaptureTie => "a hit's t equals the held hit's t".into(),
             Event::RtiBary(k) => format!("{} of a valid hit", ["u", "v"][k]),
             Event::RtiT => "t of a valid hit against tmin and tmax".into(),
             Event::SlabTouch => "a hit's entry against its exit (tn_xyz vs tf_xyz)".into(),
+            Event::TraverseBack => "back-traversal distance of a restart (levels)".into(),
+            Event::TraverseTie => "siblings both hit at equal entry t (a tie) on the path".into(),
         }
     }
 
@@ -1234,6 +1312,11 @@ impl Event {
             ],
             Event::SlabExtent(_) => &["min < max", "min = max (zero extent)", "min > max (empty)", "NaN"],
             Event::SlabGuard => &["no guard", "reciprocal guarded", "difference guarded"],
+            Event::SlabGuardCondition => &[
+                "no guard condition",
+                "1/d of a finite nonzero d is inf, zero or subnormal",
+                "o - face of finite operands overflows",
+            ],
             Event::CaptureTie => &["no tie", "tie (the tie rule decides)"],
             Event::RtiBary(0) => {
                 &["u = 0 (on the edge v0-v2)", "0 < u < 1", "u = 1 (at the vertex v1)", "other (past 1, inf, NaN)"]
@@ -1247,6 +1330,10 @@ impl Event {
                 "entry = exit (touching: an edge, a corner or a zero-extent box)",
                 "entry > exit (a hit by widening)",
             ],
+            Event::TraverseBack => &BACK_BINS,
+            Event::TraverseTie => {
+                &["no tie", "tie, the nearer (left) child taken", "tie, the farther (right) child taken"]
+            }
         }
     }
 
@@ -1268,6 +1355,12 @@ impl Event {
             (Event::RtiDet, "0 < det <= threshold" | "-threshold <= det < 0") if zero_thr => Some(WHY_ZERO_THRESHOLD),
             (Event::SlabTouch, "entry > exit (a hit by widening)") if widen == 0 => Some(WHY_NO_WIDENING),
             (Event::RtiT, "other (past an end, NaN)") => Some(WHY_HIT_T_IN_RANGE),
+            (Event::TraverseBack, b) => {
+                // a restart resumes at a level 0..levels-1 from a pass that ended at one
+                let levels = m.params.get("levels").copied().unwrap_or(0);
+                let least = BACK_BINS.iter().position(|&x| x == b).unwrap_or(0) as u64;
+                (least + 1 > levels).then_some(WHY_BACK_DEPTH)
+            }
             _ => None,
         }
     }
@@ -1326,20 +1419,36 @@ impl Event {
                     _ => 3,
                 }]
             }
-            Event::SlabGuard => {
+            Event::SlabGuard | Event::SlabGuardCondition => {
                 let finite = |x: Option<Option<f64>>| matches!(x, Some(Some(x)) if x.is_finite());
-                let nan = |x: Option<Option<f64>>| matches!(x, Some(None));
+                // the guard writes NaN where its condition holds; without it the value stands
+                let min_normal = min_normal(m);
+                let guarded = self == Event::SlabGuard;
+                let tiny_or_inf = |x: Option<Option<f64>>| {
+                    if guarded {
+                        matches!(x, Some(None))
+                    } else {
+                        matches!(x, Some(Some(v)) if !v.is_finite() || v.abs() < min_normal)
+                    }
+                };
+                let overflowed = |x: Option<Option<f64>>| {
+                    if guarded {
+                        matches!(x, Some(None))
+                    } else {
+                        matches!(x, Some(Some(v)) if v.is_infinite())
+                    }
+                };
                 let mut out = Vec::new();
                 for (pd, inv) in [("pdx", "inv_dx"), ("pdy", "inv_dy"), ("pdz", "inv_dz")] {
                     let d = num(pd);
-                    if finite(d) && d != Some(Some(0.0)) && nan(num(inv)) {
+                    if finite(d) && d != Some(Some(0.0)) && tiny_or_inf(num(inv)) {
                         out.push(1);
                         break;
                     }
                 }
                 'sub: for a in 0..3 {
                     for (r, b) in [(["lox", "loy", "loz"][a], MINS[a]), (["hix", "hiy", "hiz"][a], MAXS[a])] {
-                        if finite(num(b)) && finite(num(["ox", "oy", "oz"][a])) && nan(num(r)) {
+                        if finite(num(b)) && finite(num(["ox", "oy", "oz"][a])) && overflowed(num(r)) {
                             out.push(2);
                             break 'sub;
                         }
@@ -1388,6 +1497,8 @@ impl Event {
                     _ => Vec::new(),
                 }
             }
+            // measured from the replayed path (RowBins::hits), not from the row's fields
+            Event::TraverseBack | Event::TraverseTie => Vec::new(),
             Event::CaptureTie => {
                 let slots = m.params.get("slots").copied().unwrap_or(0) as usize;
                 let tie = (1..slots).any(|s| {

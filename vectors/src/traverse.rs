@@ -490,3 +490,49 @@ pub fn expected_for<F: Format>(
     let empty = BTreeMap::new();
     Ok(expected_row(&run(&s, &hw, n, &bits, &empty, u32::MAX, &NoFault).result, n, hw.depth()))
 }
+
+/// What a ray's traversal did that its expected row does not hold: the back-traversal
+/// distance of each restart and the ties between siblings (coverage events; [`PathReplay`]).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct PathEvents {
+    /// Per restart, the levels between where the previous pass ended and where the next one
+    /// turns to the farther child.
+    pub back_distances: Vec<u32>,
+    /// Ties (both children hit at equal entry t): `[nearer (left) taken, farther (right) taken]`.
+    pub ties: [u64; 2],
+}
+
+type ReplayFn = dyn Fn(&[u64]) -> PathEvents + Send + Sync;
+
+/// A traverse set's tree and slab tester, rebuilt from its BRAM images, that re-runs a ray of
+/// the set: the path events of its traversal (the same traversal as the set's expected rows).
+pub struct PathReplay(Box<ReplayFn>);
+
+impl PathReplay {
+    /// The replay of the traverse set with manifest `m` and rows `contents` (its files in
+    /// manifest order; the per-vector files may be empty, the tree images must be whole).
+    pub fn from_set(m: &crate::manifest::Manifest, contents: &[Vec<Vec<u64>>]) -> Result<Self, String> {
+        let any: datapath::AnyFormat = m.format.parse().map_err(|e| format!("manifest.json: field format: {e}"))?;
+        let n = m.params.get("leaves").copied().ok_or("manifest has no leaves parameter")? as usize;
+        let variant = m.options.get("variant").map_or("plain", |s| s.as_str()).to_string();
+        let (root, images) = crate::read::tree_images(m, contents)?;
+        let banks: Vec<BankRows> = images.into_iter().map(|(a, b)| (a.clone(), b.clone())).collect();
+        datapath::with_format!(any, |f| {
+            let s = Slab::new(f, SlabConfig::named(&variant)?);
+            let hw = tree_from_images(&s, root, &banks)?;
+            let empty = BTreeMap::new();
+            Ok(PathReplay(Box::new(move |bits: &[u64]| {
+                let r = run(&s, &hw, n, bits, &empty, u32::MAX, &NoFault).result;
+                PathEvents { back_distances: r.back_distances, ties: r.ties }
+            })))
+        })
+    }
+
+    /// The path events of the ray with input row `ray` (class id, then o, d, tmin, tmax).
+    pub fn events(&self, ray: &[u64]) -> PathEvents {
+        match ray.get(1..) {
+            Some(bits) if bits.len() == RAY_INPUTS.len() => (self.0)(bits),
+            _ => PathEvents::default(),
+        }
+    }
+}

@@ -337,3 +337,61 @@ fn options_classes_and_coverage_files() {
     bad["version"] = 3.into();
     assert!(vectors::cover_file::read(&bad.to_string()).is_err());
 }
+
+/// Two levels, four leaves that are the same unit cube (every box of the tree is it): a ray
+/// through the cube ties every pair of siblings.
+fn stacked_tree() -> vectors::traverse::TreeInput {
+    use datapath::bvh::NodeDesc;
+    let (min, max) = ([0.0; 3], [1.0; 3]);
+    let leaf = |id: u32| NodeDesc { children: None, leaf: id, min, max };
+    let inner = |l: u32, r: u32| NodeDesc { children: Some([l, r]), leaf: 0, min, max };
+    let nodes = vec![inner(1, 2), inner(3, 4), inner(5, 6), leaf(0), leaf(1), leaf(2), leaf(3)];
+    vectors::traverse::TreeInput { name: "stacked".into(), nodes, root: 0 }
+}
+
+/// The traverse unit's path events by hand. A ray through the stacked cubes, N = 8: pass 1
+/// takes the near (left) child at both levels (2 ties, near), pass 2 resumes level 1 (the
+/// pass ended there: distance 0) and takes its far child (level 0 passed near), pass 3
+/// resumes level 0 (from level 1: distance 1; far) and takes the new level 1 near, pass 4
+/// resumes level 1 (distance 0) with level 0 in 11 (far, far): ties near 4, far 4. A ray
+/// missing the root: no tie, no restart. The same counts streamed from disk.
+#[test]
+fn traverse_back_distances_and_ties_by_hand() {
+    let f = |x: f64| (x as f32).to_bits() as u64;
+    let through = [-1.0, 0.5, 0.5, 1.0, 0.0, 0.0, 0.0, f64::INFINITY].map(f).to_vec();
+    let miss = [-1.0, 5.0, 0.5, 1.0, 0.0, 0.0, 0.0, f64::INFINITY].map(f).to_vec();
+    let mut r = Request::new(Unit::Traverse, "f32".parse().unwrap());
+    r.count = 1;
+    r.command = "test".into();
+    r.tree = Some(stacked_tree());
+    r.leaves = 8;
+    r.closure = Some(vectors::gen::Explicit { rows: vec![through, miss], ..explicit_close() });
+    let set = generate(&r).unwrap();
+    assert_eq!(set.manifest.params["levels"], 2);
+    let rows = set_rows(&set).unwrap();
+    let n = rows[0].len();
+    let mut c = Coverage::model(&set.manifest);
+    let counts = |c: &Coverage, sig: &str| -> Vec<u64> {
+        c.coverpoints.iter().find(|p| p.signal.starts_with(sig)).unwrap().bins.iter().map(|b| b.count).collect()
+    };
+    c.add_rows(&set.manifest, &rows, n - 2..n - 1).unwrap();
+    assert_eq!(counts(&c, "back-traversal distance"), [1, 1, 0, 0]);
+    assert_eq!(counts(&c, "siblings both hit"), [0, 1, 1]);
+    c.add_rows(&set.manifest, &rows, n - 1..n).unwrap();
+    assert_eq!(counts(&c, "back-traversal distance"), [1, 1, 0, 0]);
+    assert_eq!(counts(&c, "siblings both hit"), [1, 1, 1]);
+    // two levels: a distance of 2 or more cannot happen, and the model says why
+    let back = c.coverpoints.iter().find(|p| p.signal.starts_with("back-traversal")).unwrap();
+    assert_eq!(back.bins.iter().map(|b| b.unreachable.is_some()).collect::<Vec<_>>(), [false, false, true, true]);
+    // a lookup without the tree refuses a traverse row instead of counting nothing
+    let mut hits = Vec::new();
+    assert!(vectors::cover::RowBins::new(&set.manifest).hits(&rows, 0, &mut hits).unwrap_err().contains("tree"));
+    // streamed from disk (the tree images read whole, the rays row by row): the same counts
+    let dir = std::env::temp_dir().join(format!("raypipe-cover-traverse-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    vectors::write::write_set(&set, &dir).unwrap();
+    let m: vectors::manifest::Manifest =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(Coverage::measure_dir(&dir, &m).unwrap(), Coverage::measure(&set.manifest, &rows).unwrap());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -474,6 +474,7 @@ impl Search {
             history_pass_faulty(&self.tree, n_limit, test, &mut r, &mut prev_end, &self.mutant)
         };
         r.back_distances.clear();
+        r.ties = [0; 2];
         if let Some(v) = forbidden {
             return Err(Fail {
                 reason: format!("a history pass tested the children of node {v:?}, in finished or missed work"),
