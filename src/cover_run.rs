@@ -64,6 +64,26 @@ pub fn slab_model(
     RunModel::new(&req, Some(classes))
 }
 
+/// The traverse unit's model in `format`: slab variant `variant`, the BVH `tree`, the first `n`
+/// leaves, `levels` level pipelines, its class bins `classes`.
+pub fn traverse_model(
+    format: AnyFormat,
+    variant: &str,
+    tree: vectors::traverse::TreeInput,
+    (n, levels): (usize, usize),
+    classes: &[(&str, &str, usize)],
+    command: &str,
+) -> Result<RunModel, String> {
+    let mut req = Request::new(Unit::Traverse, format);
+    req.slab_variant = variant.into();
+    req.tree = Some(tree);
+    req.leaves = n;
+    req.max_levels = levels;
+    req.count = 1;
+    req.command = command.into();
+    RunModel::new(&req, Some(classes))
+}
+
 /// A worker's row buffers: the input, expected-output and stage-signal rows of one test.
 pub struct Rows {
     contents: Vec<Vec<Vec<u64>>>,
@@ -121,6 +141,28 @@ impl Rows {
         self.contents[1][0] = expected;
         self.contents[2][0] = stages;
         run.count(bins, &self.contents, &mut self.hits, acc).expect("a slab row of its own unit");
+    }
+
+    /// Counts one ray of class `class` (`bits`: o, d, tmin, tmax as the format holds them)
+    /// traversed on `hw` (the model's own tree) for the first `n` leaves into `acc` under model
+    /// `run`, whose lookup `bins` re-runs it for its path events.
+    #[allow(clippy::too_many_arguments)]
+    pub fn traverse<F: Format>(
+        &mut self,
+        (run, bins): (&RunModel, &RowBins),
+        slab: &Slab<F>,
+        hw: &datapath::bvh::HwTree<Aabb<F::V>>,
+        n: usize,
+        class: u64,
+        bits: &[u64; 8],
+        acc: &mut CoverCounts,
+    ) {
+        let inputs = &mut self.contents[0][0];
+        inputs.clear();
+        inputs.push(class);
+        inputs.extend_from_slice(bits);
+        self.contents[1][0] = vectors::traverse::ray_row(slab, hw, n, bits, &datapath::fault::NoFault);
+        run.count(bins, &self.contents, &mut self.hits, acc).expect("a traverse row of its own unit");
     }
 }
 

@@ -2,6 +2,8 @@
 //! against the ordered stack traversal on a scene's BVH, ray by ray, with every format's slab
 //! unit as the box tester: the same first N leaves in the same order, plus the work each does.
 
+pub mod cover;
+
 use crate::bvh::{build, SceneBvh};
 use crate::scene::Scene;
 use datapath::bvh::{history_traverse, trail_traverse, HwTree};

@@ -368,3 +368,67 @@ fn verify_and_stress_cover_count_every_test_and_merge_like_one_pass() {
 fn rti_set(dir: &std::path::Path) {
     set(dir, &["--unit", "rti", "--format", "fp16", "--count", "1"]);
 }
+
+/// `traverse --cover`: one traverse model per format on the run's BVH; every ray counted once;
+/// rays with a restart (two or more passes) are the rays that reach a back-traversal distance
+/// bin; the shards' files merged equal the one-pass file, which merges with a vector set of the
+/// built-in scene; the directed variant (no traverse model) is refused before the run.
+#[test]
+fn traverse_cover_counts_every_ray_and_merges_like_one_pass() {
+    let tmp = std::env::temp_dir().join(format!("raypipe-travcover-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).unwrap();
+    let p = |n: &str| tmp.join(n).display().to_string();
+    let run = |args: &[&str]| -> serde_json::Value {
+        let o = raypipe(args);
+        assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap_or(serde_json::Value::Null)
+    };
+    let trav = ["traverse", "--rays", "600", "--format", "fp16,f32", "--quiet"];
+    let rep = run(&[&trav[..], &["--json", "--cover", &p("t.json")]].concat());
+    let c = cover_json(&[&p("t.json")]);
+    let models = c["models"].as_array().unwrap();
+    assert_eq!(models.len(), 2);
+    for (m, row) in models.iter().zip(rep["rows"].as_array().unwrap()) {
+        assert_eq!(m["unit"], "traverse");
+        assert_eq!(m["format"], row["format"]);
+        assert_eq!(m["vectors"], row["rays"]);
+        let passes = |b: &str| bin_count(m, "expected outputs", "passes", b);
+        let restarted = passes("2") + passes("3 or more");
+        assert!(restarted > 0, "{}", m["format"]);
+        let back: Vec<u64> = ["0", "1", "2", "3 or more"]
+            .iter()
+            .map(|b| bin_count(m, "events", "back-traversal distance of a restart (levels)", b))
+            .collect();
+        // each restarted ray reaches one to four distance bins, and no other ray reaches any
+        let total: u64 = back.iter().sum();
+        assert!(restarted <= total && total <= 4 * restarted, "{back:?} vs {restarted}");
+        // the report's restarts: at least one per restarted ray
+        assert!(row["restarts"].as_u64().unwrap() >= restarted);
+        let ties: Vec<u64> = ["no tie", "tie, the nearer (left) child taken", "tie, the farther (right) child taken"]
+            .iter()
+            .map(|b| bin_count(m, "events", "siblings both hit at equal entry t (a tie) on the path", b))
+            .collect();
+        // every ray is counted in the tie coverpoint: in `no tie` or in one or both tie bins
+        let rays = m["vectors"].as_u64().unwrap();
+        assert!(ties[0] + ties[1].max(ties[2]) <= rays && rays <= ties.iter().sum::<u64>(), "{ties:?} of {rays}");
+    }
+    // two shards' files merged equal the one pass
+    run(&[&trav[..], &["--shard", "0/2", "--partial", &p("p0.json"), "--cover", &p("s0.json")]].concat());
+    run(&[&trav[..], &["--shard", "1/2", "--partial", &p("p1.json"), "--cover", &p("s1.json")]].concat());
+    assert_eq!(cover_json(&[&p("s0.json"), &p("s1.json")])["models"], c["models"]);
+    // with the built-in scene's traverse set: one model, the set's classes beside `scene`
+    let set = p("set");
+    let o = raypipe(&["vectors", "--unit", "traverse", "--format", "fp16", "--count", "2", "--out", &set]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let both = cover_json(&[&p("t.json"), &set]);
+    let fp16 = &both["models"][0];
+    assert_eq!(bin_count(fp16, "inputs", "class", "scene"), 600);
+    assert!(bin_count(fp16, "inputs", "class", "primary") > 0);
+    // directed: refused before the run (exit 2), nothing written
+    let o = raypipe(&["traverse", "--rays", "10", "--variant", "directed", "--cover", &p("d.json")]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("directed"));
+    assert!(!tmp.join("d.json").exists());
+    let _ = std::fs::remove_dir_all(&tmp);
+}

@@ -32,6 +32,11 @@ pub struct Args {
     /// Print the results as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Also measure the functional coverage of the run's rays (per format the traverse unit's
+    /// coverage model on the run's BVH; a pass of its own, the report unchanged) and write it to
+    /// FILE (`raypipe cover FILE…` reports and merges it; docs/coverage.md).
+    #[arg(long)]
+    pub cover: Option<PathBuf>,
     #[command(flatten)]
     pub run: EngineArgs,
     #[command(flatten)]
@@ -40,8 +45,18 @@ pub struct Args {
 
 /// Runs `raypipe traverse`.
 pub fn run(a: Args) -> Result<Outcome, String> {
-    let Args { scene, format, variant, rays, seed, n, leaf_size, levels, json, run, sharding } = a;
+    let Args { scene, format, variant, rays, seed, n, leaf_size, levels, json, cover, run, sharding } = a;
     check_rays(rays)?;
+    if let Some(c) = &cover {
+        // before the work: a file raypipe did not write is never replaced
+        check_written_path("--cover", c, vectors::cover_file::KIND)?;
+        if variant == "directed" {
+            return Err(
+                "--cover: the traverse unit's coverage model has the slab variants plain, conservative, take-on-false and embree as its box tester (directed has none)"
+                    .into(),
+            );
+        }
+    }
     let sh = shard_of(sharding.shard.as_deref(), sharding.partial.as_deref())?;
     let scene = load_scene(scene.as_deref())?;
     let cfg = raypipe::traverse::TraverseConfig {
@@ -56,6 +71,10 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         progress: !run.quiet,
     };
     let rep = raypipe::traverse::traverse(&cfg, &scene)?;
+    if let Some(path) = &cover {
+        let models = raypipe::traverse::cover::cover(&cfg, &scene, &command_as_typed())?;
+        raypipe::cover_run::write(path, &models, &command_as_typed())?;
+    }
     let id = Run {
         args: raypipe::traverse::args(&cfg),
         scene_hash: raypipe::partial::scene_hash(&scene),

@@ -148,6 +148,9 @@ pub struct RunModel {
     pub model: Coverage,
     offsets: Vec<usize>,
     total: usize,
+    /// The traverse unit: the set's files with its tree images (the per-vector files empty),
+    /// what [`RowBins::with_set`] needs; other units: empty.
+    images: Vec<Vec<Vec<u64>>>,
 }
 
 impl RunModel {
@@ -155,7 +158,18 @@ impl RunModel {
     /// the class in the run) in place of the set's classes: the class bins are then the run's
     /// stimulus classes.
     pub fn new(req: &crate::gen::Request, classes: Option<&[(&str, &str, usize)]>) -> Result<Self, String> {
-        let mut manifest = crate::gen::generate(req)?.manifest;
+        let set = crate::gen::generate(req)?;
+        let images = if set.manifest.unit == "traverse" {
+            let mut rows = crate::read::set_rows(&set)?;
+            // keep the tree images only (the per-vector files are the first two: inputs, expected)
+            for r in rows.iter_mut().take(2) {
+                r.clear();
+            }
+            rows
+        } else {
+            Vec::new()
+        };
+        let mut manifest = set.manifest;
         if let Some(classes) = classes {
             manifest.classes = classes
                 .iter()
@@ -171,7 +185,18 @@ impl RunModel {
         manifest.command = req.command.clone();
         let model = Coverage::model(&manifest);
         let (offsets, total) = offsets(&model);
-        Ok(RunModel { manifest, model, offsets, total })
+        Ok(RunModel { manifest, model, offsets, total, images })
+    }
+
+    /// This model's row lookup (for the traverse unit with the set's tree, to re-run each ray).
+    pub fn row_bins(&self) -> Result<RowBins, String> {
+        RowBins::new(&self.manifest).with_set(&self.images)
+    }
+
+    /// The traverse unit: the set's tree images as [`crate::read::tree_images`] reads them
+    /// (the root entry row and each level's banks); other units: an error.
+    pub fn tree_images(&self) -> Result<(&[u64], Vec<crate::read::BankImages<'_>>), String> {
+        crate::read::tree_images(&self.manifest, &self.images)
     }
 
     /// Counts row 0 of `contents` (every file's row, unpacked) into `acc`; `bins` is this
