@@ -185,7 +185,9 @@ pub fn close(req: &Request, budget: u64) -> Result<Closed, String> {
 /// the template itself (D = 1), with o.x or o.z the smallest normal (u or v at the smallest
 /// normal), o.y = −max (t at the largest finite value), D = ±2^−emin (1/det at ±the smallest
 /// normal) and D the value below 1 with o.y = −max (t' x (1/det) above the largest finite);
-/// and three placements whose differences lose M + 1 bits (p.y, p.z, det_xy, u'_xy, v'_xy).
+/// and three placements whose differences lose M + 1 bits (p.y, p.z, det_xy, u'_xy, v'_xy);
+/// and two triangles for the crosses after `valid`: t' = +inf with 1/det = +inf (a subnormal
+/// det), and v' subnormal with 1/det subnormal (det = 2^emax).
 fn templates(unit: Unit, kinds: &[Kind]) -> Vec<Vec<u64>> {
     let Some(Kind::Ieee { exp, man }) = kinds.first() else { return Vec::new() };
     let (exp, man) = (*exp, *man);
@@ -219,6 +221,8 @@ fn templates(unit: Unit, kinds: &[Kind]) -> Vec<Vec<u64>> {
         b
     };
     let neg_emin = pow2(bias as i64 - 1); // 2^−emin = 2^(bias − 1)
+    let two = pow2(1);
+    let half_max = ((((1u64 << exp) - 3) << man) | ((1u64 << man) - 1)) & !sign; // max / 2
     vec![
         base.clone(),
         with(&[(0, min_normal)]),
@@ -236,6 +240,14 @@ fn templates(unit: Unit, kinds: &[Kind]) -> Vec<Vec<u64>> {
         with(&[(2, one), (3, one - 1), (12, one)]),
         // and with o = (1, 1, 1): u'_xy = 1 - p1
         with(&[(0, one), (1, one), (2, one), (3, one - 1), (12, one)]),
+        // after valid, t' infinite times an infinite 1/det: e1 = (2, 0, 0), e2 = (0, 2, 0),
+        // o = (0, 0, max/2), d = (0, 0, -tiny): q = (0, max, 0), t' = 2 max = +inf, p = (2 tiny,
+        // 0, 0), det = 4 tiny (subnormal, 1/det overflows), u' = 0, v' = -0
+        vec![0, 0, half_max, 0, 0, sign | 1, 0, inf, 0, 0, 0, two, 0, 0, 0, two, 0],
+        // after valid, v' subnormal times a subnormal 1/det: e1 = (1, 0, 0), e2 = (0, 1, 0),
+        // o = (0, 0, 1), d = (0, tiny, -2^emax): p = (2^emax, 0, 0), det = 2^emax (1/det =
+        // 2^-emax, subnormal), q = (0, 1, 0), t' = 1, u' = 0, v' = tiny
+        vec![0, 0, one, 0, 1, pow2(bias as i64) | sign, 0, inf, 0, 0, 0, one, 0, 0, 0, one, 0],
     ]
 }
 

@@ -270,7 +270,7 @@ impl Coverage {
                     .iter()
                     .flat_map(|x| CROSS_CLASSES.iter().map(move |y| format!("{x} x {y}")))
                     .map(|n| {
-                        let unreachable = cross_reason(m, b, &n);
+                        let unreachable = cross_reason(m, (name, a, b), &n);
                         Bin { name: n, count: 0, unreachable }
                     })
                     .collect(),
@@ -614,8 +614,13 @@ impl RowBins {
             }
             cp += 1;
         }
-        for &(_, _, _, a, b) in &self.crossed {
-            if let (Some(x), Some(y)) = (operand(ix, contents, row, a, ftz), operand(ix, contents, row, b, ftz)) {
+        for &(_, name, _, a, b) in &self.crossed {
+            // a result gated by a care flag (RTI after `valid`): counted only where it is defined
+            let cared =
+                ix.field(name).and_then(|(_, x, _)| x.care_when.as_deref()).is_none_or(|c| out_flag(c) != Some(false));
+            if let (true, Some(x), Some(y)) =
+                (cared, operand(ix, contents, row, a, ftz), operand(ix, contents, row, b, ftz))
+            {
                 out.push((cp, cross_class(x, self.min_normal) * CROSS_CLASSES.len() + cross_class(y, self.min_normal)));
             }
             cp += 1;
@@ -1185,16 +1190,30 @@ fn cancel_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static st
 /// signals after RTI's valid bit are defined only where valid is 1, which constrains their
 /// operands; they are not crossed).
 fn crossed_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str, &'static str)> {
-    arith_rows(m)
-        .into_iter()
-        .filter(|&(_, name, _, a, _)| a != "one" && field(m, name).is_some_and(|x| x.1.care_when.is_none()))
-        .collect()
+    arith_rows(m).into_iter().filter(|&(_, name, _, a, _)| a != "one" && field(m, name).is_some()).collect()
 }
 
 /// Why a cross bin is unreachable (`b` the second operand's signal, `bin` "x x y").
-fn cross_reason(m: &Manifest, b: &str, bin: &str) -> Option<&'static str> {
+fn cross_reason(m: &Manifest, (name, a, b): (&str, &str, &str), bin: &str) -> Option<&'static str> {
     let (x, y) = bin.split_once(" x ")?;
     let ftz = m.params.get("ftz") == Some(&1);
+    if field(m, name).is_some_and(|f| f.1.care_when.is_some()) {
+        // RTI after `valid` (t, u, v: t' u' v' times 1/det, or divided by det)
+        if x == "NaN" || y == "NaN" {
+            return Some(WHY_VALID_NUMBERS);
+        }
+        let barycentric = a == "up" || a == "vp";
+        let recip = b == "inv_det";
+        match (recip, x, y) {
+            (true, "inf", _) if barycentric && y != "zero" => return Some(WHY_VALID_UV_INF_RECIP),
+            (true, "normal", "inf") if barycentric => return Some(WHY_VALID_UV_TINY_DET),
+            (true, _, "inf") if ftz => return Some(WHY_VALID_FTZ_RECIP),
+            (false, _, "zero") => return Some(WHY_VALID_DET_NONZERO),
+            (false, "inf", _) if barycentric && y != "inf" => return Some(WHY_VALID_UV_INF_DIV),
+            (false, "normal", "subnormal") if barycentric => return Some(WHY_VALID_UV_TINY_DET),
+            _ => {}
+        }
+    }
     let guard = m.params.get("slab_guard") == Some(&1);
     if ftz && (x == "subnormal" || y == "subnormal") {
         return Some(WHY_FTZ);
@@ -1207,6 +1226,20 @@ fn cross_reason(m: &Manifest, b: &str, bin: &str) -> Option<&'static str> {
     }
     None
 }
+
+/// Why an operand of RTI's t, u or v (counted only when `valid`) is never NaN.
+pub const WHY_VALID_NUMBERS: &str = "counted only when valid: then det is a number with |det| > det_threshold (det_ok), so 1/det is not NaN, and t', u', v' are NaN-free (t_ok, u_ok, v_ok)";
+/// Why an infinite u' or v' meets only a zero 1/det.
+pub const WHY_VALID_UV_INF_RECIP: &str = "counted only when valid: |u'| <= |det| and |v'| <= |det| (uv_ok with u_ok, v_ok), so an infinite u' or v' needs an infinite det, whose reciprocal is 0";
+/// Why an infinite u' or v' meets only an infinite det.
+pub const WHY_VALID_UV_INF_DIV: &str = "counted only when valid: |u'| <= |det| and |v'| <= |det| (uv_ok with u_ok, v_ok), so an infinite u' or v' needs an infinite det";
+/// Why a normal u' or v' never meets a subnormal det (or its infinite reciprocal).
+pub const WHY_VALID_UV_TINY_DET: &str = "counted only when valid: |u'| <= |det| and |v'| <= |det| (uv_ok with u_ok, v_ok); 1/det overflows only for |det| < 1/max < the smallest normal, so with an infinite 1/det (or a subnormal det) u' and v' are zero or subnormal";
+/// Why 1/det is finite under flush-to-zero when valid.
+pub const WHY_VALID_FTZ_RECIP: &str = "counted only when valid under flush-to-zero: det is nonzero, so normal (a subnormal det is read as zero) or infinite, and 1/det of a normal det is at most 1/min_normal = 2^(emax-1) in magnitude: never infinite";
+/// Why the divisor det is never zero when valid.
+pub const WHY_VALID_DET_NONZERO: &str =
+    "counted only when valid: |det| > det_threshold >= 0 (det_ok), so det is not zero";
 
 /// A per-unit event coverpoint.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

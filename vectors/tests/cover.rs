@@ -395,3 +395,42 @@ fn traverse_back_distances_and_ties_by_hand() {
     assert_eq!(Coverage::measure_dir(&dir, &m).unwrap(), Coverage::measure(&set.manifest, &rows).unwrap());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The crosses after RTI's `valid`, by hand in fp16 (e1 = (2, 0, 0), e2 = (0, 2, 0) or
+/// (1, 0, 0), (0, 1, 0); the algebra in `close.rs`'s templates): A, o = (0, 0, max/2), d = (0,
+/// 0, -tiny): t' = 2 max = +inf, det = 4 tiny, 1/det = +inf, u' = 0, v' = -0 — valid, so t
+/// crosses inf x inf and u, v zero x inf; B, o = (0, 0, 1), d = (0, tiny, -2^15): det = 2^15,
+/// 1/det = 2^-15 (subnormal), t' = 1, u' = 0, v' = tiny — v crosses subnormal x subnormal,
+/// t normal x subnormal, u zero x subnormal. A third row with det = 0 (not valid) counts in
+/// none of them, and no bin the model marks unreachable is hit.
+#[test]
+fn crosses_after_valid_by_hand() {
+    let (two, one, inf, half_max, tiny, neg) = (0x4000u64, 0x3c00u64, 0x7c00u64, 0x77ffu64, 1u64, 0x8000u64);
+    let a = vec![0, 0, half_max, 0, 0, neg | tiny, 0, inf, 0, 0, 0, two, 0, 0, 0, two, 0];
+    let b = vec![0, 0, one, 0, tiny, neg | 0x7800, 0, inf, 0, 0, 0, one, 0, 0, 0, one, 0];
+    // d parallel to the triangle's plane (d = (1, 0, 0)): det = 0, not valid
+    let c = vec![0, 0, one, one, 0, 0, 0, inf, 0, 0, 0, one, 0, 0, 0, one, 0];
+    let ex = vectors::gen::Explicit { rows: vec![a, b, c], ..explicit_close() };
+    let set = generate(&Request { closure: Some(ex), ..req(Unit::Rti, "fp16") }).unwrap();
+    let rows = set_rows(&set).unwrap();
+    let n = rows[0].len();
+    let mut cov = Coverage::model(&set.manifest);
+    cov.add_rows(&set.manifest, &rows, n - 3..n).unwrap();
+    let hit = |sig: &str| -> Vec<String> {
+        let p = cov.coverpoints.iter().find(|p| p.kind == "operand cross" && p.signal.starts_with(sig)).unwrap();
+        assert!(p.bins.iter().all(|b| b.count == 0 || b.unreachable.is_none()), "{sig}: an unreachable bin hit");
+        p.bins.iter().filter(|b| b.count > 0).map(|b| b.name.clone()).collect()
+    };
+    assert_eq!(hit("t (mul)"), ["normal x subnormal", "inf x inf"]);
+    assert_eq!(hit("u (mul)"), ["zero x subnormal", "zero x inf"]);
+    assert_eq!(hit("v (mul)"), ["zero x inf", "subnormal x subnormal"]);
+    // what the model marks unreachable after valid, with the simple arguments
+    let why = |sig: &str, bin: &str| {
+        let p = cov.coverpoints.iter().find(|p| p.kind == "operand cross" && p.signal.starts_with(sig)).unwrap();
+        p.bins.iter().find(|b| b.name == bin).unwrap().unreachable
+    };
+    assert_eq!(why("u (mul)", "inf x normal"), Some(vectors::cover::WHY_VALID_UV_INF_RECIP));
+    assert_eq!(why("u (mul)", "normal x inf"), Some(vectors::cover::WHY_VALID_UV_TINY_DET));
+    assert_eq!(why("t (mul)", "NaN x normal"), Some(vectors::cover::WHY_VALID_NUMBERS));
+    assert_eq!(why("t (mul)", "inf x inf"), None);
+}
