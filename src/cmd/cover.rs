@@ -200,9 +200,13 @@ impl<'a> Report<'a> {
                 s += &format!("  {}:\n", p.role);
                 last = p.role.clone();
             }
+            // hit / reachable (the unreachable bins, if any, named after)
             let h = p.bins.iter().filter(|b| b.count > 0).count();
+            let reachable = p.bins.iter().filter(|b| b.unreachable.is_none()).count();
+            let unreachable = p.bins.len() - reachable;
             let stage = p.stage.map_or(String::new(), |x| format!(" [{x}]"));
-            s += &format!("    {}{stage} ({}): {h}/{}\n", p.signal, p.kind, p.bins.len());
+            let note = if unreachable > 0 { format!(" (+{unreachable} unreachable)") } else { String::new() };
+            s += &format!("    {}{stage} ({}): {h}/{reachable}{note}\n", p.signal, p.kind);
         }
         let shown = if show == 0 { self.holes.len() } else { show.min(self.holes.len()) };
         if !self.holes.is_empty() {

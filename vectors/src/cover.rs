@@ -3,8 +3,7 @@
 //! by the field's kind) and the counts a set's rows put into its bins. Counts merge exactly
 //! (integer sums), so the coverage of shards merged is the coverage of one pass.
 //!
-//! Bins (first version: the value classes of issue #37's item 1; rounding events, per-unit
-//! events and crosses are not modelled yet):
+//! Bins:
 //! - an IEEE-like float field: `+0`, `-0`, `+subnormal`, `-subnormal`, `+min normal`,
 //!   `-min normal`, `+normal`, `-normal`, `+max finite`, `-max finite`, `+inf`, `-inf`,
 //!   `canonical NaN` (the contract's: exponent all ones, only the top fraction bit set, either
@@ -860,6 +859,11 @@ fn unit_value_reason(m: &Manifest, x: &Field, bin: &str) -> Option<&'static str>
         ("rti", "inv_det") if valid && matches!(bin, "+max finite" | "-max finite") => Some(WHY_RECIP_NOT_MAX),
         ("rti", "inv_det") if valid && bin.ends_with("NaN") => Some(WHY_RTI_DET_NUMBER),
         ("rti", "inv_det") if valid && ftz_float(m) && matches!(bin, "+inf" | "-inf") => Some(WHY_FTZ_RECIP),
+        ("rti", "inv_det") if valid && culled(m) && (neg_nonzero || bin == "-0") => Some(WHY_CULL_POSITIVE),
+        ("rti", "inv_det") if valid && threshold_bounds_recip(m) && matches!(bin, "+inf" | "-inf") => {
+            Some(WHY_THRESHOLD_RECIP)
+        }
+        ("rti", "u" | "v") if valid && threshold_bounds_recip(m) && bin == "+inf" => Some(WHY_THRESHOLD_RECIP),
         ("rti", "u" | "v") if valid && ftz_float(m) && bin == "+inf" => Some(WHY_FTZ_RECIP),
         ("slab", "inv_dx" | "inv_dy" | "inv_dz") => match bin {
             "+max finite" | "-max finite" => Some(WHY_RECIP_NOT_MAX),
@@ -918,6 +922,9 @@ fn unit_rounding_reason(m: &Manifest, signal: &str, bin: &str) -> Option<&'stati
         ("overflow" | "underflow", "div") if m.unit == "slab" && recip && guard => Some(WHY_GUARD_RECIP),
         ("overflow", "sub") if m.unit == "slab" && guard => Some(WHY_GUARD_SUB),
         ("overflow", "div") if recip && ftz_float(m) => Some(WHY_FTZ_RECIP),
+        ("overflow", "div") if m.unit == "rti" && valid && recip && threshold_bounds_recip(m) => {
+            Some(WHY_THRESHOLD_RECIP)
+        }
         ("overflow", "div") if m.unit == "slab" && recip && m.params.get("slab_embree") == Some(&1) && gradual(m) => {
             Some(WHY_EMBREE)
         }
@@ -1208,6 +1215,7 @@ fn cross_reason(m: &Manifest, (name, a, b): (&str, &str, &str), bin: &str) -> Op
             (true, "inf", _) if barycentric && y != "zero" => return Some(WHY_VALID_UV_INF_RECIP),
             (true, "normal", "inf") if barycentric => return Some(WHY_VALID_UV_TINY_DET),
             (true, _, "inf") if ftz => return Some(WHY_VALID_FTZ_RECIP),
+            (true, _, "inf") if threshold_bounds_recip(m) => return Some(WHY_THRESHOLD_RECIP),
             (false, _, "zero") => return Some(WHY_VALID_DET_NONZERO),
             (false, "inf", _) if barycentric && y != "inf" => return Some(WHY_VALID_UV_INF_DIV),
             (false, "normal", "subnormal") if barycentric => return Some(WHY_VALID_UV_TINY_DET),
@@ -1226,6 +1234,28 @@ fn cross_reason(m: &Manifest, (name, a, b): (&str, &str, &str), bin: &str) -> Op
     }
     None
 }
+
+/// Whether the RTI set culls back faces (then `valid` needs det > threshold).
+fn culled(m: &Manifest) -> bool {
+    m.unit == "rti" && m.params.get("cull_backface") == Some(&1)
+}
+
+/// Whether the RTI set's det threshold keeps 1/det finite where it is counted (`valid`):
+/// a threshold t > 0 with 1/t below the format's largest finite value (IEEE-like formats).
+fn threshold_bounds_recip(m: &Manifest) -> bool {
+    let p = |k: &str| m.params.get(k).copied();
+    let (Some(1), Some(exp), Some(man), Some(thr)) = (p("float"), p("exp"), p("man"), p("det_thr")) else {
+        return false;
+    };
+    let t = decode(m, thr);
+    let max = (2.0 - pow2(-(man as i64))) * pow2((1i64 << (exp - 1)) - 1);
+    t > 0.0 && 1.0 / t < max
+}
+
+/// Why 1/det is never negative (or -0) under backface culling where it is counted.
+pub const WHY_CULL_POSITIVE: &str = "counted only when valid: under backface culling valid needs det > det_threshold >= 0, so 1/det is positive, or +0 for det = +inf";
+/// Why 1/det stays finite under a positive det threshold where it is counted.
+pub const WHY_THRESHOLD_RECIP: &str = "counted only when valid: |det| > det_threshold > 0 (det_ok), so |1/det| <= fl(1/det_threshold), finite since 1/det_threshold is below the largest finite value: 1/det never overflows, and u' x (1/det), v' x (1/det) (|u'|, |v'| <= |det|) stay at most 2";
 
 /// Why an operand of RTI's t, u or v (counted only when `valid`) is never NaN.
 pub const WHY_VALID_NUMBERS: &str = "counted only when valid: then det is a number with |det| > det_threshold (det_ok), so 1/det is not NaN, and t', u', v' are NaN-free (t_ok, u_ok, v_ok)";

@@ -115,6 +115,27 @@ fn closed_default_sets_reach_every_reachable_bin_in_fp16_and_f32() {
     }
 }
 
+/// The RTI unit's options change what is reachable after `valid` (backface culling: 1/det is
+/// positive; a det threshold > 0: 1/det finite) and the capture unit's tie rule changes its
+/// outputs: the closed fp16 sets with each option still reach every reachable bin.
+#[test]
+fn closed_sets_with_rti_options_reach_every_reachable_bin() {
+    use datapath::rti::{Cull, RtiConfig, TieRule};
+    let thr = RtiConfig { det_threshold: 0.001, ..RtiConfig::default() };
+    for (unit, rti) in [
+        (Unit::Rti, RtiConfig { cull: Cull::Backface, ..RtiConfig::default() }),
+        (Unit::Rti, thr),
+        (Unit::Rti, RtiConfig { cull: Cull::Backface, ..thr }),
+        (Unit::Capture, RtiConfig { tie: TieRule::Last, ..RtiConfig::default() }),
+    ] {
+        let r = Request { count: 64, seed: 1, rti, ..req(unit, "fp16") };
+        let c = vectors::close::close(&r, vectors::close::DEFAULT_BUDGET).unwrap();
+        assert!(c.coverage.contradictions().is_empty(), "{unit:?} {rti:?}: {:?}", c.coverage.contradictions());
+        let (hit, bins) = c.coverage.totals();
+        assert_eq!(hit, bins, "{unit:?} {rti:?}: {hit} of {bins} bins");
+    }
+}
+
 /// The closure's search hunts for the bins the model marks unreachable in the other formats
 /// too (a hit one is a wrong reason): none is hit, and closing never loses coverage.
 #[test]
