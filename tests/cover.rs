@@ -59,6 +59,22 @@ fn cover_reports_merges_and_gates() {
     assert_eq!(o.status.code(), Some(1));
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("empty bins") && text.contains("reachable bins hit"), "{text}");
+    // each hole names the default set's classes that reach it: a hole names no class exactly
+    // when the default set (64 per class, seed 1), written and measured on its own, misses it too
+    let jr = json(&[&r.display().to_string()]);
+    let (holes, stim) = (jr["holes"].as_array().unwrap(), jr["hole_stimulus"].as_array().unwrap());
+    assert_eq!(holes.len(), stim.len());
+    let d = tmp.join("rti-default");
+    set(&d, &["--unit", "rti", "--format", "fp16"]);
+    let jd = json(&[&d.display().to_string()]);
+    let default_holes: Vec<&serde_json::Value> = jd["holes"].as_array().unwrap().iter().collect();
+    let mut named = 0;
+    for (h, st) in holes.iter().zip(stim) {
+        let st = st.as_str().unwrap();
+        assert_eq!(st.starts_with("no default class"), default_holes.contains(&h), "{h}: {st}");
+        named += usize::from(st.starts_with("class "));
+    }
+    assert!(named > 0);
     // sets of two formats: two models, each reported on its own
     let two = json(&[&sa, &f32set.display().to_string()]);
     let formats: Vec<&str> = two["models"].as_array().unwrap().iter().map(|m| m["format"].as_str().unwrap()).collect();

@@ -88,11 +88,24 @@ pub fn run(a: Args) -> Result<Outcome, String> {
         let x = vectors::cover::ucis_xml_all(&models, &vectors::cover::utc(now), &command_as_typed());
         vectors::outdir::atomic_write(u, x.as_bytes())?;
     }
+    // the stimulus classes that reach each bin, for the models with holes (the traverse unit's
+    // default set needs its tree: no classes named there)
+    let reach: Vec<Option<vectors::cover_reach::ReachMap>> = models
+        .iter()
+        .map(|c| {
+            let (hit, bins) = c.totals();
+            if hit < bins {
+                vectors::cover_reach::reach(c).ok()
+            } else {
+                None
+            }
+        })
+        .collect();
     if let Some(h) = &a.html {
-        let page = vectors::cover_html::page_all(&models, &command_as_typed(), &vectors::cover::utc(now));
+        let page = vectors::cover_html::page_all(&models, &reach, &command_as_typed(), &vectors::cover::utc(now));
         vectors::outdir::atomic_write(h, page.as_bytes())?;
     }
-    let reports: Vec<Report> = models.iter().map(Report::of).collect();
+    let reports: Vec<Report> = models.iter().zip(&reach).map(|(c, r)| Report::of(c, r.as_ref())).collect();
     let (hit, bins) = reports.iter().fold((0, 0), |(h, b), r| (h + r.hit, b + r.bins));
     let pct = percent(hit, bins);
     let mut j = serde_json::json!({
@@ -147,21 +160,27 @@ struct Report<'a> {
     pct: f64,
     unreachable: usize,
     holes: Vec<String>,
+    /// Per hole: the default classes that reach it, or the closure.
+    stimulus: Vec<String>,
 }
 
 impl<'a> Report<'a> {
-    fn of(c: &'a vectors::cover::Coverage) -> Self {
+    fn of(c: &'a vectors::cover::Coverage, reach: Option<&vectors::cover_reach::ReachMap>) -> Self {
         let (hit, bins) = c.totals();
-        let holes = c
+        let (holes, stimulus) = c
             .coverpoints
             .iter()
             .flat_map(|p| {
                 p.bins.iter().filter(|b| b.count == 0 && b.unreachable.is_none()).map(move |b| {
                     let stage = p.stage.map_or(String::new(), |s| format!(" (stage {s})"));
-                    format!("{} {}{stage}: {}", p.role, p.signal, b.name)
+                    let hint = match reach {
+                        Some(r) => vectors::cover_reach::hint(r, &p.role, &p.signal, &b.name),
+                        None => "vectors --close".into(),
+                    };
+                    (format!("{} {}{stage}: {}", p.role, p.signal, b.name), hint)
                 })
             })
-            .collect();
+            .unzip();
         Report {
             cov: c,
             hit,
@@ -169,6 +188,7 @@ impl<'a> Report<'a> {
             pct: percent(hit, bins),
             unreachable: c.coverpoints.iter().flat_map(|p| &p.bins).filter(|b| b.unreachable.is_some()).count(),
             holes,
+            stimulus,
         }
     }
 
@@ -183,6 +203,7 @@ impl<'a> Report<'a> {
             "bins_unreachable": self.unreachable,
             "percent": self.pct,
             "holes": self.holes,
+            "hole_stimulus": self.stimulus,
             "coverpoints": c.coverpoints,
         })
     }
@@ -211,8 +232,8 @@ impl<'a> Report<'a> {
         let shown = if show == 0 { self.holes.len() } else { show.min(self.holes.len()) };
         if !self.holes.is_empty() {
             s += &format!("empty bins ({} of {} shown):\n", shown, self.holes.len());
-            for h in &self.holes[..shown] {
-                s += &format!("  {h}\n");
+            for (h, st) in self.holes[..shown].iter().zip(&self.stimulus) {
+                s += &format!("  {h}  [{st}]\n");
             }
         }
         s

@@ -85,16 +85,7 @@ pub fn check_set(dir: &Path) -> Result<usize, String> {
 fn request_from(m: &Manifest, unit: Unit, format: AnyFormat, contents: &[Vec<Vec<u64>>]) -> Result<Request, String> {
     let opt = |k: &str| m.options.get(k).map(String::as_str);
     let param = |k: &str| m.params.get(k).copied().ok_or(format!("manifest.json: params has no {k}"));
-    let rti = if unit == Unit::Rti {
-        let thr = opt("det_threshold").and_then(|s| s.split_whitespace().next()).unwrap_or("0");
-        RtiConfig {
-            cull: if opt("cull") == Some("Backface") { Cull::Backface } else { Cull::TwoSided },
-            det_threshold: thr.parse().map_err(|_| format!("manifest.json: options.det_threshold '{thr}'"))?,
-            tie: if opt("tie") == Some("Last") { TieRule::Last } else { TieRule::First },
-        }
-    } else {
-        RtiConfig::default()
-    };
+    let rti = if unit == Unit::Rti { rti_from_options(&m.options)? } else { RtiConfig::default() };
     let count = if m.count > 0 { m.count } else { m.classes.iter().map(|c| c.count).max().unwrap_or(0).max(1) };
     let (tree, leaves, max_levels) = if unit == Unit::Traverse {
         let tree = with_format!(format, |f| tree_from_banks(&f, m, contents))?;
@@ -117,6 +108,17 @@ fn request_from(m: &Manifest, unit: Unit, format: AnyFormat, contents: &[Vec<Vec
         max_levels,
         explicit: explicit_from(m, unit, contents)?,
         closure: closure_from(m, contents)?,
+    })
+}
+
+/// The RTI options a manifest's `options` name (cull, det_threshold, tie).
+pub(crate) fn rti_from_options(options: &std::collections::BTreeMap<String, String>) -> Result<RtiConfig, String> {
+    let opt = |k: &str| options.get(k).map(String::as_str);
+    let thr = opt("det_threshold").and_then(|s| s.split_whitespace().next()).unwrap_or("0");
+    Ok(RtiConfig {
+        cull: if opt("cull") == Some("Backface") { Cull::Backface } else { Cull::TwoSided },
+        det_threshold: thr.parse().map_err(|_| format!("manifest.json: options.det_threshold '{thr}'"))?,
+        tie: if opt("tie") == Some("Last") { TieRule::Last } else { TieRule::First },
     })
 }
 

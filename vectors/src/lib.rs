@@ -11,6 +11,7 @@ pub mod close;
 pub mod cover;
 pub mod cover_file;
 pub mod cover_html;
+pub mod cover_reach;
 pub mod gen;
 pub mod hdl;
 pub mod manifest;
