@@ -30,6 +30,10 @@
 //!   Exact values: sums by TwoSum in binary64, products exactly in binary64 (significands of
 //!   at most 26 bits), quotients by comparing `r × b` with `a` exactly.
 //!
+//! - every operation of the stage table in fixed point (and the op unit's result): the event
+//!   of its exact result — `exact`, `inexact` (rounded), `saturated` or `wrapped` (beyond the
+//!   range, by the format), `divide by zero` (exact integer arithmetic in i128);
+//!
 //! Unreachable bins, with the reason, left out of the totals: in a format with the canonical
 //! NaN rule, `other NaN` of every output and stage signal; under flush-to-zero, the subnormal
 //! bins of every output and stage signal. (Inputs can hold anything.)
@@ -241,6 +245,36 @@ impl Coverage {
                             "flushed" if !ftz => Some(WHY_NO_FTZ),
                             "underflow" if ftz => Some(WHY_FTZ_UNDERFLOW),
                             _ => unit_rounding_reason(m, &signal, n),
+                        },
+                    })
+                    .collect(),
+            });
+        }
+        let mut fixed_rows: Vec<(u8, String, &str)> = fixed_arith_rows(m)
+            .into_iter()
+            .map(|(stage, name, op, _, _)| (stage, format!("{name} ({op})"), op))
+            .collect();
+        if op_unit_fixed(m) {
+            fixed_rows.push((1, "result (add, sub, mul or div by opcode)".into(), "any"));
+        }
+        let saturating = !m.format.contains("wrap");
+        for (stage, signal, op) in fixed_rows {
+            coverpoints.push(Coverpoint {
+                signal: signal.clone(),
+                role: "stage signals".into(),
+                stage: Some(stage),
+                kind: "fixed-point event".into(),
+                bins: FIXED_EVENT_BINS
+                    .iter()
+                    .map(|&n| Bin {
+                        name: n.into(),
+                        count: 0,
+                        unreachable: match n {
+                            "saturated" if !saturating => Some(WHY_WRAPS),
+                            "wrapped" if saturating => Some(WHY_SATURATES),
+                            "inexact" if matches!(op, "add" | "sub") => Some(WHY_FIXED_SUM_EXACT),
+                            "divide by zero" if op != "div" && op != "any" => Some(WHY_NOT_DIV),
+                            _ => fixed_event_reason(m, &signal, n),
                         },
                     })
                     .collect(),
@@ -510,6 +544,8 @@ pub struct RowBins {
     cmps: Vec<(u8, &'static str, &'static str, &'static str)>,
     ariths: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
     op_rounding: bool,
+    fixed_ops: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
+    op_fixed: bool,
     cancels: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
     crossed: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
     min_normal: f64,
@@ -527,6 +563,8 @@ impl RowBins {
             cmps: compares(m),
             ariths: arith_rows(m),
             op_rounding: op_unit_rounding(m),
+            fixed_ops: fixed_arith_rows(m),
+            op_fixed: op_unit_fixed(m),
             cancels: cancel_rows(m),
             crossed: crossed_rows(m),
             min_normal: min_normal(m),
@@ -603,6 +641,26 @@ impl RowBins {
                 _ => None,
             };
             if let Some(bin) = op.and_then(|op| rounding_event(ix, contents, row, "result", op, "a", "b", ftz)) {
+                out.push((cp, bin));
+            }
+            cp += 1;
+        }
+        for &(_, name, op, a, b) in &self.fixed_ops {
+            if let Some(bin) = fixed_event(ix, contents, row, name, op, a, b) {
+                out.push((cp, bin));
+            }
+            cp += 1;
+        }
+        if self.op_fixed {
+            let opcode = ix.field("opcode").and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied());
+            let op = match opcode {
+                Some(0) => Some("add"),
+                Some(1) => Some("sub"),
+                Some(2) => Some("mul"),
+                Some(3) if m.format.contains("divide") => Some("div"),
+                _ => None,
+            };
+            if let Some(bin) = op.and_then(|op| fixed_event(ix, contents, row, "result", op, "a", "b")) {
                 out.push((cp, bin));
             }
             cp += 1;
@@ -955,6 +1013,130 @@ fn arith_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str
         })
         .filter(|&(_, n, _, a, b)| known(n) && known(a) && known(b))
         .collect()
+}
+
+/// The operations of the set's unit with fixed-point operands: (stage, signal, op, a, b).
+fn fixed_arith_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str, &'static str)> {
+    use datapath::stage::{Op, Rule};
+    let known = |n: &str| n == "one" || field(m, n).is_some_and(|x| matches!(x.1.kind, Kind::Fixed { .. }));
+    stage_table_of(m)
+        .into_iter()
+        .filter(|d| matches!(d.rule, Rule::Arith | Rule::ArithGuardRecip | Rule::ArithGuardSub))
+        .filter_map(|d| {
+            let op = match d.op {
+                Op::Add => "add",
+                Op::Sub => "sub",
+                Op::Mul => "mul",
+                Op::Div => "div",
+                Op::Logic => return None,
+            };
+            Some((d.stage, d.name, op, d.a, d.b))
+        })
+        .filter(|&(_, n, _, a, b)| n != "one" && known(n) && known(a) && known(b))
+        .collect()
+}
+
+/// Whether the set is an op set with a fixed-point result (its operation events are counted).
+fn op_unit_fixed(m: &Manifest) -> bool {
+    m.unit == "op"
+        && field(m, "result").is_some_and(|x| matches!(x.1.kind, Kind::Fixed { .. }))
+        && field(m, "opcode").is_some()
+}
+
+/// The bins of a fixed-point operation: the exact result against the format's range.
+pub const FIXED_EVENT_BINS: [&str; 5] = ["exact", "inexact", "saturated", "wrapped", "divide by zero"];
+/// Why a saturating format never wraps.
+pub const WHY_SATURATES: &str =
+    "the format saturates: a result beyond the range is clamped to its end (counted as saturated)";
+/// Why a wrapping format never saturates.
+pub const WHY_WRAPS: &str = "the format wraps: a result beyond the range is taken modulo 2^width (counted as wrapped)";
+/// Why a fixed-point sum or difference is never inexact.
+pub const WHY_FIXED_SUM_EXACT: &str =
+    "a sum or difference of two values on the same grid is on the grid: exact, or beyond the range";
+/// Why RTI's fixed-point u and v never leave the range where they are counted.
+pub const WHY_RTI_UV_FIXED_IN_RANGE: &str = "counted only when valid: 0 <= u' <= fl(u' + v') <= det (det > 0; the mirror for det < 0), so u'/det is in [0, 1], and u' x fl(1/det) is at most det x fl(1/det) <= 1 + det x step <= 2 (u' <= det < 2^(I-1)... at most 2 plus a step), inside a range of at least 3 integer bits (v alike)";
+/// Why a fixed-point u or v of a valid hit is never past 1 in divide mode.
+pub const WHY_RTI_BARY_DIVIDE_FIXED: &str = "divide mode, fixed point, a valid hit: 0 <= u' <= det (det > 0; the mirror for det < 0), so u'/det is in [0, 1] exactly and every rounding mode keeps it there (0 and 1 are on the grid); fixed point has no inf or NaN (v alike)";
+/// Why the op unit's division is not counted in reciprocal mode.
+pub const WHY_OP_RECIP_NOT_COUNTED: &str = "in reciprocal mode the op unit's div is a x (1/b), two roundings: not counted as one operation (only add, sub, mul)";
+/// Why an operation that is not a division never divides by zero.
+pub const WHY_NOT_DIV: &str = "not a division";
+
+/// The fixed-point event bin of operation `name = a op b` in row `row`: the exact result
+/// (sums exactly; a product a b / 2^F; a quotient a 2^F / b; `one` is 2^F) inside the range
+/// and on the grid (exact), inside and off it (inexact: rounded), or beyond the range
+/// (saturated or wrapped, by the format); a division by zero has its own bin. None when the
+/// result is don't-care in this row (care_when).
+fn fixed_event(
+    ix: &Ix,
+    contents: &[Vec<Vec<u64>>],
+    row: usize,
+    name: &str,
+    op: &str,
+    a: &str,
+    b: &str,
+) -> Option<usize> {
+    let (_, rf, _) = ix.field(name)?;
+    let Kind::Fixed { frac, .. } = rf.kind else { return None };
+    raw_fixed(ix, contents, row, name)?;
+    let val = |n: &str| if n == "one" { Some(1i128 << frac) } else { raw_fixed(ix, contents, row, n) };
+    let (x, y) = (val(a)?, val(b)?);
+    let w = rf.width;
+    let (lo, hi) = (-(1i128 << (w - 1)), (1i128 << (w - 1)) - 1);
+    // the exact result as num / den steps, den > 0
+    let (num, den) = match op {
+        "add" => (x + y, 1),
+        "sub" => (x - y, 1),
+        "mul" => (x * y, 1i128 << frac),
+        "div" if y == 0 => return Some(4),
+        "div" if y < 0 => (-(x << frac), -y),
+        "div" => (x << frac, y),
+        _ => return None,
+    };
+    let beyond = num > hi * den || num < lo * den;
+    let saturating = !ix.m.format.contains("wrap");
+    Some(match (beyond, num % den == 0) {
+        (true, _) if saturating => 2,
+        (true, _) => 3,
+        (false, true) => 0,
+        (false, false) => 1,
+    })
+}
+
+/// A unit's reason why fixed-point event bin `bin` of operation coverpoint `signal`
+/// (`name (op)`) is unreachable.
+fn fixed_event_reason(m: &Manifest, signal: &str, bin: &str) -> Option<&'static str> {
+    let (name, _) = signal.split_once(" (")?;
+    let valid = field(m, name).is_some_and(|x| x.1.care_when.as_deref() == Some("valid"));
+    let divide = m.format.contains("divide");
+    let embree = m.params.get("slab_embree") == Some(&1) && m.params.get("slab_delta").is_some_and(|&d| d > 1);
+    let int = match field(m, name).map(|x| &x.1.kind) {
+        Some(Kind::Fixed { int, .. }) => *int,
+        _ => 0,
+    };
+    match (m.unit.as_str(), name, bin) {
+        ("rti", _, "divide by zero") if valid => Some(WHY_VALID_DET_NONZERO),
+        ("rti", "u" | "v", "saturated") if valid && (divide || int >= 3) => Some(WHY_RTI_UV_FIXED_IN_RANGE),
+        ("op", "result", "divide by zero") if !divide => Some(WHY_OP_RECIP_NOT_COUNTED),
+        ("slab", "inv_dx" | "inv_dy" | "inv_dz", "saturated" | "divide by zero") if embree => Some(WHY_EMBREE_FIXED),
+        _ => None,
+    }
+}
+
+/// The raw (two's-complement, in steps) value of fixed-point field `name` in row `row`; None
+/// when it is don't-care in this row (care_when) or not a fixed-point field.
+fn raw_fixed(ix: &Ix, contents: &[Vec<Vec<u64>>], row: usize, name: &str) -> Option<i128> {
+    let (i, x, k) = ix.field(name)?;
+    if let Some(flag) = &x.care_when {
+        let j = *ix.outs.get(flag.as_str())?;
+        if contents.get(1)?.get(row)?.get(j)? & 1 == 0 {
+            return None;
+        }
+    }
+    let Kind::Fixed { .. } = x.kind else { return None };
+    let v = *contents.get(i)?.get(row)?.get(k)?;
+    let sh = 128 - x.width;
+    Some(((v as i128) << sh) >> sh)
 }
 
 /// Whether the set is an op set with an IEEE-like result (its rounding events are counted).
@@ -1418,6 +1600,9 @@ impl Event {
             (Event::RtiDet, "0 < det <= threshold" | "-threshold <= det < 0") if zero_thr => Some(WHY_ZERO_THRESHOLD),
             (Event::SlabTouch, "entry > exit (a hit by widening)") if widen == 0 => Some(WHY_NO_WIDENING),
             (Event::RtiT, "other (past an end, NaN)") => Some(WHY_HIT_T_IN_RANGE),
+            (Event::RtiBary(_), "other (past 1, inf, NaN)") if !float && m.format.contains("divide") => {
+                Some(WHY_RTI_BARY_DIVIDE_FIXED)
+            }
             (Event::TraverseBack, b) => {
                 // a restart resumes at a level 0..levels-1 from a pass that ended at one
                 let levels = m.params.get("levels").copied().unwrap_or(0);

@@ -455,3 +455,37 @@ fn crosses_after_valid_by_hand() {
     assert_eq!(why("t (mul)", "NaN x normal"), Some(vectors::cover::WHY_VALID_NUMBERS));
     assert_eq!(why("t (mul)", "inf x inf"), None);
 }
+
+/// Fixed-point operation events by hand, the op unit in q8.8 (divide mode, saturating; 1.0 is
+/// 256 steps): 1 + 2 exact; 127 + 127 beyond the range (saturated); 0.5 x 0.5 exact (64
+/// steps); 1 step x 1 step inexact (1/256 of a step); 1 / 3 inexact; 1 / 0 divide by zero. In
+/// q8.8:wrap the same sum wraps; a sum is never inexact, and a saturating format never wraps.
+#[test]
+fn fixed_point_operation_events_by_hand() {
+    let run = |format: &str, rows: Vec<Vec<u64>>| -> Vec<u64> {
+        let k = rows.len();
+        let ex = vectors::gen::Explicit { rows, ..explicit_close() };
+        let set = generate(&Request { closure: Some(ex), ..req(Unit::Op, format) }).unwrap();
+        let all = set_rows(&set).unwrap();
+        let n = all[0].len();
+        let mut c = Coverage::model(&set.manifest);
+        c.add_rows(&set.manifest, &all, n - k..n).unwrap();
+        assert!(c.contradictions().is_empty(), "{format}: {:?}", c.contradictions());
+        let p = c.coverpoints.iter().find(|p| p.kind == "fixed-point event").unwrap();
+        assert_eq!(p.bins.iter().map(|b| b.name.as_str()).collect::<Vec<_>>(), vectors::cover::FIXED_EVENT_BINS);
+        p.bins.iter().map(|b| b.count).collect()
+    };
+    let (one, half, max) = (256u64, 128u64, 0x7fffu64);
+    let (add, mul, div) = (0u64, 2u64, 3u64);
+    let rows = vec![
+        vec![add, one, 2 * one],
+        vec![add, max, max],
+        vec![mul, half, half],
+        vec![mul, 1, 1],
+        vec![div, one, 3 * one],
+        vec![div, one, 0],
+    ];
+    // exact, inexact, saturated, wrapped, divide by zero
+    assert_eq!(run("q8.8:divide", rows.clone()), [2, 2, 1, 0, 1]);
+    assert_eq!(run("q8.8:divide+wrap", rows), [2, 2, 0, 1, 1]);
+}
