@@ -19,7 +19,9 @@
 //!   distance of each restart (`0`, `1`, `2`, `3 or more` levels) and the ties between siblings
 //!   on the path (`no tie`; a tie where the nearer, left, child is taken; one where the farther,
 //!   right, child is taken: on resuming the pair or passing it in `11`);
-//! - every compare of the stage table (rti `tmin_ok`, `tmax_ok`; slab `hit` and the
+//! - the op unit: its `opcode`, the compare outcome of `a` and `b` under `lt` / `le`, and the
+//!   operand classes of `a` and `b` crossed per opcode;
+//! - every compare of the stage table (rti `u_ok`, `v_ok`, `t_ok`, `uv_ok`, `tmin_ok`, `tmax_ok`; slab `hit` and the
 //!   compare-select chain `tn_*`, `tf_*`): the outcome of its operands as the datapath reads
 //!   them (FTZ: a subnormal as zero) — `<`, `=`, `>`, `unordered` (a NaN operand);
 //! - every rounded operation of the stage table (add, sub, mul, div rows) in an IEEE-like
@@ -208,7 +210,8 @@ impl Coverage {
             }
         }
         for (stage, name, a, b) in compares(m) {
-            let fixed = !matches!(field(m, a).map(|x| &x.1.kind), Some(Kind::Ieee { .. }));
+            let fixed =
+                !matches!(field(m, if a == "zero" { b } else { a }).map(|x| &x.1.kind), Some(Kind::Ieee { .. }));
             coverpoints.push(Coverpoint {
                 signal: format!("{name} ({a} vs {b})"),
                 role: "stage signals".into(),
@@ -321,6 +324,44 @@ impl Coverage {
                     .map(|&n| Bin { name: n.into(), count: 0, unreachable: e.unreachable(m, n) })
                     .collect(),
             });
+        }
+        if op_unit_extras(m) {
+            // the op unit: its operands' compare outcome under lt / le, and (IEEE-like) the
+            // operand classes crossed with each opcode
+            let fixed = !matches!(field(m, "a").map(|x| &x.1.kind), Some(Kind::Ieee { .. }));
+            coverpoints.push(Coverpoint {
+                signal: "cmp (a vs b, opcodes lt and le)".into(),
+                role: "stage signals".into(),
+                stage: Some(1),
+                kind: "compare".into(),
+                bins: COMPARE_BINS
+                    .iter()
+                    .map(|&n| Bin {
+                        name: n.into(),
+                        count: 0,
+                        unreachable: (n == "unordered" && fixed).then_some(WHY_FIXED_ORDERED),
+                    })
+                    .collect(),
+            });
+            if !fixed {
+                for op in crate::gen::OPCODES {
+                    coverpoints.push(Coverpoint {
+                        signal: format!("{op}: a x b"),
+                        role: "stage signals".into(),
+                        stage: Some(1),
+                        kind: "operand cross".into(),
+                        bins: CROSS_CLASSES
+                            .iter()
+                            .flat_map(|x| CROSS_CLASSES.iter().map(move |y| format!("{x} x {y}")))
+                            .map(|n| {
+                                let unreachable =
+                                    (m.format.contains("ftz") && n.contains("subnormal")).then_some(WHY_FTZ);
+                                Bin { name: n, count: 0, unreachable }
+                            })
+                            .collect(),
+                    });
+                }
+            }
         }
         Coverage { unit: m.unit.clone(), format: m.format.clone(), options: m.options.clone(), vectors: 0, coverpoints }
     }
@@ -550,6 +591,8 @@ pub struct RowBins {
     crossed: Vec<(u8, &'static str, &'static str, &'static str, &'static str)>,
     min_normal: f64,
     events: Vec<Event>,
+    op_extras: bool,
+    op_crosses: bool,
     /// The traverse unit: the set's tree, to re-run each ray for its path events.
     path: Option<crate::traverse::PathReplay>,
 }
@@ -569,6 +612,8 @@ impl RowBins {
             crossed: crossed_rows(m),
             min_normal: min_normal(m),
             events: events(m),
+            op_extras: op_unit_extras(m),
+            op_crosses: op_unit_extras(m) && matches!(field(m, "a").map(|x| &x.1.kind), Some(Kind::Ieee { .. })),
             path: None,
         }
     }
@@ -611,8 +656,10 @@ impl RowBins {
                 out.push((here, bin));
             }
         }
+        // `zero`: the constant 0 of the RTI's sign tests
+        let cmp_operand = |n: &str| if n == "zero" { Some(Some(0.0)) } else { operand(ix, contents, row, n, ftz) };
         for &(_, _, a, b) in &self.cmps {
-            if let (Some(x), Some(y)) = (operand(ix, contents, row, a, ftz), operand(ix, contents, row, b, ftz)) {
+            if let (Some(x), Some(y)) = (cmp_operand(a), cmp_operand(b)) {
                 let bin = match (x, y) {
                     (None, _) | (_, None) => 3,
                     (Some(x), Some(y)) if x < y => 0,
@@ -720,8 +767,41 @@ impl RowBins {
             }
             cp += 1;
         }
+        if self.op_extras {
+            let opcode = ix.field("opcode").and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied());
+            let (x, y) = (operand(ix, contents, row, "a", ftz), operand(ix, contents, row, "b", ftz));
+            if let (Some(4 | 5), Some(x), Some(y)) = (opcode, x, y) {
+                out.push((cp, compare_bin(x, y)));
+            }
+            cp += 1;
+            if self.op_crosses {
+                if let (Some(op), Some(x), Some(y)) = (opcode, x, y) {
+                    if (op as usize) < crate::gen::OPCODES.len() {
+                        let bin =
+                            cross_class(x, self.min_normal) * CROSS_CLASSES.len() + cross_class(y, self.min_normal);
+                        out.push((cp + op as usize, bin));
+                    }
+                }
+            }
+        }
         Ok(())
     }
+}
+
+/// The compare bin (<, =, >, unordered) of two operands as the datapath reads them.
+fn compare_bin(x: Option<f64>, y: Option<f64>) -> usize {
+    match (x, y) {
+        (None, _) | (_, None) => 3,
+        (Some(x), Some(y)) if x < y => 0,
+        (Some(x), Some(y)) if x == y => 1,
+        _ => 2,
+    }
+}
+
+/// Whether the set is an op set with operands `a`, `b` and an `opcode` (its compare outcome and
+/// operand crosses are counted).
+fn op_unit_extras(m: &Manifest) -> bool {
+    m.unit == "op" && field(m, "opcode").is_some() && field(m, "a").is_some() && field(m, "b").is_some()
 }
 
 /// XML text escaping for attribute values.
@@ -822,8 +902,12 @@ pub fn ucis_xml_all(covs: &[Coverage], written: &str, command: &str) -> String {
 }
 
 /// The traverse unit's counters and history registers: (kind, bins), for its fields `count`
-/// (leaves returned), `passes` and `hist_<level>` (the final 2-bit history of each level).
+/// (leaves returned), `passes` and `hist_<level>` (the final 2-bit history of each level); and
+/// the op unit's `opcode` (one bin per operation).
 fn traverse_bins(m: &Manifest, name: &str) -> Option<(&'static str, &'static [&'static str])> {
+    if m.unit == "op" && name == "opcode" {
+        return Some(("opcode", &crate::gen::OPCODES));
+    }
     if m.unit != "traverse" {
         return None;
     }
@@ -1469,6 +1553,8 @@ enum Event {
     SlabGuardCondition,
     /// Capture: a hit whose t equals the held hit's.
     CaptureTie,
+    /// Capture: each slot's comparator, a hit's t against the held hit's (true: tie rule last).
+    CaptureCompare(bool),
     /// RTI, a valid hit: where its barycentric `u` (0) or `v` (1) is: at 0, at 1, between or
     /// past (rounding).
     RtiBary(usize),
@@ -1503,7 +1589,7 @@ fn events(m: &Manifest) -> Vec<Event> {
             }
             v
         }
-        "capture" => vec![Event::CaptureTie],
+        "capture" => vec![Event::CaptureTie, Event::CaptureCompare(m.params.get("tie_last") == Some(&1))],
         "traverse" => vec![Event::TraverseBack, Event::TraverseTie],
         _ => Vec::new(),
     }
@@ -1529,6 +1615,7 @@ impl Event {
             Event::SlabGuard => "conservative guard fired".into(),
             Event::SlabGuardCondition => "the conservative guard's condition (this variant has no guard)".into(),
             Event::CaptureTie => "a hit's t equals the held hit's t".into(),
+            Event::CaptureCompare(_) => "each slot's compare: a hit's t against the held hit's t".into(),
             Event::RtiBary(k) => format!("{} of a valid hit", ["u", "v"][k]),
             Event::RtiT => "t of a valid hit against tmin and tmax".into(),
             Event::SlabTouch => "a hit's entry against its exit (tn_xyz vs tf_xyz)".into(),
@@ -1563,6 +1650,16 @@ impl Event {
                 "o - face of finite operands overflows",
             ],
             Event::CaptureTie => &["no tie", "tie (the tie rule decides)"],
+            Event::CaptureCompare(false) => &[
+                "t < held t (the new hit is taken)",
+                "t = held t (tie rule first: the held hit is kept)",
+                "t > held t (the held hit is kept)",
+            ],
+            Event::CaptureCompare(true) => &[
+                "t < held t (the new hit is taken)",
+                "t = held t (tie rule last: the new hit is taken)",
+                "t > held t (the held hit is kept)",
+            ],
             Event::RtiBary(0) => {
                 &["u = 0 (on the edge v0-v2)", "0 < u < 1", "u = 1 (at the vertex v1)", "other (past 1, inf, NaN)"]
             }
@@ -1747,6 +1844,25 @@ impl Event {
             }
             // measured from the replayed path (RowBins::hits), not from the row's fields
             Event::TraverseBack | Event::TraverseTie => Vec::new(),
+            Event::CaptureCompare(_) => {
+                let slots = m.params.get("slots").copied().unwrap_or(0) as usize;
+                let mut seen = [false; 3];
+                for s in 1..slots {
+                    if flag(&format!("hit{s}")) != Some(true) || flag(&format!("c{}_hit", s - 1)) != Some(true) {
+                        continue;
+                    }
+                    if let (Some(Some(x)), Some(Some(y))) = (num(&format!("t{s}")), num(&format!("c{}_t", s - 1))) {
+                        seen[if x < y {
+                            0
+                        } else if x == y {
+                            1
+                        } else {
+                            2
+                        }] = true;
+                    }
+                }
+                (0..3).filter(|&k| seen[k]).collect()
+            }
             Event::CaptureTie => {
                 let slots = m.params.get("slots").copied().unwrap_or(0) as usize;
                 let tie = (1..slots).any(|s| {
@@ -1828,10 +1944,12 @@ fn compares(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str)>
     table
         .into_iter()
         .filter_map(|d| match d.rule {
-            Rule::Le(a, b) | Rule::SelNear(a, b) | Rule::SelFar(a, b) => Some((d.stage, d.name, a, b)),
+            Rule::Le(a, b) | Rule::SelNear(a, b) | Rule::SelFar(a, b) | Rule::Oriented(a, b) => {
+                Some((d.stage, d.name, a, b))
+            }
             _ => None,
         })
-        .filter(|(_, _, a, b)| field(m, a).is_some() && field(m, b).is_some())
+        .filter(|(_, _, a, b)| (*a == "zero" || field(m, a).is_some()) && field(m, b).is_some())
         .collect()
 }
 
@@ -1946,6 +2064,7 @@ fn bin_of(x: &Field, v: u64, m: &Manifest) -> Option<usize> {
             traverse_bins(m, &x.name)?;
             let n = m.params.get("leaves").copied().unwrap_or(0);
             Some(match x.name.as_str() {
+                "opcode" => (v as usize).min(crate::gen::OPCODES.len() - 1),
                 "count" if v == 0 => 0,
                 "count" if v < n => 1,
                 "count" => 2,

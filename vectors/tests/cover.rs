@@ -50,9 +50,11 @@ fn unreachable_bins_are_never_hit_and_op_sets_reach_every_other_bin() {
             assert!(hit > 0 && hit <= bins);
             // every compare coverpoint of the unit is there, with its four outcomes
             let compares = c.coverpoints.iter().filter(|p| p.kind == "compare").count();
+            // (rti: u_ok, v_ok, uv_ok, t_ok, tmin_ok, tmax_ok; op: a vs b under lt / le)
             let want = match unit {
-                Unit::Rti => 2,
+                Unit::Rti => 6,
                 Unit::Slab => 7,
+                Unit::Op => 1,
                 _ => 0,
             };
             assert_eq!(compares, want, "{unit:?} {format}");
@@ -488,4 +490,41 @@ fn fixed_point_operation_events_by_hand() {
     // exact, inexact, saturated, wrapped, divide by zero
     assert_eq!(run("q8.8:divide", rows.clone()), [2, 2, 1, 0, 1]);
     assert_eq!(run("q8.8:divide+wrap", rows), [2, 2, 0, 1, 1]);
+}
+
+/// The op unit's compare outcome and operand crosses by hand (fp16): lt 1 < 2, le 2 = 2, lt
+/// NaN (unordered), add 1 + inf (normal x inf), mul 0 x subnormal; the opcode coverpoint counts
+/// each opcode. And RTI's sign tests (u_ok: 0 vs u'): the hand triangle of
+/// `cancellation_and_events_by_hand` with u' = o.x = 0.25 (<), 0 (=), -0.25 (>).
+#[test]
+fn op_compares_crosses_and_rti_sign_tests_by_hand() {
+    let (one, two, inf, nan, sub) = (0x3c00u64, 0x4000u64, 0x7c00u64, 0x7e00u64, 1u64);
+    let rows = vec![vec![4, one, two], vec![5, two, two], vec![4, nan, one], vec![0, one, inf], vec![2, 0, sub]];
+    let k = rows.len();
+    let ex = vectors::gen::Explicit { rows, ..explicit_close() };
+    let set = generate(&Request { closure: Some(ex), ..req(Unit::Op, "fp16") }).unwrap();
+    let all = set_rows(&set).unwrap();
+    let n = all[0].len();
+    let mut c = Coverage::model(&set.manifest);
+    c.add_rows(&set.manifest, &all, n - k..n).unwrap();
+    let cp = |sig: &str| c.coverpoints.iter().find(|p| p.signal == sig).unwrap_or_else(|| panic!("{sig}"));
+    let counts = |sig: &str| -> Vec<u64> { cp(sig).bins.iter().map(|b| b.count).collect() };
+    assert_eq!(counts("cmp (a vs b, opcodes lt and le)"), [1, 1, 0, 1]);
+    assert_eq!(counts("opcode"), [1, 0, 1, 0, 2, 1]);
+    let hit =
+        |sig: &str| -> Vec<String> { cp(sig).bins.iter().filter(|b| b.count > 0).map(|b| b.name.clone()).collect() };
+    assert_eq!(hit("add: a x b"), ["normal x inf"]);
+    assert_eq!(hit("mul: a x b"), ["zero x subnormal"]);
+    assert_eq!(hit("lt: a x b"), ["normal x normal", "NaN x normal"]);
+    // RTI: v0 = 0, v1 = (1, 0, 0), v2 = (0, 0, 1), d = (0, 1, 0): det = 1, u' = o.x
+    let (q, mq) = (0x3400u64, 0xb400u64);
+    let rrow = |ox: u64| vec![ox, 0xc000, 0, 0, one, 0, 0, inf, 0, 0, 0, one, 0, 0, 0, 0, one];
+    let ex = vectors::gen::Explicit { rows: vec![rrow(q), rrow(0), rrow(mq)], ..explicit_close() };
+    let set = generate(&Request { closure: Some(ex), ..req(Unit::Rti, "fp16") }).unwrap();
+    let all = set_rows(&set).unwrap();
+    let n = all[0].len();
+    let mut c = Coverage::model(&set.manifest);
+    c.add_rows(&set.manifest, &all, n - 3..n).unwrap();
+    let p = c.coverpoints.iter().find(|p| p.signal == "u_ok (zero vs up)").unwrap();
+    assert_eq!(p.bins.iter().map(|b| b.count).collect::<Vec<_>>(), [1, 1, 1, 0]);
 }
