@@ -319,6 +319,13 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
             }));
         });
     }
+    // the AVX2 binary16 kernel with its rounding in binary32 lanes instead of an F16C round
+    // trip per operation (docs/speed.md: measured both; the dispatch keeps the faster)
+    if datapath::simd::kernels_here().contains(&Kernel::Avx2) {
+        push(row("rti fp16 kernel (AVX2, rounding in binary32 lanes)", pairs, RTI_OPS, 7, || {
+            datapath::simd::rti_batch_f16_lanes(&r16, &rays16, &tris16, &mut o16);
+        }));
+    }
     let c16: Vec<([half::f16; 6], [half::f16; 9])> = cases
         .iter()
         .map(|(r, t)| {
@@ -357,6 +364,19 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
             }
             push(row(&format!("slab {name} scalar model (plain)"), pairs, SLAB_OPS, 3, || s.batch(&rs, &bs, &mut out)));
         });
+    }
+    if datapath::simd::kernels_here().contains(&Kernel::Avx2) {
+        let s = Slab::new(f16f, SlabConfig::default());
+        let (rs, bs) = slab_columns(&s, &cases);
+        let mut out = SlabOutSoa::with_len(pairs);
+        datapath::simd::with_kernel_cap(Kernel::Avx2, || {
+            push(row("slab fp16 kernel (AVX2, capped, plain)", pairs, SLAB_OPS, 7, || {
+                datapath::simd::slab_batch_f16(&s, &rs, &bs, &mut out);
+            }));
+        });
+        push(row("slab fp16 kernel (AVX2, rounding in binary32 lanes, plain)", pairs, SLAB_OPS, 7, || {
+            datapath::simd::slab_batch_f16_lanes(&s, &rs, &bs, &mut out);
+        }));
     }
     // the golden and the error bound on f64 lanes (one ray against a block of 256 triangles, as
     // the engine runs them; f64 work, so no fraction of the binary32 peak)

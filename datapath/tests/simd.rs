@@ -164,6 +164,25 @@ proptest! {
     }
 }
 
+proptest! {
+    // a measured alternative, not the dispatched kernel: fewer cases
+    #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+
+    /// The AVX2 binary16 RTI kernel whose rounding stays in binary32 lanes (`isa::v8r`), with
+    /// and without FTZ (products subnormal at scales 2^−12…2^−3).
+    #[test]
+    fn f16_kernel_rounding_in_lanes_matches_the_scalar_model(seed in any::<u64>(), n in 0usize..300, divide in any::<bool>(), cull in any::<bool>(), thr in prop_oneof![Just(0.0), Just(1e-3), Just(0.5)], k in -12i32..-2) {
+        let f = Ieee::new(F16Half, FpOpts { div: if divide { DivMode::Divide } else { DivMode::RecipMul }, ..FpOpts::default() });
+        let rti = Rti::new(f, config(cull, thr));
+        let (rays, tris) = columns(&f, n, seed, &F16_SPECIALS);
+        let mut a = HitsSoa::with_len(n);
+        rti.batch(&rays, &tris, &mut a);
+        on_every_kernel(Kernel::Avx2, &a, |b| datapath::simd::rti_batch_f16_lanes(&rti, &rays, &tris, b), || HitsSoa::with_len(n), |a, b| same(&f, a, b))?;
+        let g = Ieee::new(F16Half, ftz_opts(divide));
+        check_ftz(&Rti::new(g, config(cull, thr)), n, seed, (&F16_SPECIALS, k), Kernel::Avx2, datapath::simd::rti_batch_f16_lanes)?;
+    }
+}
+
 /// Edge encodings of a float layout: ±0, ±least subnormal, the largest subnormal, the least
 /// normal, ±max finite, ±infinity, a quiet NaN with a payload and a negative signalling NaN.
 fn float_specials(l: datapath::format::FloatLayout) -> Vec<u64> {
@@ -620,6 +639,31 @@ mod slab {
         fn bf16_slab_kernels_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..5, divide in any::<bool>(), ftz in any::<bool>()) {
             let o = FpOpts { div: if divide { DivMode::Divide } else { DivMode::RecipMul }, ..subnormals(ftz) };
             check(datapath::simd::WIDEST_NARROW, Ieee::new(datapath::format::Bf16, o), VARIANTS[v], seed, n, slab_batch_bf16, slab_ray_bf16)?;
+        }
+    }
+
+    /// `slab_ray_f16` on at most the AVX2 kernel (a cap only lowers: an outer one stands).
+    fn ray_f16_at_most_avx2(
+        s: &Slab<Ieee<F16Half>>,
+        r: &SlabRay<half::f16>,
+        b: &BoxesSoa<half::f16>,
+        o: &mut SlabOutSoa<half::f16>,
+    ) -> Kernel {
+        match slab_ray_f16(s, r, b, o) {
+            k if k > Kernel::Avx2 => with_kernel_cap(Kernel::Avx2, || slab_ray_f16(s, r, b, o)),
+            k => k,
+        }
+    }
+
+    proptest! {
+        // a measured alternative, not the dispatched kernel: fewer cases
+        #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+
+        /// The AVX2 binary16 slab kernel whose rounding stays in binary32 lanes (`isa::v8r`),
+        /// its one-ray batches the AVX2 kernel's.
+        #[test]
+        fn f16_slab_kernels_rounding_in_lanes_match_the_scalar_model(seed in any::<u64>(), n in 0usize..300, v in 0usize..5, ftz in any::<bool>()) {
+            check(Kernel::Avx2, Ieee::new(F16Half, subnormals(ftz)), VARIANTS[v], seed, n, datapath::simd::slab_batch_f16_lanes, ray_f16_at_most_avx2)?;
         }
     }
 

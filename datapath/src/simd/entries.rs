@@ -292,3 +292,51 @@ slab_entry!(
     /// [`Slab::batch_ray`] (one ray, many boxes) for bf16 on the fastest kernel available; the same bits.
     slab_ray_bf16, Ieee<Bf16>, u16, SlabRay<u16>, One, slab_ray_kernel_bf16, b8, b16, slab_bf16, None
 );
+
+/// [`rti_batch_f16`] on the AVX2 kernel whose binary16 rounding stays in binary32 lanes
+/// (`isa::v8r`: no F16C round trip per operation), or the scalar model where that kernel does
+/// not apply (no AVX2 + F16C, a cap below AVX2, a unit the binary16 kernels do not take); the
+/// same bits. Measured beside the dispatched kernel by `raypipe speed` (docs/speed.md).
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn rti_batch_f16_lanes(
+    rti: &Rti<Ieee<F16Half>>,
+    rays: &RaysSoa<f16>,
+    tris: &TrisSoa<f16>,
+    out: &mut HitsSoa<f16>,
+) -> Kernel {
+    let which = kernel_f16(rti).min(Kernel::Avx2);
+    rti_dispatch(
+        rti,
+        rays,
+        tris,
+        out,
+        which,
+        #[cfg(target_arch = "x86_64")]
+        (kernels::v8r::rti_f16, kernels::v8r::rti_f16, None),
+    )
+}
+
+/// [`slab_batch_f16`] on the AVX2 kernel whose binary16 rounding stays in binary32 lanes, as
+/// [`rti_batch_f16_lanes`]; the same bits.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn slab_batch_f16_lanes(
+    s: &Slab<Ieee<F16Half>>,
+    rays: &SlabRaysSoa<f16>,
+    boxes: &BoxesSoa<f16>,
+    out: &mut SlabOutSoa<f16>,
+) -> Kernel {
+    let which = slab_kernel_f16(s).min(Kernel::Avx2);
+    slab_dispatch(
+        s,
+        SlabRays::Pairs(rays),
+        boxes,
+        out,
+        which,
+        #[cfg(target_arch = "x86_64")]
+        (kernels::v8r::slab_f16, kernels::v8r::slab_f16, None),
+    )
+}

@@ -596,6 +596,9 @@ macro_rules! kernels_for {
 }
 
 kernels_for!(v8, "avx2", "avx2,f16c");
+// binary16 rounded in binary32 lanes instead of an F16C round trip per operation (measured
+// beside `v8` by `raypipe speed`; the dispatch keeps `v8`, docs/speed.md)
+kernels_for!(v8r, binary16 "avx2,f16c");
 kernels_for!(v16, "avx512f", "avx512f,avx2");
 kernels_for!(v32h, binary16 "avx512fp16,avx512bw,avx512f");
 

@@ -1,4 +1,4 @@
-use super::isa::{v4d, v8d};
+use super::isa::{self, v4d, v8d};
 use crate::format::{Ieee, Soft};
 use crate::Format;
 
@@ -101,5 +101,45 @@ fn next_up_in_binary64_lanes_equals_the_model_on_every_encoding() {
                 assert_eq!(g.to_bits(), want.to_bits(), "{name}: next_up({x:e}) = {g:e}, the model {want:e}");
             }
         }
+    }
+}
+
+/// `isa::v8r::round16_lanes` equals the F16C round trip (`vcvtps2ph` nearest-even, then
+/// `vcvtph2ps`) on every binary32 encoding: the same bits, or NaN for NaN.
+#[test]
+fn round16_in_lanes_equals_the_conversion_on_every_binary32() {
+    use std::arch::is_x86_feature_detected as has;
+    use std::arch::x86_64::*;
+    if !(has!("avx2") && has!("f16c")) {
+        return;
+    }
+    #[target_feature(enable = "avx2,f16c")]
+    fn sweep(from: u32, to: u32) -> Option<(u32, u32, u32)> {
+        let mut b = from;
+        while b < to {
+            let x = _mm256_castsi256_ps(_mm256_add_epi32(
+                _mm256_set1_epi32(b as i32),
+                _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+            ));
+            let got: [u32; 8] = unsafe { std::mem::transmute(isa::v8r::round16_lanes(x)) };
+            let want: [u32; 8] = unsafe { std::mem::transmute(isa::v8::round16(x)) };
+            for k in 0..8 {
+                let nan = |v: u32| v & 0x7fff_ffff > 0x7f80_0000;
+                if got[k] != want[k] && !(nan(got[k]) && nan(want[k])) {
+                    return Some((b + k as u32, got[k], want[k]));
+                }
+            }
+            b = b.wrapping_add(8);
+            if b == 0 {
+                break;
+            }
+        }
+        None
+    }
+    // every encoding, in two halves (the sign) of 2^31
+    for (from, to) in [(0u32, 0x8000_0000u32), (0x8000_0000, u32::MAX)] {
+        // SAFETY: the features were detected.
+        let bad = unsafe { sweep(from, to) };
+        assert_eq!(bad, None, "(input, lanes, conversion)");
     }
 }

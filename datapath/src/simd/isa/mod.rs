@@ -73,6 +73,8 @@ macro_rules! table_ops {
 
 pub(super) mod v8;
 
+pub(super) mod v8r;
+
 pub(super) mod v16;
 /// The binary16 next-up step on 32 binary16 encodings, as [`step_up16`] (AVX512BW).
 #[inline]
