@@ -43,6 +43,27 @@ fn bench_traversals(c: &mut Criterion) {
                 .sum::<usize>()
         })
     });
+    // the same history traversal with each box test of a ray computed once (datapath::box_memo;
+    // the traversal's results and counted box tests unchanged): against the stack traversal,
+    // the ratio (history >= 0.8 of stack)
+    let mut memo = datapath::box_memo::BoxMemo::new(boxes.len());
+    g.bench_function("history_f32_slab_n4_memo", |bch| {
+        bch.iter(|| {
+            rays.iter()
+                .map(|r| {
+                    memo.next_ray();
+                    history_traverse(&hw, 4, |&i| {
+                        memo.get_or(i, || {
+                            let o = s.test(r, &boxes[i as usize]);
+                            o.hit.then_some(o.t_near as f64)
+                        })
+                    })
+                    .leaves
+                    .len()
+                })
+                .sum::<usize>()
+        })
+    });
     g.bench_function("stack_f32_slab_n4", |bch| {
         bch.iter(|| {
             rays.iter()

@@ -130,14 +130,20 @@ pub fn render<F: Format>(
             leaf_of[t as usize] = l as u32;
         }
     }
+    // each box test of a ray computed once over the history traversal's passes (its leaves
+    // unchanged: datapath::box_memo)
+    let mut memo = datapath::box_memo::BoxMemo::new(boxes.len());
     for j in 0..height {
         for i in 0..width {
             let ray = Ray64 { o: camera.eye, d: camera.ray_dir(i, j, width, height), tmin: 0.0, tmax: f64::INFINITY };
             // the pipeline: slab-unit traversal, then the leaves' triangles through the min-capture
             let sr = slab.prepare(ray.o, ray.d, ray.tmin, ray.tmax);
+            memo.next_ray();
             let leaves = history_traverse(&hw, usize::MAX, |&n| {
-                let o = slab.test(&sr, &boxes[n as usize]);
-                o.hit.then(|| f.to_f64(o.t_near))
+                memo.get_or(n, || {
+                    let o = slab.test(&sr, &boxes[n as usize]);
+                    o.hit.then(|| f.to_f64(o.t_near))
+                })
             })
             .leaves;
             let mray = rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);

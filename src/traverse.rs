@@ -6,6 +6,7 @@ pub mod cover;
 
 use crate::bvh::{build, SceneBvh};
 use crate::scene::Scene;
+use datapath::box_memo::BoxMemo;
 use datapath::bvh::{history_traverse, trail_traverse, HwTree};
 use datapath::rng::SplitMix64;
 use datapath::slab::{Slab, SlabConfig};
@@ -350,8 +351,10 @@ fn one_format<F: Format>(
         &cfg.engine,
         cfg.rays as u64,
         &progress,
-        || (),
-        |_, range| {
+        // each box test of a ray computed once and remembered for the four traversals (their
+        // results and counted box tests unchanged: datapath::box_memo)
+        || BoxMemo::new(boxes.len()),
+        |memo, range| {
             let mut c = engine::Counts::<COUNTERS>::default();
             for k in range {
                 let ray = gen.ray(k);
@@ -360,14 +363,15 @@ fn one_format<F: Format>(
                     let o = s.test(&sr, &boxes[i as usize]);
                     o.hit.then(|| f.to_f64(o.t_near))
                 };
-                let g = stack_traverse(tree, n, test);
-                let h = history_traverse(hw, n, |&i| test(i));
+                memo.next_ray();
+                let g = stack_traverse(tree, n, |i| memo.get_or(i, || test(i)));
+                let h = history_traverse(hw, n, |&i| memo.get_or(i, || test(i)));
                 let skipped = if h.leaves.len() == n {
-                    history_traverse(hw, usize::MAX, |&i| test(i)).box_tests - h.box_tests
+                    history_traverse(hw, usize::MAX, |&i| memo.get_or(i, || test(i))).box_tests - h.box_tests
                 } else {
                     0
                 };
-                let t = trail_traverse(hw, n, |&i| test(i));
+                let t = trail_traverse(hw, n, |&i| memo.get_or(i, || test(i)));
                 let with_leaves = !g.leaves.is_empty();
                 let add = [
                     1,

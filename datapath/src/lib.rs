@@ -6,6 +6,7 @@
 pub mod alloc;
 pub mod bound;
 pub mod bound_filter;
+pub mod box_memo;
 pub mod bvh;
 pub mod fault;
 pub mod format;

@@ -92,6 +92,19 @@ fn check_all_n(nodes: &[NodeDesc], outcome: &dyn Fn(u32) -> Option<f64>) -> Resu
         let want = stack_traverse(&g, n, outcome);
         let h = history_traverse(&hw, n, |&i| outcome(i));
         let t = trail_traverse(&hw, n, |&i| outcome(i));
+        // with each box test remembered (datapath::box_memo, as `traverse` and `render` run
+        // it): the same result, counted box tests included, and each box tested at most once
+        let mut memo = datapath::box_memo::BoxMemo::new(nodes.len());
+        let mut tested = vec![0u32; nodes.len()];
+        let hm = history_traverse(&hw, n, |&i| {
+            memo.get_or(i, || {
+                tested[i as usize] += 1;
+                outcome(i)
+            })
+        });
+        if hm != h || tested.iter().any(|&c| c > 1) {
+            return Err(format!("history N={n} with the memo: {hm:?} vs {h:?}, tests per box {tested:?}"));
+        }
         if h.leaves != want.leaves {
             return Err(format!("history N={n}: {:?} vs stack {:?}", h.leaves, want.leaves));
         }
