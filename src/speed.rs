@@ -403,6 +403,10 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
         push(row("error bound f64 block (widest here)", n, 0.0, 3, || {
             datapath::bound::verdict_block(Kernel::Avx512Fp16, opts, bray, c9(), &mut dec, &mut hit, &mut te)
         }));
+        // the same bound as one loop the compiler vectorises (before the explicit registers)
+        push(row("error bound f64 block, compiler-vectorised loop (widest here)", n, 0.0, 3, || {
+            datapath::bound::verdict_block_loop(Kernel::Avx512Fp16, opts, bray, c9(), &mut dec, &mut hit, &mut te)
+        }));
         // the same block with the static filter in front (datapath::bound_filter; verify's path)
         let mut cert = vec![false; n];
         push(row("error bound f64 block, static filter first (widest here)", n, 0.0, 3, || {

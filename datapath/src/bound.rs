@@ -285,15 +285,13 @@ pub struct BlockOpts {
     pub det_threshold: f64,
 }
 
-/// Per lane: the verdict's `decisive` and `hit`, and the bound `t_err`, for `ray` against
-/// triangle columns x0 y0 z0 x1 y1 z1 x2 y2 z2, on AVX-512F lanes, AVX2 lanes or the baseline
-/// (the widest the machine has within `cap`); bit-identical to [`RtiBound::new`] +
-/// [`RtiBound::verdict`] on each lane (same operations, same order; the level changes only the
-/// instructions).
+/// [`verdict_block`] as one loop over the lanes that the compiler vectorises (AVX-512F lanes,
+/// AVX2 lanes or the baseline, the widest within `cap`); bit-identical to it (same operations,
+/// same order; the level changes only the instructions).
 ///
 /// # Panics
 /// If the column lengths differ.
-pub fn verdict_block(
+pub fn verdict_block_loop(
     cap: crate::simd::Kernel,
     opts: BlockOpts,
     ray: BlockRay,
@@ -321,6 +319,102 @@ pub fn verdict_block(
     }
     let _ = cap;
     block_body(opts, ray, tris, decisive, hit, t_err)
+}
+
+/// Per lane: the verdict's `decisive` and `hit`, and the bound `t_err`, for `ray` against
+/// triangle columns x0 y0 z0 x1 y1 z1 x2 y2 z2, on explicit vector registers
+/// ([`crate::lanes_x86`]: the bound written in [`crate::lanes::Lane`] on 8 AVX-512F or 4 AVX2
+/// binary64 lanes, the remainder lane by lane) or the baseline (the widest the machine has
+/// within `cap`); bit-identical to [`RtiBound::new`] + [`RtiBound::verdict`] on each lane and
+/// to [`verdict_block_loop`], the loop the compiler vectorises (measured beside it by `raypipe
+/// speed`: 1.35–1.45× its rate on AVX-512F, about equal on AVX2; docs/speed.md).
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn verdict_block(
+    cap: crate::simd::Kernel,
+    opts: BlockOpts,
+    ray: BlockRay,
+    tris: [&[f64]; 9],
+    decisive: &mut [bool],
+    hit: &mut [bool],
+    t_err: &mut [f64],
+) {
+    use crate::simd::Kernel;
+    let n = hit.len();
+    assert!(decisive.len() == n && t_err.len() == n && tris.iter().all(|c| c.len() == n), "column lengths differ");
+    let cap = crate::simd::best_kernel(true, cap);
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::is_x86_feature_detected as has;
+        if cap >= Kernel::Avx512 && has!("avx512f") {
+            // SAFETY: AVX-512F is present (checked above)
+            return unsafe { explicit_avx512(opts, ray, tris, decisive, hit, t_err) };
+        }
+        if cap >= Kernel::Avx2 && has!("avx2") {
+            // SAFETY: AVX2 is present (checked above)
+            return unsafe { explicit_avx2(opts, ray, tris, decisive, hit, t_err) };
+        }
+    }
+    let _ = cap;
+    block_body(opts, ray, tris, decisive, hit, t_err)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn explicit_avx512(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: &mut [bool], te: &mut [f64]) {
+    use crate::lanes::Lane;
+    use crate::lanes_x86::F64x8;
+    use std::arch::x86_64::*;
+    let n = hit.len();
+    let full = n / 8 * 8;
+    let sp = F64x8::splat;
+    let (ro, rd) = ([sp(r.o[0]), sp(r.o[1]), sp(r.o[2])], [sp(r.d[0]), sp(r.d[1]), sp(r.d[2])]);
+    for i in (0..full).step_by(8) {
+        // SAFETY: i + 8 <= n = every column's length
+        let ld = |k: usize| F64x8(unsafe { _mm512_loadu_pd(c[k].as_ptr().add(i)) });
+        let v = [[ld(0), ld(1), ld(2)], [ld(3), ld(4), ld(5)], [ld(6), ld(7), ld(8)]];
+        let b = RtiBound::<F64x8>::new(o.em, o.div, ro, rd, v);
+        let vd = b.verdict(o.cull, o.det_threshold, r.tmin, r.tmax);
+        // SAFETY: as above
+        unsafe { _mm512_storeu_pd(te.as_mut_ptr().add(i), b.t_err.0) };
+        for k in 0..8 {
+            dec[i + k] = vd.decisive.0 >> k & 1 == 1;
+            hit[i + k] = vd.hit.0 >> k & 1 == 1;
+        }
+    }
+    for i in full..n {
+        (dec[i], hit[i], te[i]) = lane(o, r, c, i);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn explicit_avx2(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: &mut [bool], te: &mut [f64]) {
+    use crate::lanes::Lane;
+    use crate::lanes_x86::F64x4;
+    use std::arch::x86_64::*;
+    let n = hit.len();
+    let full = n / 4 * 4;
+    let sp = F64x4::splat;
+    let (ro, rd) = ([sp(r.o[0]), sp(r.o[1]), sp(r.o[2])], [sp(r.d[0]), sp(r.d[1]), sp(r.d[2])]);
+    for i in (0..full).step_by(4) {
+        // SAFETY: i + 4 <= n = every column's length
+        let ld = |k: usize| F64x4(unsafe { _mm256_loadu_pd(c[k].as_ptr().add(i)) });
+        let v = [[ld(0), ld(1), ld(2)], [ld(3), ld(4), ld(5)], [ld(6), ld(7), ld(8)]];
+        let b = RtiBound::<F64x4>::new(o.em, o.div, ro, rd, v);
+        let vd = b.verdict(o.cull, o.det_threshold, r.tmin, r.tmax);
+        // SAFETY: as above
+        unsafe { _mm256_storeu_pd(te.as_mut_ptr().add(i), b.t_err.0) };
+        let (d, h) = (_mm256_movemask_pd(vd.decisive.0), _mm256_movemask_pd(vd.hit.0));
+        for k in 0..4 {
+            dec[i + k] = d >> k & 1 == 1;
+            hit[i + k] = h >> k & 1 == 1;
+        }
+    }
+    for i in full..n {
+        (dec[i], hit[i], te[i]) = lane(o, r, c, i);
+    }
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -225,11 +225,21 @@ pub fn verdict_block_filtered(
         certified.fill(false);
         return 0;
     }
-    let mut k = 0;
+    let k = certified.iter().filter(|&&c| c).count();
+    if n - k > n / 8 {
+        // many lanes left: the per-test bound on the whole block in vector registers, then the
+        // certified lanes' verdicts put back (cheaper than the rest lane by lane)
+        crate::bound::verdict_block(cap, opts, ray, tris, decisive, hit, t_err);
+        for i in 0..n {
+            if certified[i] {
+                (decisive[i], hit[i], t_err[i]) = (true, false, f64::INFINITY);
+            }
+        }
+        return k;
+    }
     for i in 0..n {
         if certified[i] {
             (decisive[i], hit[i], t_err[i]) = (true, false, f64::INFINITY);
-            k += 1;
         } else {
             (decisive[i], hit[i], t_err[i]) = crate::bound::lane(opts, ray, tris, i);
         }

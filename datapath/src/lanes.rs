@@ -2,7 +2,8 @@
 //! selects on f64, nothing else (no FMA, no reassociation, no branch on data). Code written in
 //! them is branch-free, so a loop that runs it over coordinate columns is vectorised by the
 //! compiler (8 lanes under AVX-512F, 4 under AVX2) with each lane's result the one-case result
-//! bit for bit (NaN encodings aside, which Rust leaves open). `f64` implements [`Lane`].
+//! bit for bit (NaN encodings aside, which Rust leaves open). `f64` implements [`Lane`], and
+//! [`crate::lanes_x86`] implements it on AVX-512F and AVX2 registers (the bound's explicit SIMD).
 
 use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};

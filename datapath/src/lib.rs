@@ -11,6 +11,8 @@ pub mod bvh;
 pub mod fault;
 pub mod format;
 pub mod lanes;
+#[cfg(target_arch = "x86_64")]
+pub mod lanes_x86;
 pub mod probe;
 pub mod rng;
 pub mod rti;

@@ -989,9 +989,11 @@ mod bound_block {
                 tmax: if r.below(3) == 0 { edge(&mut r) } else { f64::INFINITY },
             };
             let cols: [Vec<f64>; 9] = std::array::from_fn(|_| (0..n).map(|_| edge(&mut r)).collect());
-            for k in kernels_here() {
+            for (k, explicit) in kernels_here().into_iter().flat_map(|k| [(k, false), (k, true)]) {
                 let (mut dec, mut hit, mut te) = (vec![false; n], vec![false; n], vec![0.0; n]);
-                verdict_block(k, opts, ray, std::array::from_fn(|c| &cols[c][..]), &mut dec, &mut hit, &mut te);
+                // the loop the compiler vectorises, and the explicit vector registers
+                let block = if explicit { verdict_block } else { datapath::bound::verdict_block_loop };
+                block(k, opts, ray, std::array::from_fn(|c| &cols[c][..]), &mut dec, &mut hit, &mut te);
                 for i in 0..n {
                     let v = std::array::from_fn(|p| std::array::from_fn(|a| cols[3 * p + a][i]));
                     let b = RtiBound::new(opts.em, opts.div, ray.o, ray.d, v);
