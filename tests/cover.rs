@@ -22,6 +22,13 @@ fn cover_json(args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&o.stdout).unwrap()
 }
 
+/// Runs raypipe, which must succeed: its stdout as JSON (null when it printed none).
+fn run_json(args: &[&str]) -> serde_json::Value {
+    let o = raypipe(args);
+    assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap_or(serde_json::Value::Null)
+}
+
 #[test]
 fn cover_reports_merges_and_gates() {
     let tmp = std::env::temp_dir().join(format!("raypipe-cover-{}", std::process::id()));
@@ -286,11 +293,7 @@ fn verify_and_stress_cover_count_every_test_and_merge_like_one_pass() {
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).unwrap();
     let p = |n: &str| tmp.join(n).display().to_string();
-    let run = |args: &[&str]| -> serde_json::Value {
-        let o = raypipe(args);
-        assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
-        serde_json::from_slice(&o.stdout).unwrap_or(serde_json::Value::Null)
-    };
+    let run = run_json;
     let cover = cover_json;
     let verify = ["verify", "--rays", "40", "--format", "fp16", "--quiet"];
     let rep = run(&[&verify[..], &["--json", "--cover", &p("v.json")]].concat());
@@ -395,11 +398,7 @@ fn traverse_cover_counts_every_ray_and_merges_like_one_pass() {
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).unwrap();
     let p = |n: &str| tmp.join(n).display().to_string();
-    let run = |args: &[&str]| -> serde_json::Value {
-        let o = raypipe(args);
-        assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
-        serde_json::from_slice(&o.stdout).unwrap_or(serde_json::Value::Null)
-    };
+    let run = run_json;
     let trav = ["traverse", "--rays", "600", "--format", "fp16,f32", "--quiet"];
     let rep = run(&[&trav[..], &["--json", "--cover", &p("t.json")]].concat());
     let c = cover_json(&[&p("t.json")]);

@@ -300,25 +300,13 @@ pub fn verdict_block_loop(
     hit: &mut [bool],
     t_err: &mut [f64],
 ) {
-    use crate::simd::Kernel;
-    let n = hit.len();
-    assert!(decisive.len() == n && t_err.len() == n && tris.iter().all(|c| c.len() == n), "column lengths differ");
-    // within this thread's and the process's caps as well
-    let cap = crate::simd::best_kernel(true, cap);
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::is_x86_feature_detected as has;
-        if cap >= Kernel::Avx512 && has!("avx512f") {
-            // SAFETY: AVX-512F is present (checked above)
-            return unsafe { block_avx512(opts, ray, tris, decisive, hit, t_err) };
-        }
-        if cap >= Kernel::Avx2 && has!("avx2") {
-            // SAFETY: AVX2 is present (checked above)
-            return unsafe { block_avx2(opts, ray, tris, decisive, hit, t_err) };
-        }
-    }
-    let _ = cap;
-    block_body(opts, ray, tris, decisive, hit, t_err)
+    run_block(
+        cap,
+        (opts, ray, tris),
+        (decisive, hit, t_err),
+        #[cfg(target_arch = "x86_64")]
+        (block_avx512, block_avx2),
+    )
 }
 
 /// Per lane: the verdict's `decisive` and `hit`, and the bound `t_err`, for `ray` against
@@ -340,6 +328,27 @@ pub fn verdict_block(
     hit: &mut [bool],
     t_err: &mut [f64],
 ) {
+    run_block(
+        cap,
+        (opts, ray, tris),
+        (decisive, hit, t_err),
+        #[cfg(target_arch = "x86_64")]
+        (explicit_avx512, explicit_avx2),
+    )
+}
+
+/// A block body compiled for one instruction set (called after detecting it).
+#[cfg(target_arch = "x86_64")]
+type BlockFn = unsafe fn(BlockOpts, BlockRay, [&[f64]; 9], &mut [bool], &mut [bool], &mut [f64]);
+
+/// The column checks, then `avx512` or `avx2` (the widest the machine has within `cap`, and
+/// this thread's and the process's caps), else the baseline loop.
+fn run_block(
+    cap: crate::simd::Kernel,
+    (opts, ray, tris): (BlockOpts, BlockRay, [&[f64]; 9]),
+    (decisive, hit, t_err): (&mut [bool], &mut [bool], &mut [f64]),
+    #[cfg(target_arch = "x86_64")] (avx512, avx2): (BlockFn, BlockFn),
+) {
     use crate::simd::Kernel;
     let n = hit.len();
     assert!(decisive.len() == n && t_err.len() == n && tris.iter().all(|c| c.len() == n), "column lengths differ");
@@ -349,11 +358,11 @@ pub fn verdict_block(
         use std::arch::is_x86_feature_detected as has;
         if cap >= Kernel::Avx512 && has!("avx512f") {
             // SAFETY: AVX-512F is present (checked above)
-            return unsafe { explicit_avx512(opts, ray, tris, decisive, hit, t_err) };
+            return unsafe { avx512(opts, ray, tris, decisive, hit, t_err) };
         }
         if cap >= Kernel::Avx2 && has!("avx2") {
             // SAFETY: AVX2 is present (checked above)
-            return unsafe { explicit_avx2(opts, ray, tris, decisive, hit, t_err) };
+            return unsafe { avx2(opts, ray, tris, decisive, hit, t_err) };
         }
     }
     let _ = cap;
@@ -363,51 +372,41 @@ pub fn verdict_block(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 fn explicit_avx512(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: &mut [bool], te: &mut [f64]) {
-    use crate::lanes::Lane;
-    use crate::lanes_x86::F64x8;
-    use std::arch::x86_64::*;
-    let n = hit.len();
-    let full = n / 8 * 8;
-    let sp = F64x8::splat;
-    let (ro, rd) = ([sp(r.o[0]), sp(r.o[1]), sp(r.o[2])], [sp(r.d[0]), sp(r.d[1]), sp(r.d[2])]);
-    for i in (0..full).step_by(8) {
-        // SAFETY: i + 8 <= n = every column's length
-        let ld = |k: usize| F64x8(unsafe { _mm512_loadu_pd(c[k].as_ptr().add(i)) });
-        let v = [[ld(0), ld(1), ld(2)], [ld(3), ld(4), ld(5)], [ld(6), ld(7), ld(8)]];
-        let b = RtiBound::<F64x8>::new(o.em, o.div, ro, rd, v);
-        let vd = b.verdict(o.cull, o.det_threshold, r.tmin, r.tmax);
-        // SAFETY: as above
-        unsafe { _mm512_storeu_pd(te.as_mut_ptr().add(i), b.t_err.0) };
-        for k in 0..8 {
-            dec[i + k] = vd.decisive.0 >> k & 1 == 1;
-            hit[i + k] = vd.hit.0 >> k & 1 == 1;
-        }
-    }
-    for i in full..n {
-        (dec[i], hit[i], te[i]) = lane(o, r, c, i);
-    }
+    explicit_body::<crate::lanes_x86::F64x8>(o, r, c, dec, hit, te)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn explicit_avx2(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], dec: &mut [bool], hit: &mut [bool], te: &mut [f64]) {
-    use crate::lanes::Lane;
-    use crate::lanes_x86::F64x4;
-    use std::arch::x86_64::*;
+    explicit_body::<crate::lanes_x86::F64x4>(o, r, c, dec, hit, te)
+}
+
+/// The bound on `V::N` lanes at a time, the remainder lane by lane (inlined into a function
+/// compiled with `V`'s feature).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn explicit_body<V: crate::lanes_x86::Vector>(
+    o: BlockOpts,
+    r: BlockRay,
+    c: [&[f64]; 9],
+    dec: &mut [bool],
+    hit: &mut [bool],
+    te: &mut [f64],
+) {
     let n = hit.len();
-    let full = n / 4 * 4;
-    let sp = F64x4::splat;
+    let full = n / V::N * V::N;
+    let sp = V::splat;
     let (ro, rd) = ([sp(r.o[0]), sp(r.o[1]), sp(r.o[2])], [sp(r.d[0]), sp(r.d[1]), sp(r.d[2])]);
-    for i in (0..full).step_by(4) {
-        // SAFETY: i + 4 <= n = every column's length
-        let ld = |k: usize| F64x4(unsafe { _mm256_loadu_pd(c[k].as_ptr().add(i)) });
+    for i in (0..full).step_by(V::N) {
+        // SAFETY: i + N <= n = every column's length; the caller has V's feature
+        let ld = |k: usize| unsafe { V::load(c[k].as_ptr().add(i)) };
         let v = [[ld(0), ld(1), ld(2)], [ld(3), ld(4), ld(5)], [ld(6), ld(7), ld(8)]];
-        let b = RtiBound::<F64x4>::new(o.em, o.div, ro, rd, v);
+        let b = RtiBound::<V>::new(o.em, o.div, ro, rd, v);
         let vd = b.verdict(o.cull, o.det_threshold, r.tmin, r.tmax);
         // SAFETY: as above
-        unsafe { _mm256_storeu_pd(te.as_mut_ptr().add(i), b.t_err.0) };
-        let (d, h) = (_mm256_movemask_pd(vd.decisive.0), _mm256_movemask_pd(vd.hit.0));
-        for k in 0..4 {
+        unsafe { b.t_err.store(te.as_mut_ptr().add(i)) };
+        let (d, h) = (V::bits(vd.decisive), V::bits(vd.hit));
+        for k in 0..V::N {
             dec[i + k] = d >> k & 1 == 1;
             hit[i + k] = h >> k & 1 == 1;
         }

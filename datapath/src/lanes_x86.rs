@@ -206,3 +206,59 @@ impl Lane for F64x4 {
         unsafe { Self(_mm256_blendv_pd(b.0, a.0, m.0)) }
     }
 }
+
+/// A [`Lane`] vector that loads and stores f64 columns: what a block body needs to run code
+/// written in [`Lane`] over columns.
+pub trait Vector: Lane {
+    /// Lanes per vector.
+    const N: usize;
+    /// The `N` values at `p`.
+    ///
+    /// # Safety
+    /// `p..p + N` must be readable f64s, and the vector's feature present.
+    unsafe fn load(p: *const f64) -> Self;
+    /// Writes the lanes to `p..p + N`.
+    ///
+    /// # Safety
+    /// `p..p + N` must be writable f64s, and the vector's feature present.
+    unsafe fn store(self, p: *mut f64);
+    /// The mask as bits, lane k in bit k.
+    fn bits(m: Self::M) -> u32;
+}
+
+impl Vector for F64x8 {
+    const N: usize = 8;
+    #[inline(always)]
+    unsafe fn load(p: *const f64) -> Self {
+        // SAFETY: the caller's contract
+        unsafe { Self(_mm512_loadu_pd(p)) }
+    }
+    #[inline(always)]
+    unsafe fn store(self, p: *mut f64) {
+        // SAFETY: the caller's contract
+        unsafe { _mm512_storeu_pd(p, self.0) }
+    }
+    #[inline(always)]
+    fn bits(m: M8) -> u32 {
+        u32::from(m.0)
+    }
+}
+
+impl Vector for F64x4 {
+    const N: usize = 4;
+    #[inline(always)]
+    unsafe fn load(p: *const f64) -> Self {
+        // SAFETY: the caller's contract
+        unsafe { Self(_mm256_loadu_pd(p)) }
+    }
+    #[inline(always)]
+    unsafe fn store(self, p: *mut f64) {
+        // SAFETY: the caller's contract
+        unsafe { _mm256_storeu_pd(p, self.0) }
+    }
+    #[inline(always)]
+    fn bits(m: M4) -> u32 {
+        // SAFETY: used only where the feature was detected (module documentation)
+        unsafe { _mm256_movemask_pd(m.0) as u32 }
+    }
+}
