@@ -422,6 +422,47 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
             );
         }));
     }
+    // the traversals on the built-in scene's BVH, f32 slab unit as box tester, first 4 leaves,
+    // 4096 rays (M rays/s): the 2-bit history traversal with each box test of a ray remembered
+    // (as `traverse` and `render` run it) against the ordered stack traversal (the speed
+    // issue's ratio, history >= 0.8 of stack, is these two rows of one run)
+    {
+        let scene = crate::scene::Scene::builtin();
+        let b = crate::bvh::build(&scene, 4);
+        let s = Slab::new(f32f, SlabConfig::default());
+        let boxes: Vec<_> =
+            b.nodes.iter().map(|nd| s.store_box(nd.min, nd.max).unwrap_or_else(|_| s.empty_box())).collect();
+        if let Ok(hw) = b.layout_ids(64) {
+            let tree = b.golden_tree();
+            let rays: Vec<_> =
+                crate::traverse::rays(&scene, 4096, seed).iter().map(|r| s.prepare(r.o, r.d, r.tmin, r.tmax)).collect();
+            let test = |r: &datapath::slab::SlabRay<f32>, i: u32| {
+                let o = s.test(r, &boxes[i as usize]);
+                o.hit.then_some(o.t_near as f64)
+            };
+            let mut memo = datapath::box_memo::BoxMemo::new(boxes.len());
+            let mut sink = 0usize;
+            push(row(
+                "traverse: 2-bit history, box tests remembered, f32 slab, N = 4 (M rays/s)",
+                rays.len(),
+                0.0,
+                3,
+                || {
+                    for r in &rays {
+                        memo.next_ray();
+                        sink +=
+                            datapath::bvh::history_traverse(&hw, 4, |&i| memo.get_or(i, || test(r, i))).leaves.len();
+                    }
+                },
+            ));
+            push(row("traverse: ordered stack, f32 slab, N = 4 (M rays/s)", rays.len(), 0.0, 3, || {
+                for r in &rays {
+                    sink += golden::bvh::stack_traverse(&tree, 4, |i| test(r, i)).leaves.len();
+                }
+            }));
+            std::hint::black_box(sink);
+        }
+    }
     // a batch far beyond the caches: one pass over 1 M-pair columns against the same pairs
     // streamed through L1-sized chunks gathered from the scene (gather included)
     {
