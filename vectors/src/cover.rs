@@ -217,14 +217,7 @@ impl Coverage {
                 role: "stage signals".into(),
                 stage: Some(stage),
                 kind: "compare".into(),
-                bins: COMPARE_BINS
-                    .iter()
-                    .map(|&n| Bin {
-                        name: n.into(),
-                        count: 0,
-                        unreachable: (n == "unordered" && fixed).then_some(WHY_FIXED_ORDERED),
-                    })
-                    .collect(),
+                bins: compare_bins(fixed),
             });
         }
         let ftz = m.format.contains("ftz");
@@ -302,14 +295,7 @@ impl Coverage {
                 role: "stage signals".into(),
                 stage: Some(stage),
                 kind: "operand cross".into(),
-                bins: CROSS_CLASSES
-                    .iter()
-                    .flat_map(|x| CROSS_CLASSES.iter().map(move |y| format!("{x} x {y}")))
-                    .map(|n| {
-                        let unreachable = cross_reason(m, (name, a, b), &n);
-                        Bin { name: n, count: 0, unreachable }
-                    })
-                    .collect(),
+                bins: cross_bins(|n| cross_reason(m, (name, a, b), n)),
             });
         }
         for e in events(m) {
@@ -334,14 +320,7 @@ impl Coverage {
                 role: "stage signals".into(),
                 stage: Some(1),
                 kind: "compare".into(),
-                bins: COMPARE_BINS
-                    .iter()
-                    .map(|&n| Bin {
-                        name: n.into(),
-                        count: 0,
-                        unreachable: (n == "unordered" && fixed).then_some(WHY_FIXED_ORDERED),
-                    })
-                    .collect(),
+                bins: compare_bins(fixed),
             });
             if !fixed {
                 for op in crate::gen::OPCODES {
@@ -350,15 +329,7 @@ impl Coverage {
                         role: "stage signals".into(),
                         stage: Some(1),
                         kind: "operand cross".into(),
-                        bins: CROSS_CLASSES
-                            .iter()
-                            .flat_map(|x| CROSS_CLASSES.iter().map(move |y| format!("{x} x {y}")))
-                            .map(|n| {
-                                let unreachable =
-                                    (m.format.contains("ftz") && n.contains("subnormal")).then_some(WHY_FTZ);
-                                Bin { name: n, count: 0, unreachable }
-                            })
-                            .collect(),
+                        bins: cross_bins(|n| (m.format.contains("ftz") && n.contains("subnormal")).then_some(WHY_FTZ)),
                     });
                 }
             }
@@ -660,13 +631,7 @@ impl RowBins {
         let cmp_operand = |n: &str| if n == "zero" { Some(Some(0.0)) } else { operand(ix, contents, row, n, ftz) };
         for &(_, _, a, b) in &self.cmps {
             if let (Some(x), Some(y)) = (cmp_operand(a), cmp_operand(b)) {
-                let bin = match (x, y) {
-                    (None, _) | (_, None) => 3,
-                    (Some(x), Some(y)) if x < y => 0,
-                    (Some(x), Some(y)) if x == y => 1,
-                    _ => 2,
-                };
-                out.push((cp, bin));
+                out.push((cp, compare_bin(x, y)));
             }
             cp += 1;
         }
@@ -679,15 +644,9 @@ impl RowBins {
         if self.op_rounding {
             // the op unit: the operation the row's opcode selects (0 add, 1 sub, 2 mul,
             // 3 div in divide mode; the reciprocal mode's a * (1/b) rounds twice: not counted)
-            let opcode = ix.field("opcode").and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied());
-            let op = match opcode {
-                Some(0) => Some("add"),
-                Some(1) => Some("sub"),
-                Some(2) => Some("mul"),
-                Some(3) if m.format.contains("divide") => Some("div"),
-                _ => None,
-            };
-            if let Some(bin) = op.and_then(|op| rounding_event(ix, contents, row, "result", op, "a", "b", ftz)) {
+            if let Some(bin) = op_unit_op(ix, contents, row)
+                .and_then(|op| rounding_event(ix, contents, row, "result", op, "a", "b", ftz))
+            {
                 out.push((cp, bin));
             }
             cp += 1;
@@ -699,15 +658,9 @@ impl RowBins {
             cp += 1;
         }
         if self.op_fixed {
-            let opcode = ix.field("opcode").and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied());
-            let op = match opcode {
-                Some(0) => Some("add"),
-                Some(1) => Some("sub"),
-                Some(2) => Some("mul"),
-                Some(3) if m.format.contains("divide") => Some("div"),
-                _ => None,
-            };
-            if let Some(bin) = op.and_then(|op| fixed_event(ix, contents, row, "result", op, "a", "b")) {
+            if let Some(bin) =
+                op_unit_op(ix, contents, row).and_then(|op| fixed_event(ix, contents, row, "result", op, "a", "b"))
+            {
                 out.push((cp, bin));
             }
             cp += 1;
@@ -785,6 +738,40 @@ impl RowBins {
             }
         }
         Ok(())
+    }
+}
+
+/// The bins of a compare coverpoint (`unordered` unreachable in fixed point).
+fn compare_bins(fixed: bool) -> Vec<Bin> {
+    COMPARE_BINS
+        .iter()
+        .map(|&n| Bin {
+            name: n.into(),
+            count: 0,
+            unreachable: (n == "unordered" && fixed).then_some(WHY_FIXED_ORDERED),
+        })
+        .collect()
+}
+
+/// The bins of an operand cross (`a class x b class`), each unreachable where `why` says.
+fn cross_bins(why: impl Fn(&str) -> Option<&'static str>) -> Vec<Bin> {
+    CROSS_CLASSES
+        .iter()
+        .flat_map(|x| CROSS_CLASSES.iter().map(move |y| format!("{x} x {y}")))
+        .map(|n| Bin { unreachable: why(&n), name: n, count: 0 })
+        .collect()
+}
+
+/// The op unit's operation that row `row`'s opcode selects, as one rounding: 0 add, 1 sub, 2
+/// mul, 3 div in divide mode (the reciprocal mode's a × (1/b) rounds twice: none).
+fn op_unit_op(ix: &Ix, contents: &[Vec<Vec<u64>>], row: usize) -> Option<&'static str> {
+    let opcode = ix.field("opcode").and_then(|(i, _, k)| contents.get(i)?.get(row)?.get(k).copied());
+    match opcode {
+        Some(0) => Some("add"),
+        Some(1) => Some("sub"),
+        Some(2) => Some("mul"),
+        Some(3) if ix.m.format.contains("divide") => Some("div"),
+        _ => None,
     }
 }
 
@@ -1079,10 +1066,18 @@ fn unit_rounding_reason(m: &Manifest, signal: &str, bin: &str) -> Option<&'stati
 
 /// The rounded operations of the set's unit with IEEE-like operands: (stage, signal, op, a, b).
 fn arith_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str, &'static str)> {
+    stage_ops(m, |k| matches!(k, Kind::Ieee { .. }))
+}
+
+/// The operations of the stage table (add, sub, mul, div rows) whose result and operands are
+/// fields of kind `kind_ok` (or the constant `one`): (stage, signal, op, a, b).
+fn stage_ops(
+    m: &Manifest,
+    kind_ok: impl Fn(&Kind) -> bool,
+) -> Vec<(u8, &'static str, &'static str, &'static str, &'static str)> {
     use datapath::stage::{Op, Rule};
-    let table = stage_table_of(m);
-    let known = |n: &str| n == "one" || field(m, n).is_some_and(|x| matches!(x.1.kind, Kind::Ieee { .. }));
-    table
+    let known = |n: &str| n == "one" || field(m, n).is_some_and(|x| kind_ok(&x.1.kind));
+    stage_table_of(m)
         .into_iter()
         .filter(|d| matches!(d.rule, Rule::Arith | Rule::ArithGuardRecip | Rule::ArithGuardSub))
         .filter_map(|d| {
@@ -1101,23 +1096,7 @@ fn arith_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str
 
 /// The operations of the set's unit with fixed-point operands: (stage, signal, op, a, b).
 fn fixed_arith_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str, &'static str)> {
-    use datapath::stage::{Op, Rule};
-    let known = |n: &str| n == "one" || field(m, n).is_some_and(|x| matches!(x.1.kind, Kind::Fixed { .. }));
-    stage_table_of(m)
-        .into_iter()
-        .filter(|d| matches!(d.rule, Rule::Arith | Rule::ArithGuardRecip | Rule::ArithGuardSub))
-        .filter_map(|d| {
-            let op = match d.op {
-                Op::Add => "add",
-                Op::Sub => "sub",
-                Op::Mul => "mul",
-                Op::Div => "div",
-                Op::Logic => return None,
-            };
-            Some((d.stage, d.name, op, d.a, d.b))
-        })
-        .filter(|&(_, n, _, a, b)| n != "one" && known(n) && known(a) && known(b))
-        .collect()
+    stage_ops(m, |k| matches!(k, Kind::Fixed { .. }))
 }
 
 /// Whether the set is an op set with a fixed-point result (its operation events are counted).
@@ -1210,15 +1189,8 @@ fn fixed_event_reason(m: &Manifest, signal: &str, bin: &str) -> Option<&'static 
 /// The raw (two's-complement, in steps) value of fixed-point field `name` in row `row`; None
 /// when it is don't-care in this row (care_when) or not a fixed-point field.
 fn raw_fixed(ix: &Ix, contents: &[Vec<Vec<u64>>], row: usize, name: &str) -> Option<i128> {
-    let (i, x, k) = ix.field(name)?;
-    if let Some(flag) = &x.care_when {
-        let j = *ix.outs.get(flag.as_str())?;
-        if contents.get(1)?.get(row)?.get(j)? & 1 == 0 {
-            return None;
-        }
-    }
+    let (x, v) = cared(ix, contents, row, name)?;
     let Kind::Fixed { .. } = x.kind else { return None };
-    let v = *contents.get(i)?.get(row)?.get(k)?;
     let sh = 128 - x.width;
     Some(((v as i128) << sh) >> sh)
 }
@@ -1459,9 +1431,9 @@ fn cancel_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static st
 }
 
 /// The operations whose operand classes are crossed: every rounded operation of the stage
-/// table with two signal operands (not the constant 1) that is not gated by a care_when (the
-/// signals after RTI's valid bit are defined only where valid is 1, which constrains their
-/// operands; they are not crossed).
+/// table with two signal operands (not the constant 1); one gated by a care_when (RTI's t, u,
+/// v after `valid`) is counted only where it is defined, and its cells `valid` rules out are
+/// marked in [`cross_reason`].
 fn crossed_rows(m: &Manifest) -> Vec<(u8, &'static str, &'static str, &'static str, &'static str)> {
     arith_rows(m).into_iter().filter(|&(_, name, _, a, _)| a != "one" && field(m, name).is_some()).collect()
 }
@@ -1851,14 +1823,10 @@ impl Event {
                     if flag(&format!("hit{s}")) != Some(true) || flag(&format!("c{}_hit", s - 1)) != Some(true) {
                         continue;
                     }
-                    if let (Some(Some(x)), Some(Some(y))) = (num(&format!("t{s}")), num(&format!("c{}_t", s - 1))) {
-                        seen[if x < y {
-                            0
-                        } else if x == y {
-                            1
-                        } else {
-                            2
-                        }] = true;
+                    if let (Some(x @ Some(_)), Some(y @ Some(_))) =
+                        (num(&format!("t{s}")), num(&format!("c{}_t", s - 1)))
+                    {
+                        seen[compare_bin(x, y)] = true;
                     }
                 }
                 (0..3).filter(|&k| seen[k]).collect()
@@ -2022,6 +1990,17 @@ impl Ix {
 /// Operand `name` of row `row` as the datapath's compare reads it: `Some(None)` a NaN,
 /// `Some(Some(v))` a number; `None` when the value is don't-care in this row (care_when).
 fn operand(ix: &Ix, contents: &[Vec<Vec<u64>>], row: usize, name: &str, ftz: bool) -> Option<Option<f64>> {
+    let (x, v) = cared(ix, contents, row, name)?;
+    Some(match x.kind {
+        Kind::Ieee { exp, man } => ieee_value(v, exp, man, ftz),
+        Kind::Fixed { .. } => Some(fixed_steps(v, x.width)),
+        _ => Some(v as f64),
+    })
+}
+
+/// Field `name` of row `row` and its raw encoding; None when the field is don't-care in this
+/// row (its care_when flag is 0) or absent.
+fn cared<'a>(ix: &'a Ix, contents: &[Vec<Vec<u64>>], row: usize, name: &str) -> Option<(&'a Field, u64)> {
     let (i, x, k) = ix.field(name)?;
     if let Some(flag) = &x.care_when {
         let j = *ix.outs.get(flag.as_str())?;
@@ -2029,12 +2008,7 @@ fn operand(ix: &Ix, contents: &[Vec<Vec<u64>>], row: usize, name: &str, ftz: boo
             return None;
         }
     }
-    let v = *contents.get(i)?.get(row)?.get(k)?;
-    Some(match x.kind {
-        Kind::Ieee { exp, man } => ieee_value(v, exp, man, ftz),
-        Kind::Fixed { .. } => Some(fixed_steps(v, x.width)),
-        _ => Some(v as f64),
-    })
+    Some((x, *contents.get(i)?.get(row)?.get(k)?))
 }
 
 /// Whether file `i` of the manifest holds one row per vector.
