@@ -445,5 +445,10 @@ fn traverse_cover_counts_every_ray_and_merges_like_one_pass() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("directed"));
     assert!(!tmp.join("d.json").exists());
+    // a file raypipe did not write is never replaced: refused before the run (exit 2), unchanged
+    std::fs::write(tmp.join("mine.json"), "my notes").unwrap();
+    let o = raypipe(&["traverse", "--rays", "10", "--quiet", "--cover", &p("mine.json")]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read_to_string(tmp.join("mine.json")).unwrap(), "my notes");
     let _ = std::fs::remove_dir_all(&tmp);
 }

@@ -51,7 +51,7 @@ pub fn reach(c: &Coverage) -> Result<ReachMap, String> {
                 continue;
             }
             let names = out.entry((cp.role.clone(), cp.signal.clone(), bin.name.clone())).or_default();
-            if names.last().map(String::as_str) != Some(class) && !names.iter().any(|n| n == class) {
+            if !names.iter().any(|n| n == class) {
                 names.push(class.to_string());
             }
         }
