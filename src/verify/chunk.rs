@@ -26,7 +26,7 @@ use datapath::bound_filter::verdict_block_filtered;
 use datapath::rng::SplitMix64;
 use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
 use datapath::simd::{self, Kernel};
-use datapath::slab::{Aabb, BoxesSoa, Slab, SlabConfig, SlabOutSoa};
+use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa};
 use datapath::Format;
 use engine::{First, Hist, Merge, Progress};
 use golden::block::{intersect_block, slab_block, Level};
@@ -118,6 +118,18 @@ struct Variant<F: Format> {
     conservative: bool,
 }
 
+/// One triangle's data as the blocks gather it, in one record (one random access per test):
+/// the model's stored triangle, the quantised triangle (the format's values in f64), the
+/// triangle's box in f64 and that box stored in the format (outward-rounded; the same for every
+/// variant). The fields a pass does not use hold defaults.
+#[derive(Clone, Copy)]
+struct Rec<V> {
+    m: [V; 9],
+    q: [f64; 9],
+    b: [f64; 6],
+    s: [V; 6],
+}
+
 /// What every chunk of one format's pass shares (O(scene), built once).
 struct Setup<'a, F: Format> {
     cfg: &'a VerifyConfig,
@@ -126,11 +138,7 @@ struct Setup<'a, F: Format> {
     gen: crate::scene::RayGen,
     rti: Rti<F>,
     with_rti: bool,
-    mtris: Vec<Tri<F::V>>,
-    qtris: Vec<[f64; 9]>,
-    boxes: Vec<[f64; 6]>,
-    /// The scene's boxes stored in the format (outward-rounded; the same for every variant).
-    stored: Vec<Aabb<F::V>>,
+    recs: Vec<Rec<F::V>>,
     variants: Vec<Variant<F>>,
     opts: BlockOpts,
     faces: golden::Faces,
@@ -168,7 +176,7 @@ impl<V: Copy + Default> Scratch<V> {
     fn new() -> Self {
         let f = || vec![0.0; BLOCK];
         let b = || vec![false; BLOCK];
-        Scratch {
+        let mut s = Scratch {
             list: Vec::new(),
             rays: RaysSoa::default(),
             tris: TrisSoa::default(),
@@ -189,12 +197,74 @@ impl<V: Copy + Default> Scratch<V> {
             prepared: Vec::new(),
             boxes: BoxesSoa::default(),
             sout: SlabOutSoa::default(),
+        };
+        s.size(BLOCK);
+        s
+    }
+
+    /// The kernels' columns at `n` lanes (only when a block's size changes: a ray's last block).
+    fn size(&mut self, n: usize) {
+        if self.tris.len() != n {
+            let z = V::default();
+            self.rays.resize(n, z);
+            self.tris.resize(n, z);
+            self.out.resize(n);
+            self.boxes.min.iter_mut().chain(self.boxes.max.iter_mut()).for_each(|c| c.resize(n, z));
+            self.sout.hit.resize(n, false);
+            self.sout.t_near.resize(n, z);
+            self.sout.t_far.resize(n, z);
         }
     }
 }
 
 fn cols<const N: usize>(c: &[Vec<f64>; N], n: usize) -> [&[f64]; N] {
     std::array::from_fn(|k| &c[k][..n])
+}
+
+/// Column by column, `cols[c][k] = pick(recs[blk[k]])[c]`: one block's gather.
+#[inline(always)]
+fn gather<R, T: Copy, const C: usize>(recs: &[R], blk: &[u32], pick: impl Fn(&R) -> &[T; C], mut cols: [&mut [T]; C]) {
+    assert!(cols.iter().all(|c| c.len() >= blk.len()), "gather: a column is shorter than the block");
+    for (k, &ti) in blk.iter().enumerate() {
+        let r = pick(&recs[ti as usize]);
+        for (col, &x) in cols.iter_mut().zip(r) {
+            // SAFETY: k < blk.len() <= col.len() (asserted above)
+            unsafe { *col.get_unchecked_mut(k) = x };
+        }
+    }
+}
+
+/// A bit mask of at most 64 lanes: bit k is `b[k]`.
+#[inline(always)]
+fn bits(b: &[bool]) -> u64 {
+    debug_assert!(b.len() <= 64);
+    let (bytes, rest) = b.as_chunks::<8>();
+    let mut m = 0u64;
+    for (j, c) in bytes.iter().enumerate() {
+        // eight 0/1 bytes to eight bits: byte i lands on bit 56 + i, no carries between them
+        let x = u64::from_le_bytes(c.map(u8::from));
+        m |= (x.wrapping_mul(0x0102_0408_1020_4080) >> 56) << (8 * j);
+    }
+    for (j, &v) in rest.iter().enumerate() {
+        m |= u64::from(v) << (8 * bytes.len() + j);
+    }
+    m
+}
+
+/// A block of `n` lanes in words of 64: (first lane, lane count) per word.
+fn words(n: usize) -> impl Iterator<Item = (usize, usize)> {
+    (0..n).step_by(64).map(move |w| (w, (n - w).min(64)))
+}
+
+/// The set bits of `m`, lowest first.
+fn ones(mut m: u64) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (m != 0).then(|| {
+            let j = m.trailing_zeros() as usize;
+            m &= m - 1;
+            j
+        })
+    })
 }
 
 impl<F: Format + 'static> Setup<'_, F>
@@ -219,6 +289,7 @@ where
             let list = std::mem::take(&mut s.list);
             for (b, blk) in list.chunks(BLOCK).enumerate() {
                 let base = b * BLOCK;
+                s.size(blk.len());
                 if self.with_rti {
                     self.rti_block(s, &mut acc, &ray, &rq, &mray, blk, base, i, &mut cap, &mut gbest);
                 }
@@ -245,7 +316,14 @@ where
         explain_cmd(&self.name, ray, tri, self.scene.scale, self.cfg.inject.map(|x| x.name))
     }
 
-    #[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
+    /// One block of a ray's RTI tests: gather, model, golden, bound (static filter first), then
+    /// the judge. A lane that is decisive with neither the model nor the bound's exact decision
+    /// hitting (most lanes) only counts as a test, a decisive test and, when the model's divide
+    /// was skipped, a skipped divide (it has no disagreement, no violation — `judge::violation`
+    /// of such a lane is `None` — no shared hit, and neither the capture unit nor the golden
+    /// closest hit takes it); those counts are taken on bit masks, every other lane is judged
+    /// one by one in lane order.
+    #[allow(clippy::too_many_arguments)]
     fn rti_block(
         &self,
         s: &mut Scratch<F::V>,
@@ -259,24 +337,18 @@ where
         cap: &mut Capture<F::V>,
         gbest: &mut Option<(usize, f64)>,
     ) {
-        let f = &self.rti.fmt;
         let n = blk.len();
-        s.rays.resize(n, F::V::default());
-        s.tris.resize(n, F::V::default());
-        s.out.resize(n);
         // every lane holds the ray: written in the ray's first block (the largest), kept after
         if base == 0 {
             for k in 0..n {
                 s.rays.set(k, mray);
             }
         }
-        for (k, &ti) in blk.iter().enumerate() {
-            s.tris.set(k, &self.mtris[ti as usize]);
-            let qt = &self.qtris[ti as usize];
-            for c in 0..9 {
-                s.cols[c][k] = qt[c];
-            }
+        {
+            let [[a, b, c], [d, e, f], [g, h, i]] = &mut s.tris.v;
+            gather(&self.recs, blk, |r| &r.m, [a, b, c, d, e, f, g, h, i].map(|x| &mut x[..]));
         }
+        gather(&self.recs, blk, |r| &r.q, s.cols.each_mut().map(|x| &mut x[..]));
         let t0 = Instant::now();
         match self.cfg.inject {
             None => {
@@ -287,7 +359,9 @@ where
                 let x = faults::inject::Injected::new(spec);
                 for (k, &ti) in blk.iter().enumerate() {
                     x.next_test();
-                    let o = self.rti.trace_faulty(mray, &self.mtris[ti as usize], &mut datapath::probe::NoProbe, &x);
+                    let m = &self.recs[ti as usize].m;
+                    let tri = Tri { v: std::array::from_fn(|p| std::array::from_fn(|a| m[3 * p + a])) };
+                    let o = self.rti.trace_faulty(mray, &tri, &mut datapath::probe::NoProbe, &x);
                     (s.out.valid[k], s.out.hit[k], s.out.t[k], s.out.u[k], s.out.v[k]) =
                         (o.valid, o.hit, o.t, o.u, o.v);
                 }
@@ -308,59 +382,89 @@ where
             &mut s.terr[..n],
             &mut s.cert[..n],
         );
-        let c = &mut acc.counts;
-        let mut c_exact = 0;
-        for k in 0..n {
-            let (mhit, dec) = (s.out.hit[k], s.dec[k]);
-            let (gt, mt) = (s.gt[k], f.to_f64(s.out.t[k]));
-            // the reference decision (crate::judge::decide): a decisive case's is the bound's;
-            // the rest go through the f64 filter, then exact arithmetic
-            let gh = if dec {
-                s.ehit[k]
-            } else {
-                let tq = Tri64 { v: std::array::from_fn(|p| std::array::from_fn(|a| s.cols[3 * p + a][k])) };
-                let (h, fell) = crate::judge::reference(&self.rti, rq, &tq, s.ghit[k]);
-                c_exact += fell as u64;
-                h
-            };
-            c.tests += 1;
-            c.decisive += dec as u64;
-            c.reference_hits += gh as u64;
-            c.model_hits += mhit as u64;
-            c.false_misses += (gh && !mhit) as u64;
-            c.false_hits += (!gh && mhit) as u64;
-            if mhit != gh {
-                let tri = &self.scene.tris[blk[k] as usize];
-                acc.disagree.offer((ray_index, (base + k) as u64), || {
-                    let what = if gh { "false miss" } else { "false hit" };
-                    let how = if dec { "decisive" } else { "within the error bound" };
-                    format!("{what} ({how}): {}", self.explain(ray, tri))
-                });
-            }
-            // the property, the one rule of crate::judge (a decisive case's reference is the
-            // bound's exact decision)
-            if let Some(why) = crate::judge::violation(dec, mhit, gh, gh, mt, gt, s.terr[k]) {
-                c.violations += 1;
-                let tri = &self.scene.tris[blk[k] as usize];
-                acc.first.offer((ray_index, (base + k) as u64), || format!("{why}: {}", self.explain(ray, tri)));
-            }
-            if mhit && gh {
-                c.shared_hits += 1;
-                let e = (mt - gt).abs();
-                acc.ulps.add(e / f.ulp(gt));
-                acc.rels.add(e / gt.abs().max(f64::MIN_POSITIVE));
-            }
-            c.divide_skipped += !s.out.valid[k] as u64;
-            let out = RtiOut { valid: s.out.valid[k], hit: mhit, t: s.out.t[k], u: s.out.u[k], v: s.out.v[k] };
-            self.rti.capture(cap, &out, (base + k) as u32);
-            if gh && gbest.is_none_or(|(_, bt)| gt < bt) {
-                *gbest = Some((base + k, gt));
+        for (w, len) in words(n) {
+            let r = w..w + len;
+            let (dec, mhit, ehit, valid) =
+                (bits(&s.dec[r.clone()]), bits(&s.out.hit[r.clone()]), bits(&s.ehit[r.clone()]), bits(&s.out.valid[r]));
+            let all = u64::MAX >> (64 - len);
+            let c = &mut acc.counts;
+            c.tests += len as u64;
+            c.decisive += u64::from(dec.count_ones());
+            c.divide_skipped += u64::from((all & !valid).count_ones());
+            for j in ones(all & !(dec & !mhit & !ehit)) {
+                self.rti_lane(s, acc, ray, rq, blk, base, w + j, ray_index, cap, gbest);
             }
         }
-        c.exact += c_exact;
     }
 
-    #[allow(clippy::needless_range_loop)]
+    /// The judge of one RTI lane beyond its test, decisive and skipped-divide counts
+    /// ([`Self::rti_block`]): the reference decision, hits, disagreements, the property, the
+    /// t errors, the capture unit and the golden closest hit.
+    #[allow(clippy::too_many_arguments)]
+    fn rti_lane(
+        &self,
+        s: &Scratch<F::V>,
+        acc: &mut RtiAcc,
+        ray: &Ray64,
+        rq: &Ray64,
+        blk: &[u32],
+        base: usize,
+        k: usize,
+        ray_index: u64,
+        cap: &mut Capture<F::V>,
+        gbest: &mut Option<(usize, f64)>,
+    ) {
+        let f = &self.rti.fmt;
+        let c = &mut acc.counts;
+        let (mhit, dec) = (s.out.hit[k], s.dec[k]);
+        let (gt, mt) = (s.gt[k], f.to_f64(s.out.t[k]));
+        // the reference decision (crate::judge::decide): a decisive case's is the bound's;
+        // the rest go through the f64 filter, then exact arithmetic
+        let gh = if dec {
+            s.ehit[k]
+        } else {
+            let tq = Tri64 { v: std::array::from_fn(|p| std::array::from_fn(|a| s.cols[3 * p + a][k])) };
+            let (h, fell) = crate::judge::reference(&self.rti, rq, &tq, s.ghit[k]);
+            c.exact += fell as u64;
+            h
+        };
+        c.reference_hits += gh as u64;
+        c.model_hits += mhit as u64;
+        c.false_misses += (gh && !mhit) as u64;
+        c.false_hits += (!gh && mhit) as u64;
+        if mhit != gh {
+            let tri = &self.scene.tris[blk[k] as usize];
+            acc.disagree.offer((ray_index, (base + k) as u64), || {
+                let what = if gh { "false miss" } else { "false hit" };
+                let how = if dec { "decisive" } else { "within the error bound" };
+                format!("{what} ({how}): {}", self.explain(ray, tri))
+            });
+        }
+        // the property, the one rule of crate::judge (a decisive case's reference is the
+        // bound's exact decision)
+        if let Some(why) = crate::judge::violation(dec, mhit, gh, gh, mt, gt, s.terr[k]) {
+            c.violations += 1;
+            let tri = &self.scene.tris[blk[k] as usize];
+            acc.first.offer((ray_index, (base + k) as u64), || format!("{why}: {}", self.explain(ray, tri)));
+        }
+        if mhit && gh {
+            c.shared_hits += 1;
+            let e = (mt - gt).abs();
+            acc.ulps.add(e / f.ulp(gt));
+            acc.rels.add(e / gt.abs().max(f64::MIN_POSITIVE));
+        }
+        let out = RtiOut { valid: s.out.valid[k], hit: mhit, t: s.out.t[k], u: s.out.u[k], v: s.out.v[k] };
+        self.rti.capture(cap, &out, (base + k) as u32);
+        if gh && gbest.is_none_or(|(_, bt)| gt < bt) {
+            *gbest = Some((base + k, gt));
+        }
+    }
+
+    /// One block of a ray's slab tests, every variant: the golden f64 slab test once, then per
+    /// variant the model and the judge. A lane whose golden interval is not close to empty and
+    /// whose model agrees with the golden (most lanes) counts as a test and, when it hits, an
+    /// exact hit (the golden decides it; no false hit or miss) on bit masks; every other lane
+    /// takes the exact rational decision (computed once per lane for all variants).
     fn slab_block(
         &self,
         s: &mut Scratch<F::V>,
@@ -370,12 +474,7 @@ where
         blk: &[u32],
     ) {
         let n = blk.len();
-        for (k, &ti) in blk.iter().enumerate() {
-            let b = &self.boxes[ti as usize];
-            for c in 0..6 {
-                s.bcols[c][k] = b[c];
-            }
-        }
+        gather(&self.recs, blk, |r| &r.b, s.bcols.each_mut().map(|x| &mut x[..]));
         slab_block(
             self.level,
             rq.o,
@@ -388,38 +487,35 @@ where
             &mut s.sfar[..n],
         );
         // the stored boxes, gathered once for every variant
-        for c in s.boxes.min.iter_mut().chain(s.boxes.max.iter_mut()) {
-            c.resize(n, F::V::default());
-        }
-        for (k, &ti) in blk.iter().enumerate() {
-            let b = &self.stored[ti as usize];
-            for a in 0..3 {
-                s.boxes.min[a][k] = b.min[a];
-                s.boxes.max[a][k] = b.max[a];
-            }
+        {
+            let ([a, b, c], [d, e, f]) = (&mut s.boxes.min, &mut s.boxes.max);
+            gather(&self.recs, blk, |r| &r.s, [a, b, c, d, e, f].map(|x| &mut x[..]));
         }
         // the exact decision of each lane, computed at most once for all variants (0: not yet);
         // whether the golden interval is too close to empty to trust, once for all variants
         s.exact[..n].fill(0);
-        for k in 0..n {
-            let (near, far) = (s.snear[k], s.sfar[k]);
+        for ((close, &near), &far) in s.sclose[..n].iter_mut().zip(&s.snear[..n]).zip(&s.sfar[..n]) {
             let scale = 1.0f64.max(near.abs()).max(if far.is_finite() { far.abs() } else { 0.0 });
-            s.sclose[k] = (far - near).abs() <= 1e-9 * scale;
+            *close = (far - near).abs() <= 1e-9 * scale;
         }
         for ((v, sr), acc) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()) {
-            s.sout.hit.resize(n, false);
-            s.sout.t_near.resize(n, F::V::default());
-            s.sout.t_far.resize(n, F::V::default());
             let t0 = Instant::now();
             simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
             acc.model_ns += t0.elapsed().as_nanos() as u64;
             let c = &mut acc.counts;
-            for k in 0..n {
-                let (hit, g) = (s.sout.hit[k], s.shit[k]);
-                let exact = if s.sclose[k] || g != hit {
+            c.tests += n as u64;
+            for (w, len) in words(n) {
+                let r = w..w + len;
+                let (hit, g, close) = (bits(&s.sout.hit[r.clone()]), bits(&s.shit[r.clone()]), bits(&s.sclose[r]));
+                let all = u64::MAX >> (64 - len);
+                let settled = all & !close & !(hit ^ g);
+                c.exact_hits += u64::from((settled & g).count_ones());
+                for j in ones(all & !settled) {
+                    let k = w + j;
+                    let (hit, g) = (s.sout.hit[k], s.shit[k]);
                     c.exact_calls += 1;
                     if s.exact[k] == 0 {
-                        let b = &self.boxes[blk[k] as usize];
+                        let b = &self.recs[blk[k] as usize].b;
                         // verify's rays and boxes are finite; a ray that overflowed the format
                         // has no exact decision and counts as the f64 reference says
                         let e =
@@ -427,14 +523,11 @@ where
                                 .unwrap_or(g);
                         s.exact[k] = 1 + e as u8;
                     }
-                    s.exact[k] == 2
-                } else {
-                    g
-                };
-                c.tests += 1;
-                c.exact_hits += exact as u64;
-                c.false_misses += (exact && !hit) as u64;
-                c.false_hits += (!exact && hit) as u64;
+                    let exact = s.exact[k] == 2;
+                    c.exact_hits += exact as u64;
+                    c.false_misses += (exact && !hit) as u64;
+                    c.false_hits += (!exact && hit) as u64;
+                }
             }
         }
     }
@@ -636,7 +729,6 @@ where
     let rti = Rti::new(fmt, cfg.rti);
     let f = &rti.fmt;
     let q = |x: f64| f.to_f64(f.from_f64(x));
-    let boxes: Vec<[f64; 6]> = scene.tris.iter().map(|t| tri_box(&t.v)).collect();
     // only the variants the format accepts (a conservative promise it cannot keep is refused)
     let variants: Vec<Variant<F>> = SlabConfig::variants_for(f)
         .into_iter()
@@ -645,27 +737,35 @@ where
             Variant { name, conservative: sc.is_conservative(f), slab: Slab::new(*f, sc) }
         })
         .collect();
-    // box storage does not depend on the variant
-    let stored = match variants.first() {
-        Some(v) => boxes
-            .iter()
-            .map(|b| v.slab.store_box([b[0], b[1], b[2]], [b[3], b[4], b[5]]).unwrap_or_else(|_| v.slab.empty_box()))
-            .collect(),
-        None => Vec::new(),
-    };
+    let recs = scene
+        .tris
+        .iter()
+        .map(|t| {
+            let b = tri_box(&t.v);
+            let (m, q) = if with_rti {
+                let m = rti.tri(t.v).v;
+                (std::array::from_fn(|k| m[k / 3][k % 3]), std::array::from_fn(|k| q(t.v[k / 3][k % 3])))
+            } else {
+                ([F::V::default(); 9], [0.0; 9])
+            };
+            // box storage does not depend on the variant
+            let s = match variants.first() {
+                Some(v) => {
+                    let a =
+                        v.slab.store_box([b[0], b[1], b[2]], [b[3], b[4], b[5]]).unwrap_or_else(|_| v.slab.empty_box());
+                    [a.min[0], a.min[1], a.min[2], a.max[0], a.max[1], a.max[2]]
+                }
+                None => [F::V::default(); 6],
+            };
+            Rec { m, q, b, s }
+        })
+        .collect();
     let setup = Setup {
         cfg,
         scene,
         gen: scene.ray_gen(cfg.seed),
         with_rti,
-        mtris: if with_rti { scene.tris.iter().map(|t| rti.tri(t.v)).collect() } else { Vec::new() },
-        qtris: if with_rti {
-            scene.tris.iter().map(|t| std::array::from_fn(|k| q(t.v[k / 3][k % 3]))).collect()
-        } else {
-            Vec::new()
-        },
-        boxes,
-        stored,
+        recs,
         variants,
         opts: BlockOpts {
             em: f.error_model(),
@@ -692,5 +792,49 @@ where
         rti: with_rti.then_some(acc),
         slab: setup.variants.iter().zip(sacc).map(|(v, a)| (v.name.to_string(), v.conservative, a)).collect(),
         wall_ns,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `bits` puts lane k on bit k for every pattern of a byte and for every length up to 64
+    /// (random lanes); `ones` lists the set bits lowest first; `words` covers a block exactly.
+    #[test]
+    fn masks() {
+        let naive = |b: &[bool]| b.iter().enumerate().fold(0u64, |m, (k, &x)| m | (u64::from(x) << k));
+        for p in 0..256u32 {
+            let b: Vec<bool> = (0..8).map(|k| p >> k & 1 == 1).collect();
+            assert_eq!(bits(&b), u64::from(p));
+        }
+        let mut r = SplitMix64::new(3);
+        for len in 0..=64 {
+            for _ in 0..50 {
+                let b: Vec<bool> = (0..len).map(|_| r.below(2) == 1).collect();
+                let m = bits(&b);
+                assert_eq!(m, naive(&b), "{b:?}");
+                let set: Vec<usize> = (0..len).filter(|&k| b[k]).collect();
+                assert_eq!(ones(m).collect::<Vec<_>>(), set);
+            }
+        }
+        assert_eq!(words(0).count(), 0);
+        assert_eq!(words(64).collect::<Vec<_>>(), [(0, 64)]);
+        assert_eq!(words(200).collect::<Vec<_>>(), [(0, 64), (64, 64), (128, 64), (192, 8)]);
+    }
+
+    /// `gather` writes record `blk[k]`'s fields to lane k of each column, and refuses a column
+    /// shorter than the block.
+    #[test]
+    fn gathers() {
+        let recs: Vec<[u32; 3]> = (0..10).map(|i| [i, 100 + i, 200 + i]).collect();
+        let (mut a, mut b, mut c) = (vec![0; 4], vec![0; 4], vec![0; 4]);
+        gather(&recs, &[7, 2, 2], |r| r, [&mut a[..], &mut b[..], &mut c[..]]);
+        assert_eq!((a, b, c), (vec![7, 2, 2, 0], vec![107, 102, 102, 0], vec![207, 202, 202, 0]));
+        let short = std::panic::catch_unwind(|| {
+            let (mut a, mut b, mut c) = (vec![0; 2], vec![0; 4], vec![0; 4]);
+            gather(&recs, &[1, 2, 3], |r| r, [&mut a[..], &mut b[..], &mut c[..]]);
+        });
+        assert!(short.is_err());
     }
 }
