@@ -119,6 +119,80 @@ fn origin_maxima(xi: f64, y: &[f64]) -> (f64, f64, f64, bool) {
     (v, a, b.max(xi.abs()), n | !xi.is_finite())
 }
 
+/// [`maxima`] in explicit vector registers of `V` (its feature present): per column pair the
+/// same three maxima and the same non-finite flag. Equal to [`maxima`]: a maximum of non-NaN
+/// values does not depend on the order they are taken in (every value is an absolute value or
+/// a sum of two, never −0; a NaN fails every compare in both), and a sum of `x·0` terms is NaN
+/// exactly when one of its `x` is not finite, in any order.
+///
+/// # Safety
+/// `V`'s instruction set must be present.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn maxima_v<V: crate::lanes_x86::Vector>(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
+    let (mut ve, mut ae) = ([0.0f64; 9], [0.0f64; 9]);
+    let (mut big, mut bad) = (0.0f64, false);
+    for a in 0..3 {
+        let y = c[a];
+        for k in 0..3 {
+            let x = if k < 2 { Some(c[3 * (k + 1) + a]) } else { None };
+            // SAFETY: the caller's contract
+            let (vm, am, bm, nf) = unsafe { pair_maxima_v::<V>(x, r.o[a], y) };
+            ve[3 * k + a] = vm;
+            ae[3 * k + a] = am;
+            big = big.max(bm);
+            bad |= nf;
+        }
+    }
+    (ve, ae, big, bad)
+}
+
+/// [`column_maxima`] (`x` a column) or [`origin_maxima`] (`x` None: the value `o`) in vector
+/// registers, the lanes past the last whole vector by the scalar steps.
+///
+/// # Safety
+/// `V`'s instruction set must be present.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn pair_maxima_v<V: crate::lanes_x86::Vector>(x: Option<&[f64]>, o: f64, y: &[f64]) -> (f64, f64, f64, bool) {
+    let n = y.len();
+    assert!(x.is_none_or(|x| x.len() == n), "column lengths differ");
+    let whole = n - n % V::N;
+    let zero = V::splat(0.0);
+    let (mut vm, mut am, mut bm, mut nf) = (zero, zero, zero, zero);
+    let ox = V::splat(o);
+    let mut i = 0;
+    while i < whole {
+        // SAFETY: i + N <= n for y and x (same length); the caller's contract for the feature
+        let (yi, xi) = unsafe { (V::load(y.as_ptr().add(i)), x.map_or(ox, |x| V::load(x.as_ptr().add(i)))) };
+        let (xa, ya) = (xi.abs(), yi.abs());
+        let (dv, sv) = ((xi - yi).abs(), xa + ya);
+        let mb = if x.is_some() { V::select(ya.lt(xa), xa, ya) } else { ya };
+        vm = V::select(vm.lt(dv), dv, vm);
+        am = V::select(am.lt(sv), sv, am);
+        bm = V::select(bm.lt(mb), mb, bm);
+        nf = nf + (if x.is_some() { xi * zero + yi * zero } else { yi * zero });
+        i += V::N;
+    }
+    let lanes = |v: V| {
+        let mut a = [0.0f64; 8];
+        // SAFETY: N <= 8 lanes written; the caller's contract for the feature
+        unsafe { v.store(a.as_mut_ptr()) };
+        a
+    };
+    let fold = |v: V, m: f64| lanes(v)[..V::N].iter().fold(m, |m, &l| if l > m { l } else { m });
+    let (rv, ra, rb) = (fold(vm, 0.0), fold(am, 0.0), fold(bm, 0.0));
+    let rn = lanes(nf)[..V::N].iter().any(|l| l.is_nan());
+    // the tail by the scalar steps (origin_maxima takes |o| and o's finiteness even on an
+    // empty tail)
+    let (tv, ta, tb, tn) = match x {
+        Some(x) => column_maxima(&x[whole..], &y[whole..]),
+        None => origin_maxima(o, &y[whole..]),
+    };
+    let max = |p: f64, q: f64| if p > q { p } else { q };
+    (max(tv, rv), max(ta, ra), max(tb, rb), rn | tn)
+}
+
 /// The accumulators folded (the non-finite flag: a NaN sum).
 fn fold<const W: usize>(vm: [f64; W], am: [f64; W], bm: [f64; W], nf: [f64; W]) -> (f64, f64, f64, bool) {
     let m = |x: [f64; W]| x.iter().fold(0.0f64, |m, &v| m.max(v));
@@ -247,23 +321,77 @@ pub fn verdict_block_filtered(
     k
 }
 
+/// The block's largest magnitudes the static constants come from, on the widest instruction
+/// level `cap` allows and the machine has: per first-difference component (e1 x, y, z, e2 x,
+/// y, z, s x, y, z) the largest |value| and the largest monomial sum, the largest |input|, and
+/// whether an input is not finite. The same bits on every level.
+pub fn block_maxima(cap: crate::simd::Kernel, ray: BlockRay, tris: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
+    use crate::simd::Kernel;
+    let n = tris[0].len();
+    assert!(tris.iter().all(|c| c.len() == n), "column lengths differ");
+    let cap = crate::simd::best_kernel(true, cap);
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::is_x86_feature_detected as has;
+        if cap >= Kernel::Avx512 && has!("avx512f") {
+            // SAFETY: AVX-512F is present (checked above)
+            return unsafe { maxima_avx512(ray, tris) };
+        } else if cap >= Kernel::Avx2 && has!("avx2") {
+            // SAFETY: AVX2 is present (checked above)
+            return unsafe { maxima_avx2(ray, tris) };
+        }
+    }
+    let _ = cap;
+    maxima(ray, tris)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn maxima_avx512(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
+    // SAFETY: AVX-512F is enabled on this function
+    unsafe { maxima_v::<crate::lanes_x86::F64x8>(r, c) }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn maxima_avx2(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
+    // SAFETY: AVX2 is enabled on this function
+    unsafe { maxima_v::<crate::lanes_x86::F64x4>(r, c) }
+}
+
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 fn filter_avx512(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool]) -> bool {
-    filter(o, r, c, out)
+    // SAFETY: AVX-512F is enabled on this function
+    let m = unsafe { maxima_v::<crate::lanes_x86::F64x8>(r, c) };
+    filter_with(o, r, c, m, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn filter_avx2(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool]) -> bool {
-    filter(o, r, c, out)
+    // SAFETY: AVX2 is enabled on this function
+    let m = unsafe { maxima_v::<crate::lanes_x86::F64x4>(r, c) };
+    filter_with(o, r, c, m, out)
 }
 
 /// The block's constants and each lane's certificate; false when the block has none (range
 /// check, NaN): then no lane is certified.
 #[inline(always)]
 fn filter(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool]) -> bool {
-    match statics(o, r, maxima(r, c)) {
+    filter_with(o, r, c, maxima(r, c), out)
+}
+
+/// [`filter`] with the block's maxima given.
+#[inline(always)]
+fn filter_with(
+    o: BlockOpts,
+    r: BlockRay,
+    c: [&[f64]; 9],
+    m: ([f64; 9], [f64; 9], f64, bool),
+    out: &mut [bool],
+) -> bool {
+    match statics(o, r, m) {
         Some(st) => {
             certify(o, r, st, c, out);
             true

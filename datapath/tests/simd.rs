@@ -1007,6 +1007,105 @@ mod bound_block {
     }
 }
 
+/// The static filter in front of the bound (`bound_filter::verdict_block_filtered`) certifies
+/// the same lanes and gives the same verdicts on every instruction level the machine has (its
+/// block maxima run in AVX2 or AVX-512F vector registers; under `emu/avx512`: AVX-512F too), on
+/// blocks of ordinary triangles (most lanes certified) with edge values mixed in; and the block
+/// maxima it starts from are the same bits on every level, on lengths around the vector widths
+/// and inputs with zeros of both signs, subnormals, huge values, infinities and NaNs.
+mod bound_filter_block {
+    use super::*;
+    use datapath::bound::{BlockOpts, BlockRay};
+    use datapath::bound_filter::{block_maxima, verdict_block_filtered};
+
+    fn bits(m: ([f64; 9], [f64; 9], f64, bool)) -> (Vec<u64>, u64, bool) {
+        (m.0.iter().chain(&m.1).map(|x| x.to_bits()).collect(), m.2.to_bits(), m.3)
+    }
+
+    #[test]
+    fn the_block_maxima_are_the_same_on_every_kernel() {
+        let mut r = SplitMix64::new(11);
+        let x = |r: &mut SplitMix64, wild: bool| match r.below(if wild { 12 } else { 8 }) {
+            0 => 0.0,
+            1 => -0.0,
+            2 => 5e-324 * r.range(-8.0, 8.0).round(),
+            3 => r.range(-1.0, 1.0) * 1e300,
+            8 | 9 => f64::INFINITY * r.range(-1.0, 1.0).signum(),
+            10 | 11 => f64::NAN,
+            _ => r.range(-4.0, 4.0),
+        };
+        let mut compared = 0;
+        for n in [0, 1, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 64, 255, 256] {
+            for t in 0..60 {
+                // ordinary blocks, blocks of edge values, and ordinary blocks with one edge
+                // value in one column's lane (or the ray's origin)
+                let wild = t % 3 == 1;
+                let mut cols: Vec<Vec<f64>> = (0..9).map(|_| (0..n).map(|_| x(&mut r, wild)).collect()).collect();
+                let mut o: [f64; 3] = std::array::from_fn(|_| x(&mut r, wild));
+                if t % 3 == 2 {
+                    let e =
+                        [0.0, -0.0, 5e-324, -1e300, f64::INFINITY, f64::NEG_INFINITY, f64::NAN][r.below(7) as usize];
+                    match (r.below(10) as usize, n) {
+                        (9, _) | (_, 0) => o[r.below(3) as usize] = e,
+                        (c, _) => cols[c][r.below(n as u64) as usize] = e,
+                    }
+                }
+                let c: [&[f64]; 9] = std::array::from_fn(|k| &cols[k][..]);
+                let ray = BlockRay { o, d: [1.0, 0.5, 0.25], tmin: 0.0, tmax: 1.0 };
+                let want = bits(block_maxima(Kernel::Scalar, ray, c));
+                for k in kernels_here() {
+                    assert_eq!(bits(block_maxima(k, ray, c)), want, "{k:?} n {n}");
+                    compared += 1;
+                }
+            }
+        }
+        assert!(compared >= 600);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn the_filter_is_the_same_on_every_kernel(seed in any::<u64>(), n in 0usize..300, wild in 0u64..4) {
+            let mut r = SplitMix64::new(seed);
+            let x = |r: &mut SplitMix64, c: f64| {
+                if wild > 0 && r.below(64) < wild {
+                    match r.below(6) {
+                        0 => 0.0,
+                        1 => -0.0,
+                        2 => f64::from_bits(r.next_u64() & 0x000f_ffff_ffff_ffff),
+                        3 => 3.0e38 * r.range(-1.0, 1.0),
+                        4 => f64::INFINITY,
+                        _ => f64::NAN,
+                    }
+                } else {
+                    c + r.range(-0.05, 0.05)
+                }
+            };
+            let opts = BlockOpts {
+                em: Ieee::new(F32Native, FpOpts::default()).error_model(),
+                div: DivMode::RecipMul,
+                cull: Cull::TwoSided,
+                det_threshold: 0.0,
+            };
+            let ray = BlockRay { o: [0.0, 0.0, -2.0], d: [r.range(-0.3, 0.3), r.range(-0.3, 0.3), 1.0], tmin: 0.0, tmax: f64::INFINITY };
+            let centres: Vec<[f64; 3]> = (0..n).map(|_| [r.range(-1.0, 1.0), r.range(-1.0, 1.0), r.range(-0.5, 0.5)]).collect();
+            let cols: [Vec<f64>; 9] = std::array::from_fn(|c| centres.iter().map(|p| x(&mut r, p[c % 3])).collect());
+            let run = |k: Kernel| {
+                let (mut dec, mut hit, mut te, mut cert) = (vec![false; n], vec![false; n], vec![0.0; n], vec![false; n]);
+                let got = verdict_block_filtered(k, opts, ray, std::array::from_fn(|c| &cols[c][..]), &mut dec, &mut hit, &mut te, &mut cert);
+                (got, dec, hit, te.iter().map(|t| if t.is_nan() { u64::MAX } else { t.to_bits() }).collect::<Vec<_>>(), cert)
+            };
+            let want = run(Kernel::Scalar);
+            if wild == 0 && n > 0 {
+                prop_assert!(want.0 > 0, "an ordinary block certifies lanes");
+            }
+            for k in kernels_here() {
+                prop_assert_eq!(&run(k), &want, "{:?}", k);
+            }
+        }
+    }
+}
+
 /// Add, subtract, multiply and divide through `batch` (`out[i] = a[i] op b[i]`) on every
 /// kernel this machine has, each result equal to the format's own operation (its division
 /// mode included).
