@@ -144,8 +144,33 @@ pub fn reference<F: Format>(rti: &Rti<F>, rq: &Ray64, tq: &Tri64, golden_hit: bo
 pub fn reference_by<F: Format>(rti: &Rti<F>, rq: &Ray64, tq: &Tri64, golden_hit: bool) -> (bool, DecidedBy) {
     let b = RtiBound::new(EXACT_F64, datapath::format::DivMode::Divide, rq.o, rq.d, tq.v);
     let v = b.verdict(rti.cull, rti.fmt.to_f64(rti.det_thr), rq.tmin, rq.tmax);
-    if v.decisive {
-        (v.hit, DecidedBy::F64Filter)
+    reference_after(rti, rq, tq, (v.decisive, v.hit), golden_hit)
+}
+
+/// The f64 filter's options as a block of tests takes them: the lanes of
+/// [`datapath::bound::verdict_block`] (or its statically filtered form) with these options are
+/// the verdicts [`reference_by`] starts from, lane by lane.
+pub fn f64_filter_opts<F: Format>(rti: &Rti<F>) -> datapath::bound::BlockOpts {
+    datapath::bound::BlockOpts {
+        em: EXACT_F64,
+        div: datapath::format::DivMode::Divide,
+        cull: rti.cull,
+        det_threshold: rti.fmt.to_f64(rti.det_thr),
+    }
+}
+
+/// [`reference_by`] given the f64 filter's verdict on the test, (decisive, hit): the filter's
+/// hit when decisive, else exact rational arithmetic (or the golden f64 hit when there is no
+/// exact answer).
+pub fn reference_after<F: Format>(
+    rti: &Rti<F>,
+    rq: &Ray64,
+    tq: &Tri64,
+    (decisive, hit): (bool, bool),
+    golden_hit: bool,
+) -> (bool, DecidedBy) {
+    if decisive {
+        (hit, DecidedBy::F64Filter)
     } else {
         match golden::intersect_exact(rq, tq, faces(rti)) {
             Some(h) => (h, DecidedBy::Exact),

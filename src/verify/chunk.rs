@@ -141,6 +141,8 @@ struct Setup<'a, F: Format> {
     recs: Vec<Rec<F::V>>,
     variants: Vec<Variant<F>>,
     opts: BlockOpts,
+    /// The reference decision's f64 filter as block options ([`crate::judge::f64_filter_opts`]).
+    fopts: BlockOpts,
     faces: golden::Faces,
     level: Level,
     name: String,
@@ -166,6 +168,11 @@ struct Scratch<V> {
     sclose: Vec<bool>,
     /// Lanes the static filter certified.
     cert: Vec<bool>,
+    /// The f64 filter of the reference decision on a block's lanes (decisive, hit, t bound):
+    /// filled when a lane of the block is not decisive.
+    fdec: Vec<bool>,
+    fhit: Vec<bool>,
+    fterr: Vec<f64>,
     exact: Vec<u8>,
     prepared: Vec<datapath::slab::SlabRay<V>>,
     boxes: BoxesSoa<V>,
@@ -193,6 +200,9 @@ impl<V: Copy + Default> Scratch<V> {
             sfar: f(),
             sclose: b(),
             cert: b(),
+            fdec: b(),
+            fhit: b(),
+            fterr: f(),
             exact: vec![0; BLOCK],
             prepared: Vec::new(),
             boxes: BoxesSoa::default(),
@@ -418,6 +428,22 @@ where
             &mut s.terr[..n],
             &mut s.cert[..n],
         );
+        // the reference decision's f64 filter on the whole block when a lane is not decisive
+        // (each lane's verdict is the scalar one: bound::verdict_block and the static filter
+        // equal it lane by lane); rti_lane reads it for the lanes that are not decisive
+        let filtered = s.dec[..n].iter().any(|&d| !d);
+        if filtered {
+            verdict_block_filtered(
+                Kernel::Avx512Fp16,
+                self.fopts,
+                bray,
+                cols(&s.cols, n),
+                &mut s.fdec[..n],
+                &mut s.fhit[..n],
+                &mut s.fterr[..n],
+                &mut s.cert[..n],
+            );
+        }
         for (w, len) in words(n) {
             let r = w..w + len;
             let (dec, mhit, ehit, valid) =
@@ -428,13 +454,14 @@ where
             c.decisive += u64::from(dec.count_ones());
             c.divide_skipped += u64::from((all & !valid).count_ones());
             for j in ones(all & !(dec & !mhit & !ehit)) {
-                self.rti_lane(s, acc, ray, rq, blk, base, w + j, ray_index, cap, gbest);
+                self.rti_lane(s, acc, ray, rq, blk, base, w + j, ray_index, filtered, cap, gbest);
             }
         }
     }
 
     /// The judge of one RTI lane beyond its test, decisive and skipped-divide counts
-    /// ([`Self::rti_block`]): the reference decision, hits, disagreements, the property, the
+    /// ([`Self::rti_block`]): the reference decision (its f64 filter from the block's lanes when
+    /// `filtered`), hits, disagreements, the property, the
     /// t errors, the capture unit and the golden closest hit.
     #[allow(clippy::too_many_arguments)]
     fn rti_lane(
@@ -447,6 +474,7 @@ where
         base: usize,
         k: usize,
         ray_index: u64,
+        filtered: bool,
         cap: &mut Capture<F::V>,
         gbest: &mut Option<(usize, f64)>,
     ) {
@@ -460,8 +488,12 @@ where
             s.ehit[k]
         } else {
             let tq = Tri64 { v: std::array::from_fn(|p| std::array::from_fn(|a| s.cols[3 * p + a][k])) };
-            let (h, fell) = crate::judge::reference(&self.rti, rq, &tq, s.ghit[k]);
-            c.exact += fell as u64;
+            let (h, by) = if filtered {
+                crate::judge::reference_after(&self.rti, rq, &tq, (s.fdec[k], s.fhit[k]), s.ghit[k])
+            } else {
+                crate::judge::reference_by(&self.rti, rq, &tq, s.ghit[k])
+            };
+            c.exact += by.fell_through() as u64;
             h
         };
         c.reference_hits += gh as u64;
@@ -809,6 +841,7 @@ where
             cull: rti.cull,
             det_threshold: f.to_f64(rti.det_thr),
         },
+        fopts: crate::judge::f64_filter_opts(&rti),
         faces: crate::judge::faces(&rti),
         level: crate::golden_level(),
         name: f.name(),
