@@ -169,7 +169,7 @@ struct Scratch<V> {
     /// Lanes the static filter certified.
     cert: Vec<bool>,
     /// The f64 filter of the reference decision on a block's lanes (decisive, hit, t bound):
-    /// filled when a lane of the block is not decisive.
+    /// filled when a lane of the block is not decisive (the lanes [`Setup::rti_lane`] reads).
     fdec: Vec<bool>,
     fhit: Vec<bool>,
     fterr: Vec<f64>,
@@ -431,8 +431,7 @@ where
         // the reference decision's f64 filter on the whole block when a lane is not decisive
         // (each lane's verdict is the scalar one: bound::verdict_block and the static filter
         // equal it lane by lane); rti_lane reads it for the lanes that are not decisive
-        let filtered = s.dec[..n].iter().any(|&d| !d);
-        if filtered {
+        if s.dec[..n].iter().any(|&d| !d) {
             verdict_block_filtered(
                 Kernel::Avx512Fp16,
                 self.fopts,
@@ -454,15 +453,15 @@ where
             c.decisive += u64::from(dec.count_ones());
             c.divide_skipped += u64::from((all & !valid).count_ones());
             for j in ones(all & !(dec & !mhit & !ehit)) {
-                self.rti_lane(s, acc, ray, rq, blk, base, w + j, ray_index, filtered, cap, gbest);
+                self.rti_lane(s, acc, ray, rq, blk, base, w + j, ray_index, cap, gbest);
             }
         }
     }
 
     /// The judge of one RTI lane beyond its test, decisive and skipped-divide counts
-    /// ([`Self::rti_block`]): the reference decision (its f64 filter from the block's lanes when
-    /// `filtered`), hits, disagreements, the property, the
-    /// t errors, the capture unit and the golden closest hit.
+    /// ([`Self::rti_block`]): the reference decision (a lane that is not decisive reads the f64
+    /// filter's verdict from the block's lanes), hits, disagreements, the property, the t
+    /// errors, the capture unit and the golden closest hit.
     #[allow(clippy::too_many_arguments)]
     fn rti_lane(
         &self,
@@ -474,7 +473,6 @@ where
         base: usize,
         k: usize,
         ray_index: u64,
-        filtered: bool,
         cap: &mut Capture<F::V>,
         gbest: &mut Option<(usize, f64)>,
     ) {
@@ -488,11 +486,7 @@ where
             s.ehit[k]
         } else {
             let tq = Tri64 { v: std::array::from_fn(|p| std::array::from_fn(|a| s.cols[3 * p + a][k])) };
-            let (h, by) = if filtered {
-                crate::judge::reference_after(&self.rti, rq, &tq, (s.fdec[k], s.fhit[k]), s.ghit[k])
-            } else {
-                crate::judge::reference_by(&self.rti, rq, &tq, s.ghit[k])
-            };
+            let (h, by) = crate::judge::reference_after(&self.rti, rq, &tq, (s.fdec[k], s.fhit[k]), s.ghit[k]);
             c.exact += by.fell_through() as u64;
             h
         };
