@@ -5,6 +5,8 @@
 //! with d = 0 (either sign) constrains nothing when o lies within [min, max] on that axis
 //! (the ray runs inside or on the face plane) and rejects the box otherwise. No NaN is formed.
 
+use num_bigint::{BigInt, Sign};
+#[cfg(test)]
 use num_rational::BigRational;
 
 /// Result of the f64 reference: entry and exit distances and the decision.
@@ -42,6 +44,7 @@ pub fn slab_f64(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], m
     SlabResult { hit: near <= far, t_near: near, t_far: far }
 }
 
+#[cfg(test)]
 fn q(x: f64) -> BigRational {
     BigRational::from_float(x).expect("finite")
 }
@@ -63,8 +66,8 @@ pub fn slab_exact(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3],
 
 fn slab_exact_finite(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], max: [f64; 3]) -> bool {
     // interval [near, far] of t; None = unbounded on that side
-    let mut near: Option<BigRational> = if tmin.is_finite() { Some(q(tmin)) } else { None };
-    let mut far: Option<BigRational> = if tmax.is_finite() { Some(q(tmax)) } else { None };
+    let mut near: Option<Frac> = if tmin.is_finite() { Some(Frac::of(tmin)) } else { None };
+    let mut far: Option<Frac> = if tmax.is_finite() { Some(Frac::of(tmax)) } else { None };
     if tmin == f64::INFINITY || tmax == f64::NEG_INFINITY {
         return false;
     }
@@ -78,33 +81,181 @@ fn slab_exact_finite(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 
             }
             continue;
         }
-        let da = q(d[a]);
-        let oa = q(o[a]);
         // plane distances; an infinite plane gives an unbounded side
-        let t = |plane: f64| -> Option<BigRational> { plane.is_finite().then(|| (q(plane) - &oa) / &da) };
+        let t = |plane: f64| plane.is_finite().then(|| Frac::distance(plane, o[a], d[a]));
         let (t_min_plane, t_max_plane) = (t(min[a]), t(max[a]));
         // with d > 0 the min plane is the entry; with d < 0 the max plane is
         let (lo, hi) = if d[a] > 0.0 { (t_min_plane, t_max_plane) } else { (t_max_plane, t_min_plane) };
         if let Some(lo) = lo {
-            if near.as_ref().is_none_or(|n| &lo > n) {
+            if near.as_ref().is_none_or(|n| lo.gt(n)) {
                 near = Some(lo);
             }
         }
         if let Some(hi) = hi {
-            if far.as_ref().is_none_or(|f| &hi < f) {
+            if far.as_ref().is_none_or(|f| f.gt(&hi)) {
                 far = Some(hi);
             }
         }
     }
     match (near, far) {
-        (Some(n), Some(f)) => n <= f,
+        (Some(n), Some(f)) => !n.gt(&f),
         _ => true,
+    }
+}
+
+/// An exact rational `n / d` with `d > 0`, never reduced (compared by cross-multiplying: no
+/// gcd, which dominated the reduced rationals' cost).
+#[derive(Clone, Debug)]
+struct Frac {
+    n: BigInt,
+    d: BigInt,
+}
+
+/// A finite f64 as `m · 2^e` exactly (m an integer of at most 53 bits, its sign the value's).
+fn dyadic(x: f64) -> (i64, i64) {
+    let bits = x.to_bits();
+    let exp = ((bits >> 52) & 0x7ff) as i64;
+    let frac = (bits & ((1u64 << 52) - 1)) as i64;
+    let (m, e) = if exp == 0 { (frac, -1074) } else { (frac | (1i64 << 52), exp - 1075) };
+    (if x.is_sign_negative() { -m } else { m }, e)
+}
+
+/// `m · 2^(e − base)` as an integer (`e >= base`).
+fn scaled(m: i64, e: i64, base: i64) -> BigInt {
+    BigInt::from(m) << (e - base) as usize
+}
+
+impl Frac {
+    /// A finite f64, exactly.
+    fn of(x: f64) -> Frac {
+        let (m, e) = dyadic(x);
+        let base = e.min(0);
+        Frac { n: scaled(m, e, base), d: BigInt::from(1) << (-base) as usize }
+    }
+
+    /// `(plane − o) / dir` exactly (all finite, `dir` nonzero): the difference of two dyadics
+    /// at their smaller exponent, over the direction's mantissa, the exponents moved to the
+    /// side that keeps them non-negative.
+    fn distance(plane: f64, o: f64, dir: f64) -> Frac {
+        let ((pm, pe), (om, oe), (dm, de)) = (dyadic(plane), dyadic(o), dyadic(dir));
+        let base = pe.min(oe);
+        let diff = scaled(pm, pe, base) - scaled(om, oe, base);
+        // (diff · 2^base) / (dm · 2^de) = diff · 2^(base − de) / dm
+        let shift = base - de;
+        let (n, d) = if shift >= 0 {
+            (diff << shift as usize, BigInt::from(dm))
+        } else {
+            (diff, BigInt::from(dm) << (-shift) as usize)
+        };
+        if d.sign() == Sign::Minus {
+            Frac { n: -n, d: -d }
+        } else {
+            Frac { n, d }
+        }
+    }
+
+    /// `self > o`, exactly (both denominators positive).
+    fn gt(&self, o: &Frac) -> bool {
+        &self.n * &o.d > &o.n * &self.d
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The reduced-rational form the unreduced one replaced (`BigRational` arithmetic): the
+    /// reference `slab_exact` is held to.
+    fn slab_exact_rational(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], max: [f64; 3]) -> bool {
+        let mut near: Option<BigRational> = if tmin.is_finite() { Some(q(tmin)) } else { None };
+        let mut far: Option<BigRational> = if tmax.is_finite() { Some(q(tmax)) } else { None };
+        if tmin == f64::INFINITY || tmax == f64::NEG_INFINITY {
+            return false;
+        }
+        for a in 0..3 {
+            if min[a] > max[a] || min[a] == f64::INFINITY || max[a] == f64::NEG_INFINITY {
+                return false;
+            }
+            if d[a] == 0.0 {
+                if o[a] < min[a] || o[a] > max[a] {
+                    return false;
+                }
+                continue;
+            }
+            let (da, oa) = (q(d[a]), q(o[a]));
+            let t = |plane: f64| -> Option<BigRational> { plane.is_finite().then(|| (q(plane) - &oa) / &da) };
+            let (t_min_plane, t_max_plane) = (t(min[a]), t(max[a]));
+            let (lo, hi) = if d[a] > 0.0 { (t_min_plane, t_max_plane) } else { (t_max_plane, t_min_plane) };
+            if let Some(lo) = lo {
+                if near.as_ref().is_none_or(|n| &lo > n) {
+                    near = Some(lo);
+                }
+            }
+            if let Some(hi) = hi {
+                if far.as_ref().is_none_or(|f| &hi < f) {
+                    far = Some(hi);
+                }
+            }
+        }
+        match (near, far) {
+            (Some(n), Some(f)) => n <= f,
+            _ => true,
+        }
+    }
+
+    /// A finite f64 from a small set of edge magnitudes (zeros of both signs, subnormals, the
+    /// largest values, powers of two, values one ulp apart) or an ordinary one.
+    fn edge(s: &mut u64) -> f64 {
+        *s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let r = *s >> 11;
+        let u = (r as f64) / (1u64 << 53) as f64;
+        let sign = if r & 1 == 0 { 1.0 } else { -1.0 };
+        sign * match r % 11 {
+            0 => 0.0,
+            1 => 5e-324 * ((r >> 8) % 5) as f64,
+            2 => f64::MAX * (0.5 + u / 2.0),
+            3 => 2f64.powi(((r >> 8) % 200) as i32 - 100),
+            4 => 1.0 + f64::EPSILON * ((r >> 8) % 3) as f64,
+            5 => 1e-300 * u,
+            _ => 4.0 * u,
+        }
+    }
+
+    /// The unreduced fractions decide every case as the reduced rationals do: flat boxes (min =
+    /// max on an axis), rays in a face plane, grazing edges, and values from subnormal to the
+    /// largest finite, with infinite interval ends and planes.
+    #[test]
+    fn unreduced_fractions_decide_as_rationals() {
+        let mut s = 7u64;
+        let mut hits = [0usize; 2];
+        for i in 0..20000 {
+            let o: [f64; 3] = std::array::from_fn(|_| edge(&mut s));
+            let mut d: [f64; 3] = std::array::from_fn(|_| edge(&mut s));
+            let mut lo: [f64; 3] = std::array::from_fn(|_| edge(&mut s));
+            let mut hi: [f64; 3] = std::array::from_fn(|a| if i % 3 == 0 { lo[a] } else { edge(&mut s) });
+            for a in 0..3 {
+                if lo[a] > hi[a] {
+                    std::mem::swap(&mut lo[a], &mut hi[a]);
+                }
+            }
+            if i % 5 == 1 {
+                // aim at a box corner: grazing cases
+                d = std::array::from_fn(|a| hi[a] - o[a]);
+            }
+            if i % 7 == 2 {
+                hi[i % 3] = f64::INFINITY;
+            }
+            let tmin = if i % 4 == 0 { f64::NEG_INFINITY } else { edge(&mut s).abs() * 0.0 };
+            let tmax = if i % 2 == 0 { f64::INFINITY } else { edge(&mut s).abs() };
+            if d.iter().any(|x| !x.is_finite()) {
+                continue;
+            }
+            let want = slab_exact_rational(o, d, tmin, tmax, lo, hi);
+            assert_eq!(slab_exact(o, d, tmin, tmax, lo, hi), Some(want), "{o:?} {d:?} {tmin} {tmax} {lo:?} {hi:?}");
+            hits[want as usize] += 1;
+        }
+        assert!(hits[0] > 1000 && hits[1] > 1000, "{hits:?}");
+    }
 
     const LO: [f64; 3] = [-1.0, -1.0, -1.0];
     const HI: [f64; 3] = [1.0, 1.0, 1.0];
