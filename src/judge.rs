@@ -142,8 +142,8 @@ pub fn reference<F: Format>(rti: &Rti<F>, rq: &Ray64, tq: &Tri64, golden_hit: bo
 /// [`reference`], naming what decided: the f64 filter, exact rational arithmetic, or (no
 /// exact answer) the golden f64 test.
 pub fn reference_by<F: Format>(rti: &Rti<F>, rq: &Ray64, tq: &Tri64, golden_hit: bool) -> (bool, DecidedBy) {
-    let b = RtiBound::new(EXACT_F64, datapath::format::DivMode::Divide, rq.o, rq.d, tq.v);
-    let v = b.verdict(rti.cull, rti.fmt.to_f64(rti.det_thr), rq.tmin, rq.tmax);
+    let o = f64_filter_opts(rti);
+    let v = RtiBound::new(o.em, o.div, rq.o, rq.d, tq.v).verdict(o.cull, o.det_threshold, rq.tmin, rq.tmax);
     reference_after(rti, rq, tq, (v.decisive, v.hit), golden_hit)
 }
 

@@ -65,9 +65,25 @@ pub fn slab_exact(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3],
 }
 
 fn slab_exact_finite(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], max: [f64; 3]) -> bool {
+    slab_exact_in::<Frac>(o, d, tmin, tmax, min, max)
+}
+
+/// The exact numbers the decision runs on: a finite f64's value, a plane distance
+/// `(plane − o) / dir` (all finite, `dir` nonzero) and their order, each exact.
+trait Exact: Sized {
+    /// A finite f64, exactly.
+    fn of(x: f64) -> Self;
+    /// `(plane − o) / dir`, exactly.
+    fn distance(plane: f64, o: f64, dir: f64) -> Self;
+    /// `self > o`, exactly.
+    fn gt(&self, o: &Self) -> bool;
+}
+
+/// The decision on finite origin and direction, no NaN, in the exact numbers `T`.
+fn slab_exact_in<T: Exact>(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], max: [f64; 3]) -> bool {
     // interval [near, far] of t; None = unbounded on that side
-    let mut near: Option<Frac> = if tmin.is_finite() { Some(Frac::of(tmin)) } else { None };
-    let mut far: Option<Frac> = if tmax.is_finite() { Some(Frac::of(tmax)) } else { None };
+    let mut near: Option<T> = if tmin.is_finite() { Some(T::of(tmin)) } else { None };
+    let mut far: Option<T> = if tmax.is_finite() { Some(T::of(tmax)) } else { None };
     if tmin == f64::INFINITY || tmax == f64::NEG_INFINITY {
         return false;
     }
@@ -82,7 +98,7 @@ fn slab_exact_finite(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 
             continue;
         }
         // plane distances; an infinite plane gives an unbounded side
-        let t = |plane: f64| plane.is_finite().then(|| Frac::distance(plane, o[a], d[a]));
+        let t = |plane: f64| plane.is_finite().then(|| T::distance(plane, o[a], d[a]));
         let (t_min_plane, t_max_plane) = (t(min[a]), t(max[a]));
         // with d > 0 the min plane is the entry; with d < 0 the max plane is
         let (lo, hi) = if d[a] > 0.0 { (t_min_plane, t_max_plane) } else { (t_max_plane, t_min_plane) };
@@ -125,17 +141,15 @@ fn scaled(m: i64, e: i64, base: i64) -> BigInt {
     BigInt::from(m) << (e - base) as usize
 }
 
-impl Frac {
-    /// A finite f64, exactly.
+impl Exact for Frac {
     fn of(x: f64) -> Frac {
         let (m, e) = dyadic(x);
         let base = e.min(0);
         Frac { n: scaled(m, e, base), d: BigInt::from(1) << (-base) as usize }
     }
 
-    /// `(plane − o) / dir` exactly (all finite, `dir` nonzero): the difference of two dyadics
-    /// at their smaller exponent, over the direction's mantissa, the exponents moved to the
-    /// side that keeps them non-negative.
+    /// The difference of two dyadics at their smaller exponent, over the direction's mantissa,
+    /// the exponents moved to the side that keeps them non-negative.
     fn distance(plane: f64, o: f64, dir: f64) -> Frac {
         let ((pm, pe), (om, oe), (dm, de)) = (dyadic(plane), dyadic(o), dyadic(dir));
         let base = pe.min(oe);
@@ -154,7 +168,7 @@ impl Frac {
         }
     }
 
-    /// `self > o`, exactly (both denominators positive).
+    /// Cross-multiplied (both denominators positive).
     fn gt(&self, o: &Frac) -> bool {
         &self.n * &o.d > &o.n * &self.d
     }
@@ -164,42 +178,17 @@ impl Frac {
 mod tests {
     use super::*;
 
-    /// The reduced-rational form the unreduced one replaced (`BigRational` arithmetic): the
-    /// reference `slab_exact` is held to.
-    fn slab_exact_rational(o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, min: [f64; 3], max: [f64; 3]) -> bool {
-        let mut near: Option<BigRational> = if tmin.is_finite() { Some(q(tmin)) } else { None };
-        let mut far: Option<BigRational> = if tmax.is_finite() { Some(q(tmax)) } else { None };
-        if tmin == f64::INFINITY || tmax == f64::NEG_INFINITY {
-            return false;
+    /// The reduced rationals (`BigRational`) the unreduced fractions replaced: the arithmetic
+    /// `slab_exact` is held to.
+    impl Exact for BigRational {
+        fn of(x: f64) -> Self {
+            q(x)
         }
-        for a in 0..3 {
-            if min[a] > max[a] || min[a] == f64::INFINITY || max[a] == f64::NEG_INFINITY {
-                return false;
-            }
-            if d[a] == 0.0 {
-                if o[a] < min[a] || o[a] > max[a] {
-                    return false;
-                }
-                continue;
-            }
-            let (da, oa) = (q(d[a]), q(o[a]));
-            let t = |plane: f64| -> Option<BigRational> { plane.is_finite().then(|| (q(plane) - &oa) / &da) };
-            let (t_min_plane, t_max_plane) = (t(min[a]), t(max[a]));
-            let (lo, hi) = if d[a] > 0.0 { (t_min_plane, t_max_plane) } else { (t_max_plane, t_min_plane) };
-            if let Some(lo) = lo {
-                if near.as_ref().is_none_or(|n| &lo > n) {
-                    near = Some(lo);
-                }
-            }
-            if let Some(hi) = hi {
-                if far.as_ref().is_none_or(|f| &hi < f) {
-                    far = Some(hi);
-                }
-            }
+        fn distance(plane: f64, o: f64, dir: f64) -> Self {
+            (q(plane) - q(o)) / q(dir)
         }
-        match (near, far) {
-            (Some(n), Some(f)) => n <= f,
-            _ => true,
+        fn gt(&self, o: &Self) -> bool {
+            self > o
         }
     }
 
@@ -250,7 +239,7 @@ mod tests {
             if d.iter().any(|x| !x.is_finite()) {
                 continue;
             }
-            let want = slab_exact_rational(o, d, tmin, tmax, lo, hi);
+            let want = slab_exact_in::<BigRational>(o, d, tmin, tmax, lo, hi);
             assert_eq!(slab_exact(o, d, tmin, tmax, lo, hi), Some(want), "{o:?} {d:?} {tmin} {tmax} {lo:?} {hi:?}");
             hits[want as usize] += 1;
         }
