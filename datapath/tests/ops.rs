@@ -329,6 +329,41 @@ fn f64_conversion_is_correctly_rounded_and_back_exact() {
     }
 }
 
+/// `to_f64_column` of `vals` equals `to_f64` of each value, bit for bit (NaN payloads too),
+/// at every length up to 40 and at the full length (the vector loops' remainders).
+fn column_is_elementwise<F: Format>(f: &F, vals: &[F::V]) {
+    let want: Vec<u64> = vals.iter().map(|&v| f.to_f64(v).to_bits()).collect();
+    for n in (0..=40.min(vals.len())).chain([vals.len()]) {
+        let mut got = vec![f64::NAN; n];
+        f.to_f64_column(&vals[..n], &mut got);
+        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert_eq!(g.to_bits(), *w, "{} to_f64_column lane {k} of {n}: {:#x}", f.name(), f.to_bits(vals[k]));
+        }
+    }
+}
+
+#[test]
+fn column_conversion_equals_the_element_conversion() {
+    // every encoding of the 16-bit formats (NaNs, subnormals, ±0, ±∞ included)
+    let fp16 = Ieee::new(F16Half, divide());
+    column_is_elementwise(&fp16, &(0..=u16::MAX).map(|b| fp16.from_bits(b as u64)).collect::<Vec<_>>());
+    let bf16 = Ieee::new(Bf16, divide());
+    column_is_elementwise(&bf16, &(0..=u16::MAX).map(|b| bf16.from_bits(b as u64)).collect::<Vec<_>>());
+    // the binary32 specials and random encodings, a custom layout, fixed point
+    let f32f = Ieee::new(F32Native, divide());
+    let mut r = SplitMix64::new(SEED ^ 0xc01);
+    let bits32: Vec<u64> =
+        specials(FloatLayout::BINARY32).into_iter().chain((0..20_000).map(|_| r.next_u64() & 0xffff_ffff)).collect();
+    column_is_elementwise(&f32f, &bits32.iter().map(|&b| f32f.from_bits(b)).collect::<Vec<_>>());
+    let e8m16 = Ieee::new(Soft(FloatLayout::new(8, 16)), divide());
+    let bits: Vec<u64> = (0..20_000).map(|_| r.next_u64() & 0x1ff_ffff).collect();
+    column_is_elementwise(&e8m16, &bits.iter().map(|&b| e8m16.from_bits(b)).collect::<Vec<_>>());
+    let q = Fixed::new(8, 24, FxRound::NearestEven, FxOverflow::Saturate, DivMode::Divide).unwrap();
+    column_is_elementwise(&q, &(0..20_000).map(|_| q.from_bits(r.next_u64())).collect::<Vec<_>>());
+    // the hint: the host's binary32, binary16 and bfloat16 convert at vector speed
+    assert!(f32f.fast_f64_column() && fp16.fast_f64_column() && bf16.fast_f64_column());
+}
+
 #[test]
 fn half_crate_from_f64_is_not_correctly_rounded_but_ours_is() {
     // 1 + 2^-11 + 2^-40 lies just above the midpoint between 1 and 1 + 2^-10: it must round up.

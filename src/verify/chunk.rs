@@ -5,7 +5,8 @@
 //! triangles; per block:
 //!
 //! 1. gather: the model's stored triangles into the kernel's columns, the quantised triangles
-//!    (the format's values in f64) into nine f64 columns;
+//!    (the format's values in f64) into nine f64 columns — converted from the model's columns
+//!    where the format converts a column at vector speed, else gathered;
 //! 2. model: the fastest bit-identical batch path ([`datapath::simd::rti_batch`]);
 //! 3. golden: Möller–Trumbore in f64 lanes ([`golden::block::intersect_block`]) and the error
 //!    bound in f64 lanes ([`datapath::bound::verdict_block`]), each equal to its scalar code;
@@ -125,7 +126,6 @@ struct Variant<F: Format> {
 #[derive(Clone, Copy)]
 struct Rec<V> {
     m: [V; 9],
-    q: [f64; 9],
     b: [f64; 6],
     s: [V; 6],
 }
@@ -139,6 +139,10 @@ struct Setup<'a, F: Format> {
     rti: Rti<F>,
     with_rti: bool,
     recs: Vec<Rec<F::V>>,
+    qs: Vec<[f64; 9]>,
+    /// The quantised columns are converted from the model's ([`Format::fast_f64_column`]);
+    /// the records' `q` is then not read.
+    q_from_m: bool,
     variants: Vec<Variant<F>>,
     opts: BlockOpts,
     /// The reference decision's f64 filter as block options ([`crate::judge::f64_filter_opts`]).
@@ -394,7 +398,16 @@ where
             let [[a, b, c], [d, e, f], [g, h, i]] = &mut s.tris.v;
             gather(&self.recs, blk, true, |r| &r.m, [a, b, c, d, e, f, g, h, i].map(|x| &mut x[..]));
         }
-        gather(&self.recs, blk, false, |r| &r.q, s.cols.each_mut().map(|x| &mut x[..]));
+        // the quantised triangles: the model's values in f64 (Rti::tri stores from_f64 of each
+        // coordinate, so to_f64 of the model's column is the quantised column), converted where
+        // the format converts a column at vector speed, else gathered from the records
+        if self.q_from_m {
+            for (c, col) in s.cols.iter_mut().enumerate() {
+                self.rti.fmt.to_f64_column(&s.tris.v[c / 3][c % 3][..n], &mut col[..n]);
+            }
+        } else {
+            gather(&self.qs, blk, true, |r| r, s.cols.each_mut().map(|x| &mut x[..]));
+        }
         let t0 = Instant::now();
         match self.cfg.inject {
             None => {
@@ -799,7 +812,8 @@ where
             Variant { name, conservative: sc.is_conservative(f), slab: Slab::new(*f, sc) }
         })
         .collect();
-    let recs = scene
+    let q_from_m = f.fast_f64_column();
+    let (recs, qs): (Vec<_>, Vec<_>) = scene
         .tris
         .iter()
         .map(|t| {
@@ -819,15 +833,19 @@ where
                 }
                 None => [F::V::default(); 6],
             };
-            Rec { m, q, b, s }
+            (Rec { m, b, s }, q)
         })
-        .collect();
+        .unzip();
+    // the quantised triangles are kept only where they are not converted from the model's
+    let qs = if q_from_m { Vec::new() } else { qs };
     let setup = Setup {
         cfg,
         scene,
         gen: scene.ray_gen(cfg.seed),
         with_rti,
         recs,
+        qs,
+        q_from_m,
         variants,
         opts: BlockOpts {
             em: f.error_model(),

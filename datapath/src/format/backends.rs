@@ -36,6 +36,20 @@ pub trait IeeeBackend: Clone + Copy + Debug + Send + Sync + 'static {
     fn to_f64(&self, v: Self::V) -> f64 {
         self.layout().to_f64(Self::bits(v))
     }
+    /// [`Self::to_f64`] of a column: `dst[k] = to_f64(src[k])` for every `k` (equal lengths).
+    #[inline]
+    fn to_f64_column(&self, src: &[Self::V], dst: &mut [f64]) {
+        assert_eq!(src.len(), dst.len(), "to_f64_column: columns of different lengths");
+        for (d, &x) in dst.iter_mut().zip(src) {
+            *d = self.to_f64(x);
+        }
+    }
+    /// Whether [`Self::to_f64_column`] runs at vector speed (a hint for callers choosing between
+    /// converting and keeping an f64 copy; the values are the same either way).
+    #[inline]
+    fn fast_f64_column(&self) -> bool {
+        false
+    }
     /// a < b, IEEE ordered.
     #[inline]
     fn lt(&self, a: Self::V, b: Self::V) -> bool {
@@ -95,6 +109,10 @@ impl IeeeBackend for F32Native {
         v as f64
     }
     #[inline(always)]
+    fn fast_f64_column(&self) -> bool {
+        true // a widening conversion the compiler vectorises
+    }
+    #[inline(always)]
     fn lt(&self, a: f32, b: f32) -> bool {
         a < b
     }
@@ -145,6 +163,16 @@ impl IeeeBackend for F16Half {
     #[inline(always)]
     fn to_f64(&self, v: f16) -> f64 {
         v.to_f64()
+    }
+    #[inline]
+    fn to_f64_column(&self, src: &[f16], dst: &mut [f64]) {
+        use half::slice::HalfFloatSliceExt;
+        assert_eq!(src.len(), dst.len(), "to_f64_column: columns of different lengths");
+        src.convert_to_f64_slice(dst); // F16C where the host has it
+    }
+    #[inline(always)]
+    fn fast_f64_column(&self) -> bool {
+        true
     }
     #[inline(always)]
     fn lt(&self, a: f16, b: f16) -> bool {
@@ -213,6 +241,10 @@ impl IeeeBackend for Bf16 {
     #[inline(always)]
     fn to_f64(&self, v: u16) -> f64 {
         Self::wide(v) as f64
+    }
+    #[inline(always)]
+    fn fast_f64_column(&self) -> bool {
+        true // a shift and a widening conversion the compiler vectorises
     }
     #[inline(always)]
     fn lt(&self, a: u16, b: u16) -> bool {

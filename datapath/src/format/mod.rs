@@ -132,6 +132,18 @@ pub trait Format: Copy + Debug + Send + Sync + 'static {
     fn from_f64(&self, x: f64) -> Self::V;
     /// Value as f64 (exact for every float format and for fixed values below 2^53 steps).
     fn to_f64(&self, v: Self::V) -> f64;
+    /// [`Format::to_f64`] of a column: `dst[k] = to_f64(src[k])` for every `k` (equal lengths).
+    fn to_f64_column(&self, src: &[Self::V], dst: &mut [f64]) {
+        assert_eq!(src.len(), dst.len(), "to_f64_column: columns of different lengths");
+        for (d, &x) in dst.iter_mut().zip(src) {
+            *d = self.to_f64(x);
+        }
+    }
+    /// Whether [`Format::to_f64_column`] runs at vector speed (a hint for callers choosing
+    /// between converting and keeping an f64 copy; the values are the same either way).
+    fn fast_f64_column(&self) -> bool {
+        false
+    }
     /// The stage-0 input read of an encoding a unit receives (both units, every input): a NaN
     /// reads as the canonical NaN under `canonical` and quieted (fraction MSB set, sign and
     /// the rest of the payload kept) under `propagate`; under FTZ a subnormal reads as zero of
@@ -377,6 +389,12 @@ impl<B: IeeeBackend> Format for Ieee<B> {
     }
     fn to_f64(&self, v: B::V) -> f64 {
         self.backend.to_f64(v)
+    }
+    fn to_f64_column(&self, src: &[B::V], dst: &mut [f64]) {
+        self.backend.to_f64_column(src, dst)
+    }
+    fn fast_f64_column(&self) -> bool {
+        self.backend.fast_f64_column()
     }
     fn to_bits(&self, v: B::V) -> u64 {
         B::bits(v)
