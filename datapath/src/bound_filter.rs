@@ -21,7 +21,8 @@
 //! per-test overflow flag: with `D = |det| − E_det` (> 0 by (3), and no larger than the
 //! per-test `|det| − err_det`), the per-test `|q| + Δ₁` is at most (|num|·D + E_num·D +
 //! |num|·E_det)/D², and a division-free check with a 2⁻⁴⁰ margin bounds its `1/denom <= max`
-//! (reciprocal mode) and `mag + extra <= max` (`quot_may_overflow`). Then the
+//! (reciprocal mode) and `mag + extra <= max` (`quot_may_overflow`; first once for all three
+//! on the lane's largest numerator and the largest constant, see `certify`). Then the
 //! per-test verdict is decisive with `hit` false, and that is what a certified lane gets; its
 //! `t_err` is +∞ (no t to bound: the lane misses). Every other lane runs [`RtiBound::new`](crate::bound::RtiBound::new) and
 //! [`RtiBound::verdict`](crate::bound::RtiBound::verdict) itself. The lane values (det, u', v', t', u'+v') are the per-test
@@ -284,16 +285,16 @@ pub fn verdict_block_filtered(
         use std::arch::is_x86_feature_detected as has;
         if cap >= Kernel::Avx512 && has!("avx512f") {
             // SAFETY: AVX-512F is present (checked above)
-            unsafe { filter_avx512(opts, ray, tris, certified) }
+            unsafe { filter_avx512(opts, ray, tris, certified, t_err) }
         } else if cap >= Kernel::Avx2 && has!("avx2") {
             // SAFETY: AVX2 is present (checked above)
-            unsafe { filter_avx2(opts, ray, tris, certified) }
+            unsafe { filter_avx2(opts, ray, tris, certified, t_err) }
         } else {
-            filter(opts, ray, tris, certified)
+            filter(opts, ray, tris, certified, t_err)
         }
     };
     #[cfg(not(target_arch = "x86_64"))]
-    let ok = filter(opts, ray, tris, certified);
+    let ok = filter(opts, ray, tris, certified, t_err);
     if !ok {
         crate::bound::verdict_block(cap, opts, ray, tris, decisive, hit, t_err);
         certified.fill(false);
@@ -361,25 +362,25 @@ fn maxima_avx2(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn filter_avx512(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool]) -> bool {
+fn filter_avx512(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) -> bool {
     // SAFETY: AVX-512F is enabled on this function
     let m = unsafe { maxima_v::<crate::lanes_x86::F64x8>(r, c) };
-    filter_with(o, r, c, m, out)
+    filter_with(o, r, c, m, out, mark)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn filter_avx2(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool]) -> bool {
+fn filter_avx2(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) -> bool {
     // SAFETY: AVX2 is enabled on this function
     let m = unsafe { maxima_v::<crate::lanes_x86::F64x4>(r, c) };
-    filter_with(o, r, c, m, out)
+    filter_with(o, r, c, m, out, mark)
 }
 
 /// The block's constants and each lane's certificate; false when the block has none (range
 /// check, NaN): then no lane is certified.
 #[inline(always)]
-fn filter(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool]) -> bool {
-    filter_with(o, r, c, maxima(r, c), out)
+fn filter(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) -> bool {
+    filter_with(o, r, c, maxima(r, c), out, mark)
 }
 
 /// [`filter`] with the block's maxima given.
@@ -390,10 +391,11 @@ fn filter_with(
     c: [&[f64]; 9],
     m: ([f64; 9], [f64; 9], f64, bool),
     out: &mut [bool],
+    mark: &mut [f64],
 ) -> bool {
     match statics(o, r, m) {
         Some(st) => {
-            certify(o, r, st, c, out);
+            certify(o, r, st, c, out, mark);
             true
         }
         None => false,
@@ -418,32 +420,58 @@ pub fn values(o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5] {
 }
 
 /// Per lane, whether the static constants certify it (conditions (2) to (4) of the module
-/// documentation; (1) is the caller's). Branch-free per lane.
+/// documentation; (1) is the caller's), branch-free per lane. Condition (4) first as one
+/// quotient check on the lane's largest numerator magnitude max(|t'|, |u'|, |v'|) with the
+/// largest of the three constants: [`quot_may_overflow`]'s inequality, divided by d² > 0,
+/// has every left-hand term non-decreasing in the numerator and in its constant (and the
+/// right side free of both), so what it certifies there holds for each of the three. A lane
+/// that meets (2) and (3) but not that check (few: |det| near its bound) then takes the
+/// three checks one by one (those lanes marked in `mark`, scratch space of the block's length).
 #[inline(always)]
-fn certify(o: BlockOpts, r: BlockRay, st: Static, c: [&[f64]; 9], out: &mut [bool]) {
+fn certify(o: BlockOpts, r: BlockRay, st: Static, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) {
     let (u, eta, max) = (o.em.u, o.em.eta, o.em.max);
     let recip = o.div == DivMode::RecipMul;
-    let backface = o.cull == Cull::Backface;
+    let e_num = st.tp.max(st.up).max(st.vp);
+    assert_eq!(mark.len(), out.len(), "certify: scratch of another length");
+    let mut near = false;
     for i in 0..out.len() {
-        let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
-        let [det, up, vp, tp, uv] = values(r.o, r.d, v);
-        let det_q = if backface { det - o.det_threshold } else { det.abs() - o.det_threshold };
-        let pos = det > 0.0;
-        let sgn = |x: f64| if pos { x } else { -x };
-        let valid = (det_q > 0.0) & (sgn(up) >= 0.0) & (sgn(vp) >= 0.0) & (sgn(det - uv) >= 0.0) & (sgn(tp) >= 0.0);
-        let clear = |x: f64, e: f64| x.abs() > e;
-        let cleared = clear(det_q, st.det)
-            & clear(det, st.det)
-            & clear(up, st.up)
-            & clear(vp, st.vp)
-            & clear(det - uv, st.det + st.uv)
-            & clear(tp, st.tp);
-        let d = det.abs() - st.det;
-        let over = quot_may_overflow(recip, u, eta, max, tp, st.tp, st.det, d)
-            | quot_may_overflow(recip, u, eta, max, up, st.up, st.det, d)
-            | quot_may_overflow(recip, u, eta, max, vp, st.vp, st.det, d);
-        out[i] = !valid & cleared & !over;
+        let (cleared, d, [up, vp, tp]) = lane_cleared(o, r, st, c, i);
+        let x = tp.abs().max(up.abs()).max(vp.abs());
+        let over = quot_may_overflow(recip, u, eta, max, x, e_num, st.det, d);
+        out[i] = cleared & !over;
+        mark[i] = if cleared & over { 1.0 } else { 0.0 };
+        near |= cleared & over;
     }
+    if near {
+        for i in 0..out.len() {
+            if mark[i] != 0.0 {
+                let (_, d, [up, vp, tp]) = lane_cleared(o, r, st, c, i);
+                out[i] = !(quot_may_overflow(recip, u, eta, max, tp, st.tp, st.det, d)
+                    | quot_may_overflow(recip, u, eta, max, up, st.up, st.det, d)
+                    | quot_may_overflow(recip, u, eta, max, vp, st.vp, st.det, d));
+            }
+        }
+    }
+}
+
+/// Lane `i`'s conditions (2) and (3) of the module documentation (not valid, every compared
+/// quantity clear of its constant), its `d = |det| − E_det` and its numerators u', v', t'.
+#[inline(always)]
+fn lane_cleared(o: BlockOpts, r: BlockRay, st: Static, c: [&[f64]; 9], i: usize) -> (bool, f64, [f64; 3]) {
+    let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
+    let [det, up, vp, tp, uv] = values(r.o, r.d, v);
+    let det_q = if o.cull == Cull::Backface { det - o.det_threshold } else { det.abs() - o.det_threshold };
+    let pos = det > 0.0;
+    let sgn = |x: f64| if pos { x } else { -x };
+    let valid = (det_q > 0.0) & (sgn(up) >= 0.0) & (sgn(vp) >= 0.0) & (sgn(det - uv) >= 0.0) & (sgn(tp) >= 0.0);
+    let clear = |x: f64, e: f64| x.abs() > e;
+    let cleared = clear(det_q, st.det)
+        & clear(det, st.det)
+        & clear(up, st.up)
+        & clear(vp, st.vp)
+        & clear(det - uv, st.det + st.uv)
+        & clear(tp, st.tp);
+    (!valid & cleared, det.abs() - st.det, [up, vp, tp])
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@
 //! both cull rules, a zero and a nonzero det threshold, on every instruction level the machine
 //! has (under `emu/avx512`: AVX-512F too).
 
-use datapath::bound::{verdict_block, BlockOpts, BlockRay};
+use datapath::bound::{verdict_block, BlockOpts, BlockRay, RtiBound};
 use datapath::bound_filter::verdict_block_filtered;
 use datapath::format::DivMode;
 use datapath::rng::SplitMix64;
@@ -165,4 +165,56 @@ fn scene_like_blocks_are_mostly_certified() {
         assert!(share(f) > 0.7, "format {f}: {:?}", total[f]);
     }
     assert!(share(2) > 0.2, "e8m7: {:?}", total[2]);
+}
+
+/// Far triangles and a slow ray, so that a lane's quotient t = t'/det (or u, v) can leave the
+/// format's range while every compared quantity clears its constant (condition (4) of the
+/// filter): each lane gets the per-test verdict, in binary16 (largest 65504) and e8m7, both
+/// division modes — a certificate that ignored a quotient's overflow flag would be caught here
+/// (the per-test bound finds such lanes not decisive; the test requires some).
+#[test]
+fn lanes_whose_quotients_overflow_get_the_per_test_verdict() {
+    let (mut undecided, mut certified) = (0, 0);
+    for seed in 0..64u64 {
+        for divide in [false, true] {
+            for fmt in [1, 2, 5] {
+                let mut r = SplitMix64::new(seed ^ 0x9e37);
+                let o = opts(&mut r, fmt, divide, false);
+                let n = 64;
+                let slow = 2f64.powi(-(r.below(12) as i32) - 4);
+                let ray = BlockRay { o: [0.0, 0.0, 0.0], d: [0.0, 0.0, slow], tmin: 0.0, tmax: f64::INFINITY };
+                let mut cols: [Vec<f64>; 9] = std::array::from_fn(|_| Vec::with_capacity(n));
+                // alike triangles (the block's constants near each lane's own bounds) beside
+                // the ray (it misses them), at a distance the slow ray takes long to reach
+                let (far, size) = (r.range(10.0, 2000.0), r.range(0.05, 1.0));
+                for _ in 0..n {
+                    let c = [r.range(1.5, 2.0), r.range(-0.5, 0.5), far * r.range(0.99, 1.0)];
+                    for p in 0..3 {
+                        for a in 0..3 {
+                            cols[3 * p + a].push(c[a] + size * r.range(-1.0, 1.0));
+                        }
+                    }
+                }
+                let (k, _) = same(o, ray, &cols).unwrap();
+                certified += k;
+                undecided += (0..n).filter(|&i| only_a_quotient_overflows(o, ray, &cols, i)).count();
+            }
+        }
+    }
+    assert!(undecided > 100, "only {undecided} lanes undecided by a quotient's overflow alone");
+    assert!(certified > 100, "only {certified} lanes certified");
+}
+
+/// Whether lane `i` misses with every compared quantity clear of its per-test bound, the
+/// per-test verdict undecided by the overflow flag alone (a quotient left the format's range).
+fn only_a_quotient_overflows(o: BlockOpts, ray: BlockRay, cols: &[Vec<f64>; 9], i: usize) -> bool {
+    let v = std::array::from_fn(|p| std::array::from_fn(|a| cols[3 * p + a][i]));
+    let b = RtiBound::<f64>::new(o.em, o.div, ray.o, ray.d, v);
+    let mut quiet = b;
+    quiet.overflow = false;
+    let (with, without) = (
+        b.verdict(o.cull, o.det_threshold, ray.tmin, ray.tmax),
+        quiet.verdict(o.cull, o.det_threshold, ray.tmin, ray.tmax),
+    );
+    b.overflow && !with.decisive && without.decisive && !without.hit
 }
