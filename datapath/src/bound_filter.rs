@@ -48,7 +48,8 @@ struct Static {
 
 /// The block's largest magnitudes: per first-difference component (e1 = v1 − v0, e2 = v2 − v0,
 /// s = o − v0, as each lane computes them) its largest |value| and largest monomial sum
-/// |x| + |y|, the largest |input|, and whether an input is NaN. Column by column, branch-free.
+/// |x| + |y|, the largest non-NaN |input|, and whether an input is not finite. Column by
+/// column, branch-free.
 #[inline(always)]
 fn maxima(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
     let (mut ve, mut ae) = ([0.0f64; 9], [0.0f64; 9]);
@@ -66,7 +67,7 @@ fn maxima(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
     (ve, ae, big, bad)
 }
 
-/// Over the lanes of columns x and y: the largest |x − y|, |x| + |y| and max(|x|, |y|), and
+/// Over the lanes of columns x and y: the largest |x − y|, |x| + |y| and non-NaN |x| or |y|, and
 /// whether a value is not finite (x·0 is NaN exactly then). Eight independent accumulators
 /// per quantity, so the loop vectorises.
 #[inline(always)]
@@ -75,10 +76,11 @@ fn column_maxima(x: &[f64], y: &[f64]) -> (f64, f64, f64, bool) {
     let (mut vm, mut am, mut bm, mut nf) = ([0.0f64; W], [0.0f64; W], [0.0f64; W], [0.0f64; W]);
     let mut step = |j: usize, xi: f64, yi: f64| {
         let (dv, sv) = ((xi - yi).abs(), xi.abs() + yi.abs());
-        let mb = if xi.abs() > yi.abs() { xi.abs() } else { yi.abs() };
         vm[j] = if dv > vm[j] { dv } else { vm[j] };
         am[j] = if sv > am[j] { sv } else { am[j] };
-        bm[j] = if mb > bm[j] { mb } else { bm[j] };
+        // each |value| on its own (a NaN is never taken, and never hides its partner)
+        bm[j] = if xi.abs() > bm[j] { xi.abs() } else { bm[j] };
+        bm[j] = if yi.abs() > bm[j] { yi.abs() } else { bm[j] };
         nf[j] += xi * 0.0 + yi * 0.0;
     };
     let (xc, yc) = (x.chunks_exact(W), y.chunks_exact(W));
@@ -120,11 +122,13 @@ fn origin_maxima(xi: f64, y: &[f64]) -> (f64, f64, f64, bool) {
     (v, a, b.max(xi.abs()), n | !xi.is_finite())
 }
 
-/// [`maxima`] in explicit vector registers of `V` (its feature present): per column pair the
-/// same three maxima and the same non-finite flag. Equal to [`maxima`]: a maximum of non-NaN
-/// values does not depend on the order they are taken in (every value is an absolute value or
-/// a sum of two, never −0; a NaN fails every compare in both), and a sum of `x·0` terms is NaN
-/// exactly when one of its `x` is not finite, in any order.
+/// [`maxima`] in explicit vector registers of `V` (its feature present): per axis one pass
+/// over the three vertex columns giving the three components' maxima (e1 = v1 − v0,
+/// e2 = v2 − v0, s = o − v0), the largest |input| and the non-finite flag. Equal to
+/// [`maxima`]: a maximum of non-NaN values does not depend on the order or grouping it is
+/// taken in (every value is an absolute value or a sum of two, never −0; a NaN is never
+/// taken: `maxpd` keeps its second operand, the running maximum, and the scalar compares fail),
+/// and a sum of `x·0` terms is NaN exactly when one of its `x` is not finite, in any order.
 ///
 /// # Safety
 /// `V`'s instruction set must be present.
@@ -134,45 +138,54 @@ unsafe fn maxima_v<V: crate::lanes_x86::Vector>(r: BlockRay, c: [&[f64]; 9]) -> 
     let (mut ve, mut ae) = ([0.0f64; 9], [0.0f64; 9]);
     let (mut big, mut bad) = (0.0f64, false);
     for a in 0..3 {
-        let y = c[a];
+        // SAFETY: the caller's contract
+        let (vm, am, bm, nf) = unsafe { axis_maxima_v::<V>(r.o[a], c[a], c[3 + a], c[6 + a]) };
         for k in 0..3 {
-            let x = if k < 2 { Some(c[3 * (k + 1) + a]) } else { None };
-            // SAFETY: the caller's contract
-            let (vm, am, bm, nf) = unsafe { pair_maxima_v::<V>(x, r.o[a], y) };
-            ve[3 * k + a] = vm;
-            ae[3 * k + a] = am;
-            big = big.max(bm);
-            bad |= nf;
+            ve[3 * k + a] = vm[k];
+            ae[3 * k + a] = am[k];
         }
+        big = big.max(bm);
+        bad |= nf;
     }
     (ve, ae, big, bad)
 }
 
-/// [`column_maxima`] (`x` a column) or [`origin_maxima`] (`x` None: the value `o`) in vector
-/// registers, the lanes past the last whole vector by the scalar steps.
+/// One axis of [`maxima_v`]: over the lanes of v0, v1, v2 (and the origin's value `o`) the
+/// largest |v1 − v0|, |v2 − v0|, |o − v0| and |v1| + |v0|, |v2| + |v0|, |o| + |v0|, the largest
+/// |input| and whether an input is not finite; the lanes past the last whole vector by the
+/// scalar steps ([`column_maxima`], [`origin_maxima`]).
 ///
 /// # Safety
 /// `V`'s instruction set must be present.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn pair_maxima_v<V: crate::lanes_x86::Vector>(x: Option<&[f64]>, o: f64, y: &[f64]) -> (f64, f64, f64, bool) {
-    let n = y.len();
-    assert!(x.is_none_or(|x| x.len() == n), "column lengths differ");
+unsafe fn axis_maxima_v<V: crate::lanes_x86::Vector>(
+    o: f64,
+    v0: &[f64],
+    v1: &[f64],
+    v2: &[f64],
+) -> ([f64; 3], [f64; 3], f64, bool) {
+    let n = v0.len();
+    assert!(v1.len() == n && v2.len() == n, "column lengths differ");
     let whole = n - n % V::N;
     let zero = V::splat(0.0);
-    let (mut vm, mut am, mut bm, mut nf) = (zero, zero, zero, zero);
-    let ox = V::splat(o);
+    let (mut vm, mut am) = ([zero; 3], [zero; 3]);
+    let (mut bm, mut nf) = (zero, zero);
+    let (ox, oa) = (V::splat(o), V::splat(o.abs()));
     let mut i = 0;
     while i < whole {
-        // SAFETY: i + N <= n for y and x (same length); the caller's contract for the feature
-        let (yi, xi) = unsafe { (V::load(y.as_ptr().add(i)), x.map_or(ox, |x| V::load(x.as_ptr().add(i)))) };
-        let (xa, ya) = (xi.abs(), yi.abs());
-        let (dv, sv) = ((xi - yi).abs(), xa + ya);
-        let mb = if x.is_some() { V::select(ya.lt(xa), xa, ya) } else { ya };
-        vm = V::select(vm.lt(dv), dv, vm);
-        am = V::select(am.lt(sv), sv, am);
-        bm = V::select(bm.lt(mb), mb, bm);
-        nf = nf + (if x.is_some() { xi * zero + yi * zero } else { yi * zero });
+        // SAFETY: i + N <= n for the three columns (same length); the caller's contract
+        let (y, x1, x2) =
+            unsafe { (V::load(v0.as_ptr().add(i)), V::load(v1.as_ptr().add(i)), V::load(v2.as_ptr().add(i))) };
+        let (ya, x1a, x2a) = (y.abs(), x1.abs(), x2.abs());
+        let dv = [(x1 - y).abs(), (x2 - y).abs(), (ox - y).abs()];
+        let sv = [x1a + ya, x2a + ya, oa + ya];
+        for k in 0..3 {
+            vm[k] = dv[k].max_of(vm[k]);
+            am[k] = sv[k].max_of(am[k]);
+        }
+        bm = x2a.max_of(x1a.max_of(ya.max_of(bm)));
+        nf = nf + (y * zero + x1 * zero + x2 * zero);
         i += V::N;
     }
     let lanes = |v: V| {
@@ -181,17 +194,20 @@ unsafe fn pair_maxima_v<V: crate::lanes_x86::Vector>(x: Option<&[f64]>, o: f64, 
         unsafe { v.store(a.as_mut_ptr()) };
         a
     };
-    let fold = |v: V, m: f64| lanes(v)[..V::N].iter().fold(m, |m, &l| if l > m { l } else { m });
-    let (rv, ra, rb) = (fold(vm, 0.0), fold(am, 0.0), fold(bm, 0.0));
+    let max = |p: f64, q: f64| if p > q { p } else { q };
+    let fold = |v: V, m: f64| lanes(v)[..V::N].iter().fold(m, |m, &l| max(l, m));
     let rn = lanes(nf)[..V::N].iter().any(|l| l.is_nan());
     // the tail by the scalar steps (origin_maxima takes |o| and o's finiteness even on an
     // empty tail)
-    let (tv, ta, tb, tn) = match x {
-        Some(x) => column_maxima(&x[whole..], &y[whole..]),
-        None => origin_maxima(o, &y[whole..]),
-    };
-    let max = |p: f64, q: f64| if p > q { p } else { q };
-    (max(tv, rv), max(ta, ra), max(tb, rb), rn | tn)
+    let t = [
+        column_maxima(&v1[whole..], &v0[whole..]),
+        column_maxima(&v2[whole..], &v0[whole..]),
+        origin_maxima(o, &v0[whole..]),
+    ];
+    let vmax = std::array::from_fn(|k| fold(vm[k], t[k].0));
+    let amax = std::array::from_fn(|k| fold(am[k], t[k].1));
+    let big = t.iter().fold(fold(bm, 0.0), |m, x| max(x.2, m));
+    (vmax, amax, big, rn | t.iter().any(|x| x.3))
 }
 
 /// The accumulators folded (the non-finite flag: a NaN sum).
@@ -324,7 +340,7 @@ pub fn verdict_block_filtered(
 
 /// The block's largest magnitudes the static constants come from, on the widest instruction
 /// level `cap` allows and the machine has: per first-difference component (e1 x, y, z, e2 x,
-/// y, z, s x, y, z) the largest |value| and the largest monomial sum, the largest |input|, and
+/// y, z, s x, y, z) the largest |value| and the largest monomial sum, the largest non-NaN |input|, and
 /// whether an input is not finite. The same bits on every level.
 pub fn block_maxima(cap: crate::simd::Kernel, ray: BlockRay, tris: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
     use crate::simd::Kernel;

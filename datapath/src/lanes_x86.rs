@@ -224,6 +224,8 @@ pub trait Vector: Lane {
     unsafe fn store(self, p: *mut f64);
     /// The mask as bits, lane k in bit k.
     fn bits(m: Self::M) -> u32;
+    /// Per lane `self > o ? self : o` (`maxpd`: o where either is NaN or both are zeros).
+    fn max_of(self, o: Self) -> Self;
 }
 
 impl Vector for F64x8 {
@@ -241,6 +243,11 @@ impl Vector for F64x8 {
     #[inline(always)]
     fn bits(m: M8) -> u32 {
         u32::from(m.0)
+    }
+    #[inline(always)]
+    fn max_of(self, o: Self) -> Self {
+        // SAFETY: used only where the feature was detected (module documentation)
+        unsafe { Self(_mm512_max_pd(self.0, o.0)) }
     }
 }
 
@@ -260,5 +267,10 @@ impl Vector for F64x4 {
     fn bits(m: M4) -> u32 {
         // SAFETY: used only where the feature was detected (module documentation)
         unsafe { _mm256_movemask_pd(m.0) as u32 }
+    }
+    #[inline(always)]
+    fn max_of(self, o: Self) -> Self {
+        // SAFETY: used only where the feature was detected (module documentation)
+        unsafe { Self(_mm256_max_pd(self.0, o.0)) }
     }
 }
