@@ -1283,3 +1283,92 @@ fn fixed_point_formats_wider_than_32_bits_run_the_scalar_model() {
         assert_eq!(datapath::simd::fixed::kernel_fixed(&fixed(name)), Kernel::Scalar, "{name}");
     }
 }
+
+/// `simd::gather::gather` on every kernel is the plain copy `cols[c][k] = pick(&recs[idx[k]])[c]`
+/// bit for bit: 4- and 8-byte numbers (the AVX-512F gathers), 2-byte ones (always scalar), a
+/// field at an offset within its record, every length up to 70 (whole 16-lane steps and
+/// tails), NaN payloads copied as they are; an index out of range and a short column panic.
+mod gather {
+    use super::*;
+    use datapath::simd::gather::gather;
+    use datapath::simd::{kernels_here, with_kernel_cap, Kernel};
+
+    #[derive(Clone, Copy)]
+    struct Rec {
+        _pad: [u16; 3],
+        a: [f32; 5],
+        b: [f64; 3],
+        h: [u16; 2],
+        q: [i64; 2],
+    }
+
+    fn recs(r: &mut SplitMix64, n: usize) -> Vec<Rec> {
+        (0..n)
+            .map(|_| Rec {
+                _pad: [0; 3],
+                a: std::array::from_fn(|_| f32::from_bits(r.next_u64() as u32)),
+                b: std::array::from_fn(|_| f64::from_bits(r.next_u64())),
+                h: std::array::from_fn(|_| r.next_u64() as u16),
+                q: std::array::from_fn(|_| r.next_u64() as i64),
+            })
+            .collect()
+    }
+
+    fn check<T: Copy + Default + 'static, const C: usize>(
+        k: Kernel,
+        recs: &[Rec],
+        idx: &[u32],
+        pick: impl Fn(&Rec) -> &[T; C] + Copy,
+        bits: impl Fn(T) -> u64,
+    ) {
+        let mut cols: [Vec<T>; C] = std::array::from_fn(|_| vec![T::default(); idx.len() + 3]);
+        with_kernel_cap(k, || gather(k, recs, idx, true, pick, cols.each_mut().map(|c| &mut c[..])));
+        for (j, &i) in idx.iter().enumerate() {
+            for (c, (col, &want)) in cols.iter().zip(pick(&recs[i as usize])).enumerate() {
+                assert_eq!(bits(col[j]), bits(want), "{k:?} lane {j} of {} column {c}", idx.len());
+            }
+        }
+        assert!(
+            cols.iter().all(|c| c[idx.len()..].iter().all(|&x| bits(x) == bits(T::default()))),
+            "{k:?}: wrote past the block"
+        );
+    }
+
+    #[test]
+    fn gathers_are_the_plain_copy_on_every_kernel() {
+        let mut r = SplitMix64::new(0x9a7);
+        let recs = recs(&mut r, 300);
+        for k in kernels_here() {
+            for n in (0..=70).chain([255, 256]) {
+                let idx: Vec<u32> = (0..n).map(|_| r.below(300) as u32).collect();
+                check(k, &recs, &idx, |x| &x.a, |v: f32| u64::from(v.to_bits()));
+                check(k, &recs, &idx, |x| &x.b, f64::to_bits);
+                check(k, &recs, &idx, |x| &x.h, u64::from);
+                check(k, &recs, &idx, |x| &x.q, |v: i64| v as u64);
+            }
+        }
+    }
+
+    #[test]
+    fn out_of_range_indices_and_short_columns_panic_on_every_kernel() {
+        let mut r = SplitMix64::new(0x9a8);
+        let recs = recs(&mut r, 40);
+        for k in kernels_here() {
+            for bad in [0usize, 5, 15, 16, 31] {
+                let mut idx: Vec<u32> = (0..32).map(|_| r.below(40) as u32).collect();
+                idx[bad] = 40;
+                let res = std::panic::catch_unwind(|| {
+                    let mut cols: [Vec<f32>; 5] = std::array::from_fn(|_| vec![0.0; 32]);
+                    with_kernel_cap(k, || gather(k, &recs, &idx, false, |x| &x.a, cols.each_mut().map(|c| &mut c[..])));
+                });
+                assert!(res.is_err(), "{k:?}: index 40 of 40 records at lane {bad} taken");
+            }
+            let res = std::panic::catch_unwind(|| {
+                let idx = [1u32; 20];
+                let mut cols: [Vec<f64>; 3] = [vec![0.0; 20], vec![0.0; 19], vec![0.0; 20]];
+                gather(k, &recs, &idx, false, |x| &x.b, cols.each_mut().map(|c| &mut c[..]));
+            });
+            assert!(res.is_err(), "{k:?}: a short column taken");
+        }
+    }
+}

@@ -26,6 +26,7 @@ use datapath::bound::{BlockOpts, BlockRay};
 use datapath::bound_filter::verdict_block_filtered;
 use datapath::rng::SplitMix64;
 use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
+use datapath::simd::gather::gather;
 use datapath::simd::{self, Kernel};
 use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa};
 use datapath::Format;
@@ -235,55 +236,6 @@ fn cols<const N: usize>(c: &[Vec<f64>; N], n: usize) -> [&[f64]; N] {
     std::array::from_fn(|k| &c[k][..n])
 }
 
-/// Records ahead of the gather that [`gather`] asks the cache for (random records come from L2).
-const AHEAD: usize = 16;
-
-/// Column by column, `cols[c][k] = pick(recs[blk[k]])[c]`: one block's gather. With `fetch`
-/// (the block's first gather) each record [`AHEAD`] lanes on is prefetched, all its lines.
-#[inline(always)]
-fn gather<R, T: Copy, const C: usize>(
-    recs: &[R],
-    blk: &[u32],
-    fetch: bool,
-    pick: impl Fn(&R) -> &[T; C],
-    mut cols: [&mut [T]; C],
-) {
-    assert!(cols.iter().all(|c| c.len() >= blk.len()), "gather: a column is shorter than the block");
-    for (k, &ti) in blk.iter().enumerate() {
-        if fetch {
-            if let Some(&tj) = blk.get(k + AHEAD) {
-                prefetch(&recs[tj as usize]);
-            }
-        }
-        let r = pick(&recs[ti as usize]);
-        for (col, &x) in cols.iter_mut().zip(r) {
-            // SAFETY: k < blk.len() <= col.len() (asserted above)
-            unsafe { *col.get_unchecked_mut(k) = x };
-        }
-    }
-}
-
-/// Asks the cache for every line of `*r` (a hint: no effect on results).
-#[inline(always)]
-fn prefetch<R>(r: &R) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        let p = (r as *const R).cast::<i8>();
-        let mut off = 0;
-        while off < std::mem::size_of::<R>() {
-            // SAFETY: a prefetch never faults; p + off lies within *r
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(off)) };
-            off += 64;
-        }
-        // the record's last line when it straddles one more
-        // SAFETY: as above
-        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(std::mem::size_of::<R>().saturating_sub(1))) };
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = r;
-}
-
 /// A bit mask of at most 64 lanes: bit k is `b[k]`.
 #[inline(always)]
 fn bits(b: &[bool]) -> u64 {
@@ -396,7 +348,14 @@ where
         }
         {
             let [[a, b, c], [d, e, f], [g, h, i]] = &mut s.tris.v;
-            gather(&self.recs, blk, true, |r| &r.m, [a, b, c, d, e, f, g, h, i].map(|x| &mut x[..]));
+            gather(
+                Kernel::Avx512Fp16,
+                &self.recs,
+                blk,
+                true,
+                |r| &r.m,
+                [a, b, c, d, e, f, g, h, i].map(|x| &mut x[..]),
+            );
         }
         // the quantised triangles: the model's values in f64 (Rti::tri stores from_f64 of each
         // coordinate, so to_f64 of the model's column is the quantised column), converted where
@@ -406,7 +365,7 @@ where
                 self.rti.fmt.to_f64_column(&s.tris.v[c / 3][c % 3][..n], &mut col[..n]);
             }
         } else {
-            gather(&self.qs, blk, true, |r| r, s.cols.each_mut().map(|x| &mut x[..]));
+            gather(Kernel::Avx512Fp16, &self.qs, blk, true, |r| r, s.cols.each_mut().map(|x| &mut x[..]));
         }
         let t0 = Instant::now();
         match self.cfg.inject {
@@ -549,7 +508,7 @@ where
         blk: &[u32],
     ) {
         let n = blk.len();
-        gather(&self.recs, blk, !self.with_rti, |r| &r.b, s.bcols.each_mut().map(|x| &mut x[..]));
+        gather(Kernel::Avx512Fp16, &self.recs, blk, !self.with_rti, |r| &r.b, s.bcols.each_mut().map(|x| &mut x[..]));
         slab_block(
             self.level,
             rq.o,
@@ -564,7 +523,7 @@ where
         // the stored boxes, gathered once for every variant
         {
             let ([a, b, c], [d, e, f]) = (&mut s.boxes.min, &mut s.boxes.max);
-            gather(&self.recs, blk, false, |r| &r.s, [a, b, c, d, e, f].map(|x| &mut x[..]));
+            gather(Kernel::Avx512Fp16, &self.recs, blk, false, |r| &r.s, [a, b, c, d, e, f].map(|x| &mut x[..]));
         }
         // the exact decision of each lane, computed at most once for all variants (0: not yet);
         // whether the golden interval is too close to empty to trust, once for all variants
@@ -902,20 +861,5 @@ mod tests {
         assert_eq!(words(0).count(), 0);
         assert_eq!(words(64).collect::<Vec<_>>(), [(0, 64)]);
         assert_eq!(words(200).collect::<Vec<_>>(), [(0, 64), (64, 64), (128, 64), (192, 8)]);
-    }
-
-    /// `gather` writes record `blk[k]`'s fields to lane k of each column, and refuses a column
-    /// shorter than the block.
-    #[test]
-    fn gathers() {
-        let recs: Vec<[u32; 3]> = (0..10).map(|i| [i, 100 + i, 200 + i]).collect();
-        let (mut a, mut b, mut c) = (vec![0; 4], vec![0; 4], vec![0; 4]);
-        gather(&recs, &[7, 2, 2], true, |r| r, [&mut a[..], &mut b[..], &mut c[..]]);
-        assert_eq!((a, b, c), (vec![7, 2, 2, 0], vec![107, 102, 102, 0], vec![207, 202, 202, 0]));
-        let short = std::panic::catch_unwind(|| {
-            let (mut a, mut b, mut c) = (vec![0; 2], vec![0; 4], vec![0; 4]);
-            gather(&recs, &[1, 2, 3], false, |r| r, [&mut a[..], &mut b[..], &mut c[..]]);
-        });
-        assert!(short.is_err());
     }
 }

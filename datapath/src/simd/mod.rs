@@ -45,6 +45,7 @@
 mod batch;
 mod entries;
 pub mod fixed;
+pub mod gather;
 #[cfg(target_arch = "x86_64")]
 mod isa;
 #[cfg(target_arch = "x86_64")]

@@ -1,0 +1,153 @@
+//! Gathers: fields of records picked by index copied into columns (`cols[c][k] =
+//! pick(recs[idx[k]])[c]`), the step that turns a block of test indices into the kernels' SoA
+//! columns. Scalar, or with AVX-512F gather instructions for 4- and 8-byte values (16 lanes a
+//! step); the same values either way: a gather only copies bits.
+
+use super::select::best_kernel;
+use super::Kernel;
+use std::any::TypeId;
+
+/// Records this many lanes ahead of the copy are prefetched when the caller asks
+/// (random records come from L2).
+pub const AHEAD: usize = 16;
+
+/// Column by column, `cols[c][k] = pick(&recs[idx[k]])[c]` for every lane `k` of `idx`. With
+/// `fetch` each record [`AHEAD`] lanes on is prefetched, all its lines (a hint). The widest
+/// copy `cap`, the thread's cap and the machine allow: AVX-512F gathers when `T` is a 4- or
+/// 8-byte number (`f32`, `u32`, `i32`, `f64`, `u64`, `i64`), else scalar.
+///
+/// # Panics
+/// If a column is shorter than `idx`, or an index is out of range.
+#[inline(always)]
+pub fn gather<R, T: Copy + 'static, const C: usize>(
+    cap: Kernel,
+    recs: &[R],
+    idx: &[u32],
+    fetch: bool,
+    pick: impl Fn(&R) -> &[T; C],
+    mut cols: [&mut [T]; C],
+) {
+    assert!(cols.iter().all(|c| c.len() >= idx.len()), "gather: a column is shorter than the block");
+    let mut done = 0;
+    #[cfg(target_arch = "x86_64")]
+    if idx.len() >= 16 && best_kernel(true, cap) >= Kernel::Avx512 && fits_i32::<R>(recs.len()) {
+        // the field's byte offset in its record (the same in every record)
+        let off = (pick(&recs[0]) as *const [T; C] as usize) - (&recs[0] as *const R as usize);
+        let wide = if is::<T, f32>() || is::<T, u32>() || is::<T, i32>() {
+            Some(4)
+        } else if is::<T, f64>() || is::<T, u64>() || is::<T, i64>() {
+            Some(8)
+        } else {
+            None
+        };
+        if let Some(w) = wide {
+            let ptrs: [*mut T; C] = std::array::from_fn(|c| cols[c].as_mut_ptr());
+            // SAFETY: AVX-512F is present (best_kernel checks the machine); every column holds
+            // idx.len() values; the byte offsets fit in i32 (fits_i32) and every index is
+            // checked against recs.len() before its records are read; T is a plain number of
+            // w bytes, so copying its bits copies it
+            done = unsafe { avx512(recs, idx, fetch, off, w, ptrs) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = cap;
+    for k in done..idx.len() {
+        if fetch {
+            if let Some(&j) = idx.get(k + AHEAD) {
+                prefetch(&recs[j as usize]);
+            }
+        }
+        let r = pick(&recs[idx[k] as usize]);
+        for (col, &x) in cols.iter_mut().zip(r) {
+            // SAFETY: k < idx.len() <= col.len() (asserted above)
+            unsafe { *col.get_unchecked_mut(k) = x };
+        }
+    }
+}
+
+/// `T` is `U`.
+#[inline(always)]
+fn is<T: 'static, U: 'static>() -> bool {
+    TypeId::of::<T>() == TypeId::of::<U>()
+}
+
+/// Every byte offset `index · size_of::<R>()` of `n` records (and the field within) fits in an
+/// i32, the gather instructions' offsets.
+#[inline(always)]
+fn fits_i32<R>(n: usize) -> bool {
+    n.checked_add(1).and_then(|m| m.checked_mul(std::mem::size_of::<R>())).is_some_and(|b| b <= i32::MAX as usize)
+}
+
+/// Asks the cache for every line of `*r` (a hint: no effect on results).
+#[inline(always)]
+pub fn prefetch<R>(r: &R) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let p = (r as *const R).cast::<i8>();
+        let mut off = 0;
+        while off < std::mem::size_of::<R>() {
+            // SAFETY: a prefetch never faults; p + off lies within *r
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(off)) };
+            off += 64;
+        }
+        // the record's last line when it straddles one more
+        // SAFETY: as above
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(std::mem::size_of::<R>().saturating_sub(1))) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = r;
+}
+
+/// The whole 16-lane steps of [`gather`] with AVX-512F gathers of `w`-byte values (4 or 8) at
+/// byte offset `off` of each record; returns the lanes done (the rest are the caller's).
+///
+/// # Safety
+/// AVX-512F present; `cols[c]` valid for `idx.len()` writes of `T`; `T` a plain `w`-byte
+/// number; `(recs.len() + 1) · size_of::<R>()` at most `i32::MAX`; `off + C·w` within a record.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn avx512<R, T, const C: usize>(
+    recs: &[R],
+    idx: &[u32],
+    fetch: bool,
+    off: usize,
+    w: usize,
+    cols: [*mut T; C],
+) -> usize {
+    use std::arch::x86_64::*;
+    let whole = idx.len() - idx.len() % 16;
+    let base = recs.as_ptr().cast::<u8>();
+    let stride = _mm512_set1_epi32(std::mem::size_of::<R>() as i32);
+    let len = _mm512_set1_epi32(recs.len() as i32);
+    let mut k = 0;
+    while k < whole {
+        // SAFETY: k + 16 <= idx.len()
+        let ix = unsafe { _mm512_loadu_si512(idx.as_ptr().add(k).cast()) };
+        assert!(_mm512_cmpge_epu32_mask(ix, len) == 0, "gather: index out of range");
+        if fetch {
+            for &j in idx.get(k + AHEAD..(k + AHEAD + 16).min(idx.len())).unwrap_or(&[]) {
+                prefetch(&recs[j as usize]);
+            }
+        }
+        let offs = _mm512_mullo_epi32(ix, stride);
+        for (c, &col) in cols.iter().enumerate() {
+            // SAFETY: every offset + off + c·w + w lies within recs (indices checked, field
+            // within its record); col + k .. col + k + 16 is within the column (the caller)
+            unsafe {
+                let p = base.add(off + c * w);
+                if w == 4 {
+                    let v = _mm512_i32gather_epi32::<1>(offs, p.cast());
+                    _mm512_storeu_si512(col.add(k).cast(), v);
+                } else {
+                    let lo = _mm512_i32gather_epi64::<1>(_mm512_castsi512_si256(offs), p.cast());
+                    let hi = _mm512_i32gather_epi64::<1>(_mm512_extracti64x4_epi64::<1>(offs), p.cast());
+                    _mm512_storeu_si512(col.add(k).cast(), lo);
+                    _mm512_storeu_si512(col.add(k + 8).cast(), hi);
+                }
+            }
+        }
+        k += 16;
+    }
+    whole
+}
