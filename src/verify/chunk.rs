@@ -27,6 +27,7 @@ use datapath::bound_filter::verdict_block_filtered;
 use datapath::rng::SplitMix64;
 use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
 use datapath::simd::gather::gather;
+use datapath::simd::mask::{bits, ones, words};
 use datapath::simd::{self, Kernel};
 use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa};
 use datapath::Format;
@@ -234,39 +235,6 @@ impl<V: Copy + Default> Scratch<V> {
 
 fn cols<const N: usize>(c: &[Vec<f64>; N], n: usize) -> [&[f64]; N] {
     std::array::from_fn(|k| &c[k][..n])
-}
-
-/// A bit mask of at most 64 lanes: bit k is `b[k]`.
-#[inline(always)]
-fn bits(b: &[bool]) -> u64 {
-    debug_assert!(b.len() <= 64);
-    let (bytes, rest) = b.as_chunks::<8>();
-    let mut m = 0u64;
-    for (j, c) in bytes.iter().enumerate() {
-        // eight 0/1 bytes to eight bits: byte i lands on bit 56 + i, no carries between them
-        let x = u64::from_le_bytes(c.map(u8::from));
-        m |= (x.wrapping_mul(0x0102_0408_1020_4080) >> 56) << (8 * j);
-    }
-    for (j, &v) in rest.iter().enumerate() {
-        m |= u64::from(v) << (8 * bytes.len() + j);
-    }
-    m
-}
-
-/// A block of `n` lanes in words of 64: (first lane, lane count) per word.
-fn words(n: usize) -> impl Iterator<Item = (usize, usize)> {
-    (0..n).step_by(64).map(move |w| (w, (n - w).min(64)))
-}
-
-/// The set bits of `m`, lowest first.
-fn ones(mut m: u64) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (m != 0).then(|| {
-            let j = m.trailing_zeros() as usize;
-            m &= m - 1;
-            j
-        })
-    })
 }
 
 impl<F: Format + 'static> Setup<'_, F>
@@ -532,15 +500,19 @@ where
             let scale = 1.0f64.max(near.abs()).max(if far.is_finite() { far.abs() } else { 0.0 });
             *close = (far - near).abs() <= 1e-9 * scale;
         }
+        // the golden hits and the close lanes as bit masks, word by word, once for all variants
+        let (mut gw, mut cw) = ([0u64; BLOCK / 64], [0u64; BLOCK / 64]);
+        for (x, (w, len)) in words(n).enumerate() {
+            (gw[x], cw[x]) = (bits(&s.shit[w..w + len]), bits(&s.sclose[w..w + len]));
+        }
         for ((v, sr), acc) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()) {
             let t0 = Instant::now();
             simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
             acc.model_ns += t0.elapsed().as_nanos() as u64;
             let c = &mut acc.counts;
             c.tests += n as u64;
-            for (w, len) in words(n) {
-                let r = w..w + len;
-                let (hit, g, close) = (bits(&s.sout.hit[r.clone()]), bits(&s.shit[r.clone()]), bits(&s.sclose[r]));
+            for (x, (w, len)) in words(n).enumerate() {
+                let (hit, g, close) = (bits(&s.sout.hit[w..w + len]), gw[x], cw[x]);
                 let all = u64::MAX >> (64 - len);
                 let settled = all & !close & !(hit ^ g);
                 c.exact_hits += u64::from((settled & g).count_ones());
@@ -832,34 +804,5 @@ where
         rti: with_rti.then_some(acc),
         slab: setup.variants.iter().zip(sacc).map(|(v, a)| (v.name.to_string(), v.conservative, a)).collect(),
         wall_ns,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `bits` puts lane k on bit k for every pattern of a byte and for every length up to 64
-    /// (random lanes); `ones` lists the set bits lowest first; `words` covers a block exactly.
-    #[test]
-    fn masks() {
-        let naive = |b: &[bool]| b.iter().enumerate().fold(0u64, |m, (k, &x)| m | (u64::from(x) << k));
-        for p in 0..256u32 {
-            let b: Vec<bool> = (0..8).map(|k| p >> k & 1 == 1).collect();
-            assert_eq!(bits(&b), u64::from(p));
-        }
-        let mut r = SplitMix64::new(3);
-        for len in 0..=64 {
-            for _ in 0..50 {
-                let b: Vec<bool> = (0..len).map(|_| r.below(2) == 1).collect();
-                let m = bits(&b);
-                assert_eq!(m, naive(&b), "{b:?}");
-                let set: Vec<usize> = (0..len).filter(|&k| b[k]).collect();
-                assert_eq!(ones(m).collect::<Vec<_>>(), set);
-            }
-        }
-        assert_eq!(words(0).count(), 0);
-        assert_eq!(words(64).collect::<Vec<_>>(), [(0, 64)]);
-        assert_eq!(words(200).collect::<Vec<_>>(), [(0, 64), (64, 64), (128, 64), (192, 8)]);
     }
 }

@@ -50,6 +50,7 @@ pub mod gather;
 mod isa;
 #[cfg(target_arch = "x86_64")]
 mod kernels;
+pub mod mask;
 mod select;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests;
