@@ -19,6 +19,7 @@
 //!
 //! The chunk's accumulators are merged by the engine; nothing else outlives the chunk.
 
+use super::clock::Clock;
 use super::counts::{RtiCounts, SlabCounts};
 use super::{FormatReport, SlabReport, VerifyConfig};
 use crate::scene::Scene;
@@ -86,6 +87,8 @@ struct RtiAcc {
     rels: Hist,
     first: First<(u64, u64), String>,
     disagree: First<(u64, u64), String>,
+    /// The model's batch calls: [`Clock`] ticks while the pass runs, nanoseconds once
+    /// [`accumulate_format`] converts them.
     model_ns: u64,
 }
 
@@ -104,6 +107,7 @@ impl Merge for RtiAcc {
 #[derive(Default, Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct SlabAcc {
     counts: SlabCounts,
+    /// As [`RtiAcc::model_ns`].
     model_ns: u64,
 }
 
@@ -152,6 +156,8 @@ struct Setup<'a, F: Format> {
     faces: golden::Faces,
     level: Level,
     name: String,
+    /// The model timings' clock (started with the pass).
+    clock: Clock,
 }
 
 /// A worker's reusable buffers (no allocation per chunk after the first).
@@ -335,7 +341,7 @@ where
         } else {
             gather(Kernel::Avx512Fp16, &self.qs, blk, true, |r| r, s.cols.each_mut().map(|x| &mut x[..]));
         }
-        let t0 = Instant::now();
+        let t0 = self.clock.now();
         match self.cfg.inject {
             None => {
                 simd::rti_batch(&self.rti, &s.rays, &s.tris, &mut s.out);
@@ -353,7 +359,7 @@ where
                 }
             }
         }
-        acc.model_ns += t0.elapsed().as_nanos() as u64;
+        acc.model_ns += self.clock.now() - t0;
         intersect_block(self.level, rq, self.faces, cols(&s.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
         let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
         // the static filter first: a lane its block constants certify gets the per-test
@@ -506,9 +512,9 @@ where
             (gw[x], cw[x]) = (bits(&s.shit[w..w + len]), bits(&s.sclose[w..w + len]));
         }
         for ((v, sr), acc) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()) {
-            let t0 = Instant::now();
+            let t0 = self.clock.now();
             simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
-            acc.model_ns += t0.elapsed().as_nanos() as u64;
+            acc.model_ns += self.clock.now() - t0;
             let c = &mut acc.counts;
             c.tests += n as u64;
             for (x, (w, len)) in words(n).enumerate() {
@@ -789,12 +795,18 @@ where
         level: crate::golden_level(),
         name: f.name(),
         rti: rti.clone(),
+        clock: Clock::start(),
     };
     let progress = Progress::new(cfg.engine.shard_items(cfg.rays), "rays", !cfg.progress);
     progress.message(format!("{} ({} tests per ray)", setup.name, tests_per_ray(scene, cfg.sample)));
     let wall = Instant::now();
-    let (acc, sacc) = engine::run(&cfg.engine, cfg.rays, &progress, Scratch::new, |s, r| setup.chunk(s, r));
+    let (mut acc, mut sacc) = engine::run(&cfg.engine, cfg.rays, &progress, Scratch::new, |s, r| setup.chunk(s, r));
     let wall_ns = wall.elapsed().as_nanos() as u64;
+    // the model timings from clock ticks to nanoseconds
+    acc.model_ns = setup.clock.to_ns(acc.model_ns);
+    for a in &mut sacc {
+        a.model_ns = setup.clock.to_ns(a.model_ns);
+    }
     progress.finish();
     // an empty run merges nothing: one empty accumulator per variant
     let sacc = if sacc.is_empty() { setup.variants.iter().map(|_| SlabAcc::default()).collect() } else { sacc };

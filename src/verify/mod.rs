@@ -5,6 +5,7 @@
 //! does, the engine runs the chunks and merges their accumulators.
 
 pub mod chunk;
+pub mod clock;
 pub mod counts;
 pub mod cover;
 
