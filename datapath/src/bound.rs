@@ -349,24 +349,18 @@ fn run_block(
     (decisive, hit, t_err): (&mut [bool], &mut [bool], &mut [f64]),
     #[cfg(target_arch = "x86_64")] (avx512, avx2): (BlockFn, BlockFn),
 ) {
-    use crate::simd::Kernel;
+    use crate::simd::F64Lanes;
     let n = hit.len();
     assert!(decisive.len() == n && t_err.len() == n && tris.iter().all(|c| c.len() == n), "column lengths differ");
-    let cap = crate::simd::best_kernel(true, cap);
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::is_x86_feature_detected as has;
-        if cap >= Kernel::Avx512 && has!("avx512f") {
-            // SAFETY: AVX-512F is present (checked above)
-            return unsafe { avx512(opts, ray, tris, decisive, hit, t_err) };
-        }
-        if cap >= Kernel::Avx2 && has!("avx2") {
-            // SAFETY: AVX2 is present (checked above)
-            return unsafe { avx2(opts, ray, tris, decisive, hit, t_err) };
-        }
+    match crate::simd::f64_lanes(cap) {
+        // SAFETY: AVX-512F is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 => unsafe { avx512(opts, ray, tris, decisive, hit, t_err) },
+        // SAFETY: AVX2 is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx2 => unsafe { avx2(opts, ray, tris, decisive, hit, t_err) },
+        _ => block_body(opts, ray, tris, decisive, hit, t_err),
     }
-    let _ = cap;
-    block_body(opts, ray, tris, decisive, hit, t_err)
 }
 
 #[cfg(target_arch = "x86_64")]

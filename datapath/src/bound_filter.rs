@@ -34,6 +34,7 @@
 use crate::bound::{BlockOpts, BlockRay, Bnd, Ctx};
 use crate::format::DivMode;
 use crate::rti::Cull;
+use crate::simd::F64Lanes;
 
 /// The block's static constants: each compared signal's `E`, or `None` when the block's range
 /// check fails or an input is NaN (then no lane is certified).
@@ -289,28 +290,20 @@ pub fn verdict_block_filtered(
     t_err: &mut [f64],
     certified: &mut [bool],
 ) -> usize {
-    use crate::simd::Kernel;
     let n = hit.len();
     assert!(
         decisive.len() == n && t_err.len() == n && certified.len() == n && tris.iter().all(|c| c.len() == n),
         "column lengths differ"
     );
-    let cap = crate::simd::best_kernel(true, cap);
-    #[cfg(target_arch = "x86_64")]
-    let ok = {
-        use std::arch::is_x86_feature_detected as has;
-        if cap >= Kernel::Avx512 && has!("avx512f") {
-            // SAFETY: AVX-512F is present (checked above)
-            unsafe { filter_avx512(opts, ray, tris, certified, t_err) }
-        } else if cap >= Kernel::Avx2 && has!("avx2") {
-            // SAFETY: AVX2 is present (checked above)
-            unsafe { filter_avx2(opts, ray, tris, certified, t_err) }
-        } else {
-            filter(opts, ray, tris, certified, t_err)
-        }
+    let ok = match crate::simd::f64_lanes(cap) {
+        // SAFETY: AVX-512F is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 => unsafe { filter_avx512(opts, ray, tris, certified, t_err) },
+        // SAFETY: AVX2 is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx2 => unsafe { filter_avx2(opts, ray, tris, certified, t_err) },
+        _ => filter(opts, ray, tris, certified, t_err),
     };
-    #[cfg(not(target_arch = "x86_64"))]
-    let ok = filter(opts, ray, tris, certified, t_err);
     if !ok {
         crate::bound::verdict_block(cap, opts, ray, tris, decisive, hit, t_err);
         certified.fill(false);
@@ -343,23 +336,17 @@ pub fn verdict_block_filtered(
 /// y, z, s x, y, z) the largest |value| and the largest monomial sum, the largest non-NaN |input|, and
 /// whether an input is not finite. The same bits on every level.
 pub fn block_maxima(cap: crate::simd::Kernel, ray: BlockRay, tris: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
-    use crate::simd::Kernel;
     let n = tris[0].len();
     assert!(tris.iter().all(|c| c.len() == n), "column lengths differ");
-    let cap = crate::simd::best_kernel(true, cap);
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::is_x86_feature_detected as has;
-        if cap >= Kernel::Avx512 && has!("avx512f") {
-            // SAFETY: AVX-512F is present (checked above)
-            return unsafe { maxima_avx512(ray, tris) };
-        } else if cap >= Kernel::Avx2 && has!("avx2") {
-            // SAFETY: AVX2 is present (checked above)
-            return unsafe { maxima_avx2(ray, tris) };
-        }
+    match crate::simd::f64_lanes(cap) {
+        // SAFETY: AVX-512F is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 => unsafe { maxima_avx512(ray, tris) },
+        // SAFETY: AVX2 is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx2 => unsafe { maxima_avx2(ray, tris) },
+        _ => maxima(ray, tris),
     }
-    let _ = cap;
-    maxima(ray, tris)
 }
 
 #[cfg(target_arch = "x86_64")]

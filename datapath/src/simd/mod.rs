@@ -58,5 +58,5 @@ mod tests;
 pub use batch::*;
 pub use entries::*;
 pub use fixed::{rti_batch_fixed, slab_batch_fixed, slab_ray_fixed};
-pub(crate) use select::best_kernel;
 pub use select::{cap_process, kernels_here, with_kernel_cap, Kernel};
+pub(crate) use select::{f64_lanes, F64Lanes};

@@ -95,6 +95,37 @@ pub(crate) fn best_kernel(eligible: bool, useful: Kernel) -> Kernel {
     }
 }
 
+/// The lanes a binary64 block body (the error bound, the static filter, its block maxima)
+/// runs on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum F64Lanes {
+    /// Eight lanes of AVX-512F.
+    Avx512,
+    /// Four lanes of AVX2.
+    Avx2,
+    /// The baseline loop (the compiler's choice of instructions).
+    Baseline,
+}
+
+/// The widest binary64 lanes the machine has (AVX-512F or AVX2, detected) within `cap` and
+/// this thread's and the process's caps: a body for [`F64Lanes::Avx512`] or
+/// [`F64Lanes::Avx2`] may be called with that feature enabled.
+pub(crate) fn f64_lanes(cap: Kernel) -> F64Lanes {
+    let cap = best_kernel(true, cap);
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::is_x86_feature_detected as has;
+        if cap >= Kernel::Avx512 && has!("avx512f") {
+            return F64Lanes::Avx512;
+        }
+        if cap >= Kernel::Avx2 && has!("avx2") {
+            return F64Lanes::Avx2;
+        }
+    }
+    let _ = cap;
+    F64Lanes::Baseline
+}
+
 /// The signature of an RTI kernel: lanes `0..full` of every column.
 #[cfg(target_arch = "x86_64")]
 pub(crate) type RtiKernelFn<F> = unsafe fn(
