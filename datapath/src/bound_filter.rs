@@ -310,8 +310,8 @@ pub fn verdict_block_filtered(
         return 0;
     }
     let k = certified.iter().filter(|&&c| c).count();
-    if n - k > n / 8 {
-        // many lanes left: the per-test bound on the whole block in vector registers, then the
+    if n - k > n / 8 && k < n / 4 {
+        // most lanes left: the per-test bound on the whole block in vector registers, then the
         // certified lanes' verdicts put back (cheaper than the rest lane by lane)
         crate::bound::verdict_block(cap, opts, ray, tris, decisive, hit, t_err);
         for i in 0..n {
@@ -319,6 +319,12 @@ pub fn verdict_block_filtered(
                 (decisive[i], hit[i], t_err[i]) = (true, false, f64::INFINITY);
             }
         }
+        return k;
+    }
+    if n - k > n / 8 {
+        // many lanes left, many certified: the lanes left packed into vectors, a group at a
+        // time, through the per-test bound in vector registers, their verdicts put back
+        bound_packed(cap, opts, ray, tris, decisive, hit, t_err, certified);
         return k;
     }
     for i in 0..n {
@@ -329,6 +335,52 @@ pub fn verdict_block_filtered(
         }
     }
     k
+}
+
+/// Lanes packed per group in [`bound_packed`].
+const PACK: usize = 64;
+
+/// The per-test bound's verdict on every lane not `certified` (+∞ `t_err`, decisive, no hit on
+/// the certified ones): the lanes left, in lane order, copied into groups of [`PACK`] lanes,
+/// each group through [`crate::bound::verdict_block`] (every lane's verdict is its own, so
+/// packing does not change it) and its verdicts written back to their lanes.
+#[allow(clippy::too_many_arguments)]
+fn bound_packed(
+    cap: crate::simd::Kernel,
+    opts: BlockOpts,
+    ray: BlockRay,
+    tris: [&[f64]; 9],
+    decisive: &mut [bool],
+    hit: &mut [bool],
+    t_err: &mut [f64],
+    certified: &[bool],
+) {
+    let n = certified.len();
+    let mut cols = [[0.0f64; PACK]; 9];
+    let (mut dec, mut hi, mut te) = ([false; PACK], [false; PACK], [0.0f64; PACK]);
+    let mut lanes = [0usize; PACK];
+    let mut i = 0;
+    while i < n {
+        // the next group: up to PACK lanes left
+        let mut m = 0;
+        while i < n && m < PACK {
+            if certified[i] {
+                (decisive[i], hit[i], t_err[i]) = (true, false, f64::INFINITY);
+            } else {
+                for (c, col) in cols.iter_mut().enumerate() {
+                    col[m] = tris[c][i];
+                }
+                lanes[m] = i;
+                m += 1;
+            }
+            i += 1;
+        }
+        let c: [&[f64]; 9] = std::array::from_fn(|k| &cols[k][..m]);
+        crate::bound::verdict_block(cap, opts, ray, c, &mut dec[..m], &mut hi[..m], &mut te[..m]);
+        for (j, &l) in lanes[..m].iter().enumerate() {
+            (decisive[l], hit[l], t_err[l]) = (dec[j], hi[j], te[j]);
+        }
+    }
 }
 
 /// The block's largest magnitudes the static constants come from, on the widest instruction

@@ -23,7 +23,7 @@ use super::clock::Clock;
 use super::counts::{RtiCounts, SlabCounts};
 use super::{FormatReport, SlabReport, VerifyConfig};
 use crate::scene::Scene;
-use datapath::bound::{BlockOpts, BlockRay};
+use datapath::bound::{self, BlockOpts, BlockRay};
 use datapath::bound_filter::verdict_block_filtered;
 use datapath::rng::SplitMix64;
 use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
@@ -43,6 +43,11 @@ pub const LIST_STREAM: u64 = 0x7e57;
 /// Tests per block: the columns of one block (15 model columns, 9 + 6 f64 columns, outputs)
 /// stay in L1/L2 while the model, golden and bound read them.
 pub const BLOCK: usize = 256;
+
+/// Blocks a worker runs straight through the per-test bound after one where the static filter
+/// certified fewer than an eighth of the lanes (then it tries the filter again): a speed
+/// choice only, every lane's verdict is the per-test bound's either way.
+pub const FILTER_REST: u32 = 15;
 
 /// Triangles tested per ray: every triangle of a scene with at most `sample`, else `sample`.
 pub fn tests_per_ray(scene: &Scene, sample: usize) -> usize {
@@ -180,6 +185,8 @@ struct Scratch<V> {
     sclose: Vec<bool>,
     /// Lanes the static filter certified.
     cert: Vec<bool>,
+    /// Blocks left to run without the static filter (see [`FILTER_REST`]).
+    filter_rest: u32,
     /// The f64 filter of the reference decision on a block's lanes (decisive, hit, t bound):
     /// filled when a lane of the block is not decisive (the lanes [`Setup::rti_lane`] reads).
     fdec: Vec<bool>,
@@ -212,6 +219,7 @@ impl<V: Copy + Default> Scratch<V> {
             sfar: f(),
             sclose: b(),
             cert: b(),
+            filter_rest: 0,
             fdec: b(),
             fhit: b(),
             fterr: f(),
@@ -363,17 +371,35 @@ where
         intersect_block(self.level, rq, self.faces, cols(&s.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
         let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
         // the static filter first: a lane its block constants certify gets the per-test
-        // bound's verdict without running it (datapath::bound_filter)
-        verdict_block_filtered(
-            Kernel::Avx512Fp16,
-            self.opts,
-            bray,
-            cols(&s.cols, n),
-            &mut s.dec[..n],
-            &mut s.ehit[..n],
-            &mut s.terr[..n],
-            &mut s.cert[..n],
-        );
+        // bound's verdict without running it (datapath::bound_filter); after a block where it
+        // certified few lanes (a coarse format: its constants grow with the block), the next
+        // FILTER_REST blocks go straight to the per-test bound — the same verdicts either way
+        if s.filter_rest > 0 {
+            s.filter_rest -= 1;
+            bound::verdict_block(
+                Kernel::Avx512Fp16,
+                self.opts,
+                bray,
+                cols(&s.cols, n),
+                &mut s.dec[..n],
+                &mut s.ehit[..n],
+                &mut s.terr[..n],
+            );
+        } else {
+            let k = verdict_block_filtered(
+                Kernel::Avx512Fp16,
+                self.opts,
+                bray,
+                cols(&s.cols, n),
+                &mut s.dec[..n],
+                &mut s.ehit[..n],
+                &mut s.terr[..n],
+                &mut s.cert[..n],
+            );
+            if k < n / 8 {
+                s.filter_rest = FILTER_REST;
+            }
+        }
         // the reference decision's f64 filter on the whole block when a lane is not decisive
         // (each lane's verdict is the scalar one: bound::verdict_block and the static filter
         // equal it lane by lane); rti_lane reads it for the lanes that are not decisive
