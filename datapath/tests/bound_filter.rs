@@ -218,3 +218,35 @@ fn only_a_quotient_overflows(o: BlockOpts, ray: BlockRay, cols: &[Vec<f64>; 9], 
     );
     b.overflow && !with.decisive && without.decisive && !without.hit
 }
+
+/// Blocks of 300 lanes, about half of them triangles the ray passes through or near (the per-test
+/// bound decides those) and half far beside it (certified), in every error model: the lanes
+/// left go through the per-test bound packed, several groups a block, and every lane still
+/// gets its own verdict.
+#[test]
+fn half_certified_blocks_get_the_per_test_verdict() {
+    let mut mixed = 0;
+    for seed in 0..24u64 {
+        for fmt in 0..6 {
+            let mut r = SplitMix64::new(seed ^ 0x5a5a);
+            let o = opts(&mut r, fmt, seed % 2 == 0, seed % 3 == 0);
+            let n = 300;
+            let ray = BlockRay { o: [0.1, -0.2, -3.0], d: [0.01, 0.02, 1.0], tmin: 0.0, tmax: f64::INFINITY };
+            let mut cols: [Vec<f64>; 9] = std::array::from_fn(|_| Vec::with_capacity(n));
+            for _ in 0..n {
+                let near = r.below(2) == 0;
+                let c =
+                    if near { [0.1, -0.2, r.range(-1.0, 1.0)] } else { [r.range(-2.0, 2.0), r.range(-2.0, 2.0), 0.0] };
+                let size = if near { r.range(0.001, 0.3) } else { 0.1 };
+                for p in 0..3 {
+                    for a in 0..3 {
+                        cols[3 * p + a].push(c[a] + size * r.range(-1.0, 1.0));
+                    }
+                }
+            }
+            let (k, _) = same(o, ray, &cols).unwrap();
+            mixed += (n / 4 <= k && n - k > n / 8 + 64) as usize;
+        }
+    }
+    assert!(mixed > 20, "only {mixed} blocks took the packed path with more than one group");
+}
