@@ -187,11 +187,17 @@ struct Scratch<V> {
     cert: Vec<bool>,
     /// Blocks left to run without the static filter (see [`FILTER_REST`]).
     filter_rest: u32,
-    /// The f64 filter of the reference decision on a block's lanes (decisive, hit, t bound):
-    /// filled when a lane of the block is not decisive (the lanes [`Setup::rti_lane`] reads).
+    /// The f64 filter of the reference decision (decisive, hit) at each lane that is not
+    /// decisive (the lanes [`Setup::rti_lane`] reads it for); other lanes hold stale values.
     fdec: Vec<bool>,
     fhit: Vec<bool>,
-    fterr: Vec<f64>,
+    /// The lanes that are not decisive, their nine quantised columns packed, and the f64
+    /// filter's verdicts on them (decisive, hit, t bound) before they are put back.
+    undec: Vec<u32>,
+    pcols: [Vec<f64>; 9],
+    pdec: Vec<bool>,
+    phit: Vec<bool>,
+    pterr: Vec<f64>,
     exact: Vec<u8>,
     prepared: Vec<datapath::slab::SlabRay<V>>,
     boxes: BoxesSoa<V>,
@@ -222,7 +228,11 @@ impl<V: Copy + Default> Scratch<V> {
             filter_rest: 0,
             fdec: b(),
             fhit: b(),
-            fterr: f(),
+            undec: Vec::with_capacity(BLOCK),
+            pcols: std::array::from_fn(|_| f()),
+            pdec: b(),
+            phit: b(),
+            pterr: f(),
             exact: vec![0; BLOCK],
             prepared: Vec::new(),
             boxes: BoxesSoa::default(),
@@ -400,20 +410,32 @@ where
                 s.filter_rest = FILTER_REST;
             }
         }
-        // the reference decision's f64 filter on the whole block when a lane is not decisive
-        // (each lane's verdict is the scalar one: bound::verdict_block and the static filter
-        // equal it lane by lane); rti_lane reads it for the lanes that are not decisive
-        if s.dec[..n].iter().any(|&d| !d) {
+        // the reference decision's f64 filter on the lanes that are not decisive, packed into
+        // columns of their own (each lane's verdict is the scalar one: bound::verdict_block
+        // and the static filter equal it lane by lane, wherever the lane sits); rti_lane reads
+        // it, put back at each lane, for those lanes
+        s.undec.clear();
+        s.undec.extend((0..n as u32).filter(|&k| !s.dec[k as usize]));
+        let m = s.undec.len();
+        if m > 0 {
+            for (pc, c) in s.pcols.iter_mut().zip(&s.cols) {
+                for (p, &k) in pc.iter_mut().zip(&s.undec) {
+                    *p = c[k as usize];
+                }
+            }
             verdict_block_filtered(
                 Kernel::Avx512Fp16,
                 self.fopts,
                 bray,
-                cols(&s.cols, n),
-                &mut s.fdec[..n],
-                &mut s.fhit[..n],
-                &mut s.fterr[..n],
-                &mut s.cert[..n],
+                cols(&s.pcols, m),
+                &mut s.pdec[..m],
+                &mut s.phit[..m],
+                &mut s.pterr[..m],
+                &mut s.cert[..m],
             );
+            for (j, &k) in s.undec.iter().enumerate() {
+                (s.fdec[k as usize], s.fhit[k as usize]) = (s.pdec[j], s.phit[j]);
+            }
         }
         for (w, len) in words(n) {
             let r = w..w + len;
