@@ -131,9 +131,10 @@ struct Variant<F: Format> {
 }
 
 /// One triangle's data as the blocks gather it, in one record (one random access per test):
-/// the model's stored triangle, the quantised triangle (the format's values in f64), the
-/// triangle's box in f64 and that box stored in the format (outward-rounded; the same for every
-/// variant). The fields a pass does not use hold defaults.
+/// the model's stored triangle, the triangle's box in f64 and that box stored in the format
+/// (outward-rounded; the same for every variant). The fields a pass does not use hold
+/// defaults. (The quantised triangle is converted from the model's, or kept in
+/// [`Setup::qs`].)
 #[derive(Clone, Copy)]
 struct Rec<V> {
     m: [V; 9],
@@ -150,9 +151,10 @@ struct Setup<'a, F: Format> {
     rti: Rti<F>,
     with_rti: bool,
     recs: Vec<Rec<F::V>>,
+    /// Per triangle the quantised triangle (the format's values in f64), where the format
+    /// does not convert a column at vector speed; empty where it does.
     qs: Vec<[f64; 9]>,
-    /// The quantised columns are converted from the model's ([`Format::fast_f64_column`]);
-    /// the records' `q` is then not read.
+    /// The quantised columns are converted from the model's ([`Format::fast_f64_column`]).
     q_from_m: bool,
     variants: Vec<Variant<F>>,
     opts: BlockOpts,
