@@ -379,7 +379,7 @@ where
                 }
             }
         }
-        acc.model_ns += self.clock.now() - t0;
+        acc.model_ns += self.clock.since(t0);
         intersect_block(self.level, rq, self.faces, cols(&s.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
         let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
         // the static filter first: a lane its block constants certify gets the per-test
@@ -564,7 +564,7 @@ where
         for ((v, sr), acc) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()) {
             let t0 = self.clock.now();
             simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
-            acc.model_ns += self.clock.now() - t0;
+            acc.model_ns += self.clock.since(t0);
             let c = &mut acc.counts;
             c.tests += n as u64;
             for (x, (w, len)) in words(n).enumerate() {

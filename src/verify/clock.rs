@@ -36,6 +36,13 @@ impl Clock {
         self.t0.elapsed().as_nanos() as u64
     }
 
+    /// Ticks from the reading `t0` to now (zero if the counter reads lower, as it may after the
+    /// thread moved to a core whose counter lags).
+    #[inline(always)]
+    pub fn since(&self, t0: u64) -> u64 {
+        self.now().saturating_sub(t0)
+    }
+
     /// `ticks` (a sum of reading differences) in nanoseconds: at the rate ticks advanced
     /// against the OS clock since the start (one tick per nanosecond without the counter).
     pub fn to_ns(&self, ticks: u64) -> u64 {
