@@ -310,73 +310,100 @@ pub fn verdict_block_filtered(
         return 0;
     }
     let k = certified.iter().filter(|&&c| c).count();
+    // a certified lane's verdict
+    let miss = (true, false, f64::INFINITY);
     if n - k > n / 8 && k < n / 4 {
         // most lanes left: the per-test bound on the whole block in vector registers, then the
         // certified lanes' verdicts put back (cheaper than the rest lane by lane)
         crate::bound::verdict_block(cap, opts, ray, tris, decisive, hit, t_err);
-        for i in 0..n {
-            if certified[i] {
-                (decisive[i], hit[i], t_err[i]) = (true, false, f64::INFINITY);
-            }
+        for i in (0..n).filter(|&i| certified[i]) {
+            (decisive[i], hit[i], t_err[i]) = miss;
         }
-        return k;
-    }
-    if n - k > n / 8 {
-        // many lanes left, many certified: the lanes left packed into vectors, a group at a
-        // time, through the per-test bound in vector registers, their verdicts put back
-        bound_packed(cap, opts, ray, tris, decisive, hit, t_err, certified);
-        return k;
-    }
-    for i in 0..n {
-        if certified[i] {
-            (decisive[i], hit[i], t_err[i]) = (true, false, f64::INFINITY);
-        } else {
-            (decisive[i], hit[i], t_err[i]) = crate::bound::lane(opts, ray, tris, i);
+    } else if n - k > n / 8 {
+        // many lanes left, many certified: the lanes left packed, a group at a time, through
+        // the per-test bound in vector registers; the certified ones get their verdict
+        packed(tris, certified, Some(miss), decisive, hit, t_err, |c, d, h, t| {
+            crate::bound::verdict_block(cap, opts, ray, c, d, h, t)
+        });
+    } else {
+        for i in 0..n {
+            (decisive[i], hit[i], t_err[i]) = if certified[i] { miss } else { crate::bound::lane(opts, ray, tris, i) };
         }
     }
     k
 }
 
-/// Lanes packed per group in [`bound_packed`].
-const PACK: usize = 64;
-
-/// The per-test bound's verdict on every lane not `certified` (+∞ `t_err`, decisive, no hit on
-/// the certified ones): the lanes left, in lane order, copied into groups of [`PACK`] lanes,
-/// each group through [`crate::bound::verdict_block`] (every lane's verdict is its own, so
-/// packing does not change it) and its verdicts written back to their lanes.
+/// [`verdict_block_filtered`] on the lanes `i` with `skip[i]` false only — their `decisive`,
+/// `hit` and `t_err` written, every other lane's left as it was — the lanes packed into groups
+/// of their own ([`packed`]: a lane's verdict does not depend on where it sits).
+///
+/// # Panics
+/// If the column lengths differ.
 #[allow(clippy::too_many_arguments)]
-fn bound_packed(
+pub fn verdict_lanes_filtered(
     cap: crate::simd::Kernel,
     opts: BlockOpts,
     ray: BlockRay,
     tris: [&[f64]; 9],
+    skip: &[bool],
     decisive: &mut [bool],
     hit: &mut [bool],
     t_err: &mut [f64],
-    certified: &[bool],
 ) {
-    let n = certified.len();
+    let mut certified = [false; PACK];
+    packed(tris, skip, None, decisive, hit, t_err, |c, d, h, t| {
+        verdict_block_filtered(cap, opts, ray, c, d, h, t, &mut certified[..d.len()]);
+    });
+}
+
+/// Lanes per group in [`packed`].
+const PACK: usize = 64;
+
+/// `verdict` (a per-lane verdict on columns: decisive, hit, t bound) on every lane `i` with
+/// `skip[i]` false: those lanes, in lane order, copied into groups of [`PACK`] lanes, each
+/// group's columns through `verdict`, its outputs written back to their lanes; a skipped
+/// lane's outputs get `fill` (not written when `fill` is `None`).
+///
+/// # Panics
+/// If the column lengths differ.
+fn packed(
+    tris: [&[f64]; 9],
+    skip: &[bool],
+    fill: Option<(bool, bool, f64)>,
+    decisive: &mut [bool],
+    hit: &mut [bool],
+    t_err: &mut [f64],
+    mut verdict: impl FnMut([&[f64]; 9], &mut [bool], &mut [bool], &mut [f64]),
+) {
+    let n = skip.len();
+    assert!(
+        decisive.len() == n && hit.len() == n && t_err.len() == n && tris.iter().all(|c| c.len() == n),
+        "column lengths differ"
+    );
     let mut cols = [[0.0f64; PACK]; 9];
     let (mut dec, mut hi, mut te) = ([false; PACK], [false; PACK], [0.0f64; PACK]);
     let mut lanes = [0usize; PACK];
     let mut i = 0;
     while i < n {
-        // the next group: up to PACK lanes left
+        // the next group: up to PACK lanes not skipped
         let mut m = 0;
         while i < n && m < PACK {
-            if certified[i] {
-                (decisive[i], hit[i], t_err[i]) = (true, false, f64::INFINITY);
-            } else {
+            if !skip[i] {
                 for (c, col) in cols.iter_mut().enumerate() {
                     col[m] = tris[c][i];
                 }
                 lanes[m] = i;
                 m += 1;
+            } else if let Some(v) = fill {
+                (decisive[i], hit[i], t_err[i]) = v;
             }
             i += 1;
         }
+        if m == 0 {
+            break;
+        }
         let c: [&[f64]; 9] = std::array::from_fn(|k| &cols[k][..m]);
-        crate::bound::verdict_block(cap, opts, ray, c, &mut dec[..m], &mut hi[..m], &mut te[..m]);
+        verdict(c, &mut dec[..m], &mut hi[..m], &mut te[..m]);
         for (j, &l) in lanes[..m].iter().enumerate() {
             (decisive[l], hit[l], t_err[l]) = (dec[j], hi[j], te[j]);
         }

@@ -250,3 +250,39 @@ fn half_certified_blocks_get_the_per_test_verdict() {
     }
     assert!(mixed > 20, "only {mixed} blocks took the packed path with more than one group");
 }
+
+/// `verdict_lanes_filtered` writes each lane not skipped with its per-test verdict (decisive and
+/// hit always, the t bound where the filter did not certify it: +∞ there) and leaves every
+/// skipped lane as it was, on edge blocks of up to 200 lanes (several groups) with random skips.
+#[test]
+fn lanes_filtered_write_exactly_the_lanes_not_skipped() {
+    use datapath::bound_filter::verdict_lanes_filtered;
+    let mut written = 0;
+    for seed in 0..200u64 {
+        let mut r = SplitMix64::new(seed ^ 0x1a9e);
+        let o = opts(&mut r, (seed % 6) as usize, seed % 2 == 0, seed % 3 == 0);
+        let n = r.below(200) as usize;
+        let ray = BlockRay { o: [0.1, -0.2, -3.0], d: [0.01, 0.02, 1.0], tmin: 0.0, tmax: f64::INFINITY };
+        let cols: [Vec<f64>; 9] =
+            std::array::from_fn(|_| (0..n).map(|_| edge(&mut r, o.em.max, seed % 4 != 0)).collect());
+        let c: [&[f64]; 9] = std::array::from_fn(|k| &cols[k][..]);
+        let skip: Vec<bool> = (0..n).map(|_| r.below(3) == 0).collect();
+        for k in kernels_here() {
+            let (mut dec, mut hit, mut te) = (vec![false; n], vec![false; n], vec![0.0; n]);
+            verdict_block(k, o, ray, c, &mut dec, &mut hit, &mut te);
+            let (mut fdec, mut fhit, mut fte) = (vec![true; n], vec![true; n], vec![-7.0; n]);
+            verdict_lanes_filtered(k, o, ray, c, &skip, &mut fdec, &mut fhit, &mut fte);
+            for i in 0..n {
+                if skip[i] {
+                    assert!(fdec[i] && fhit[i] && fte[i] == -7.0, "{k:?} seed {seed}: skipped lane {i} written");
+                } else {
+                    assert_eq!((fdec[i], fhit[i]), (dec[i], hit[i]), "{k:?} seed {seed} lane {i}");
+                    let same = fte[i].to_bits() == te[i].to_bits() || (fte[i].is_nan() && te[i].is_nan());
+                    assert!(same || (fte[i] == f64::INFINITY && dec[i] && !hit[i]), "{k:?} seed {seed} lane {i}");
+                    written += 1;
+                }
+            }
+        }
+    }
+    assert!(written > 10_000, "only {written} lanes written");
+}

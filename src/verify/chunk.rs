@@ -24,7 +24,7 @@ use super::counts::{RtiCounts, SlabCounts};
 use super::{FormatReport, SlabReport, VerifyConfig};
 use crate::scene::Scene;
 use datapath::bound::{self, BlockOpts, BlockRay};
-use datapath::bound_filter::verdict_block_filtered;
+use datapath::bound_filter::{verdict_block_filtered, verdict_lanes_filtered};
 use datapath::rng::SplitMix64;
 use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
 use datapath::simd::gather::gather;
@@ -189,17 +189,11 @@ struct Scratch<V> {
     cert: Vec<bool>,
     /// Blocks left to run without the static filter (see [`FILTER_REST`]).
     filter_rest: u32,
-    /// The f64 filter of the reference decision (decisive, hit) at each lane that is not
-    /// decisive (the lanes [`Setup::rti_lane`] reads it for); other lanes hold stale values.
+    /// The f64 filter of the reference decision (decisive, hit, t bound) at each lane that is
+    /// not decisive (the lanes [`Setup::rti_lane`] reads it for); other lanes hold stale values.
     fdec: Vec<bool>,
     fhit: Vec<bool>,
-    /// The lanes that are not decisive, their nine quantised columns packed, and the f64
-    /// filter's verdicts on them (decisive, hit, t bound) before they are put back.
-    undec: Vec<u32>,
-    pcols: [Vec<f64>; 9],
-    pdec: Vec<bool>,
-    phit: Vec<bool>,
-    pterr: Vec<f64>,
+    fterr: Vec<f64>,
     exact: Vec<u8>,
     prepared: Vec<datapath::slab::SlabRay<V>>,
     boxes: BoxesSoa<V>,
@@ -230,11 +224,7 @@ impl<V: Copy + Default> Scratch<V> {
             filter_rest: 0,
             fdec: b(),
             fhit: b(),
-            undec: Vec::with_capacity(BLOCK),
-            pcols: std::array::from_fn(|_| f()),
-            pdec: b(),
-            phit: b(),
-            pterr: f(),
+            fterr: f(),
             exact: vec![0; BLOCK],
             prepared: Vec::new(),
             boxes: BoxesSoa::default(),
@@ -412,33 +402,18 @@ where
                 s.filter_rest = FILTER_REST;
             }
         }
-        // the reference decision's f64 filter on the lanes that are not decisive, packed into
-        // columns of their own (each lane's verdict is the scalar one: bound::verdict_block
-        // and the static filter equal it lane by lane, wherever the lane sits); rti_lane reads
-        // it, put back at each lane, for those lanes
-        s.undec.clear();
-        s.undec.extend((0..n as u32).filter(|&k| !s.dec[k as usize]));
-        let m = s.undec.len();
-        if m > 0 {
-            for (pc, c) in s.pcols.iter_mut().zip(&s.cols) {
-                for (p, &k) in pc.iter_mut().zip(&s.undec) {
-                    *p = c[k as usize];
-                }
-            }
-            verdict_block_filtered(
-                Kernel::Avx512Fp16,
-                self.fopts,
-                bray,
-                cols(&s.pcols, m),
-                &mut s.pdec[..m],
-                &mut s.phit[..m],
-                &mut s.pterr[..m],
-                &mut s.cert[..m],
-            );
-            for (j, &k) in s.undec.iter().enumerate() {
-                (s.fdec[k as usize], s.fhit[k as usize]) = (s.pdec[j], s.phit[j]);
-            }
-        }
+        // the reference decision's f64 filter on the lanes that are not decisive, packed (each
+        // lane's verdict is the scalar one wherever it sits); rti_lane reads it for those lanes
+        verdict_lanes_filtered(
+            Kernel::Avx512Fp16,
+            self.fopts,
+            bray,
+            cols(&s.cols, n),
+            &s.dec[..n],
+            &mut s.fdec[..n],
+            &mut s.fhit[..n],
+            &mut s.fterr[..n],
+        );
         for (w, len) in words(n) {
             let r = w..w + len;
             let (dec, mhit, ehit, valid) =
@@ -799,17 +774,16 @@ where
             Variant { name, conservative: sc.is_conservative(f), slab: Slab::new(*f, sc) }
         })
         .collect();
-    let q_from_m = f.fast_f64_column();
-    let (recs, qs): (Vec<_>, Vec<_>) = scene
+    let recs = scene
         .tris
         .iter()
         .map(|t| {
             let b = tri_box(&t.v);
-            let (m, q) = if with_rti {
+            let m = if with_rti {
                 let m = rti.tri(t.v).v;
-                (std::array::from_fn(|k| m[k / 3][k % 3]), std::array::from_fn(|k| q(t.v[k / 3][k % 3])))
+                std::array::from_fn(|k| m[k / 3][k % 3])
             } else {
-                ([F::V::default(); 9], [0.0; 9])
+                [F::V::default(); 9]
             };
             // box storage does not depend on the variant
             let s = match variants.first() {
@@ -820,11 +794,16 @@ where
                 }
                 None => [F::V::default(); 6],
             };
-            (Rec { m, b, s }, q)
+            Rec { m, b, s }
         })
-        .unzip();
-    // the quantised triangles are kept only where they are not converted from the model's
-    let qs = if q_from_m { Vec::new() } else { qs };
+        .collect();
+    // the quantised triangles, kept only where they are not converted from the model's
+    let q_from_m = f.fast_f64_column();
+    let qs: Vec<[f64; 9]> = if with_rti && !q_from_m {
+        scene.tris.iter().map(|t| std::array::from_fn(|k| q(t.v[k / 3][k % 3]))).collect()
+    } else {
+        Vec::new()
+    };
     let setup = Setup {
         cfg,
         scene,
