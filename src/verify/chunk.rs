@@ -14,8 +14,9 @@
 //!    rule [`crate::judge::violation`]; the min-capture unit and the golden
 //!    closest hit run along the ray's blocks;
 //! 5. slab: the boxes of the same triangles through every variant's batch path, against the
-//!    f64 slab test in lanes ([`golden::block::slab_block`], shared by the variants) and the
-//!    exact rational decision where f64 cannot decide (near the boundary or disagreeing).
+//!    f64 slab test's decision in lanes ([`golden::block::slab_block_flags`], shared by the
+//!    variants) and the exact rational decision where f64 cannot decide (an interval within
+//!    [`CLOSE_REL`] of empty, or the model disagreeing).
 //!
 //! The chunk's accumulators are merged by the engine; nothing else outlives the chunk.
 
@@ -33,12 +34,16 @@ use datapath::simd::{self, Kernel};
 use datapath::slab::{BoxesSoa, Slab, SlabConfig, SlabOutSoa};
 use datapath::Format;
 use engine::{First, Hist, Merge, Progress};
-use golden::block::{intersect_block, slab_block, Level};
+use golden::block::{intersect_block, slab_block_flags, Level};
 use golden::{Ray64, Tri64};
 use std::time::Instant;
 
 /// Stream number of the per-ray test lists in [`SplitMix64::for_item`].
 pub const LIST_STREAM: u64 = 0x7e57;
+
+/// How close to empty (relative, [`golden::block::slab_block_flags`]) a golden f64 slab
+/// interval may be before the exact decision settles the lane.
+pub const CLOSE_REL: f64 = 1e-9;
 
 /// Tests per block: the columns of one block (15 model columns, 9 + 6 f64 columns, outputs)
 /// stay in L1/L2 while the model, golden and bound read them.
@@ -181,9 +186,7 @@ struct Scratch<V> {
     terr: Vec<f64>,
     bcols: [Vec<f64>; 6],
     shit: Vec<bool>,
-    snear: Vec<f64>,
-    sfar: Vec<f64>,
-    /// Lanes whose golden f64 interval is within 1e-9 (relative) of empty: exact decides.
+    /// Lanes whose golden f64 interval is within [`CLOSE_REL`] of empty: exact decides.
     sclose: Vec<bool>,
     /// Lanes the static filter certified.
     cert: Vec<bool>,
@@ -217,8 +220,6 @@ impl<V: Copy + Default> Scratch<V> {
             terr: f(),
             bcols: std::array::from_fn(|_| f()),
             shit: b(),
-            snear: f(),
-            sfar: f(),
             sclose: b(),
             cert: b(),
             filter_rest: 0,
@@ -508,29 +509,26 @@ where
     ) {
         let n = blk.len();
         gather(Kernel::Avx512Fp16, &self.recs, blk, !self.with_rti, |r| &r.b, s.bcols.each_mut().map(|x| &mut x[..]));
-        slab_block(
+        // the golden hit, and whether the golden interval is too close to empty to trust
+        // (|far − near| ≤ 1e-9 · max(1, |near|, |far| if finite)), once for all variants
+        slab_block_flags(
             self.level,
             rq.o,
             rq.d,
             rq.tmin,
             rq.tmax,
             cols(&s.bcols, n),
+            CLOSE_REL,
             &mut s.shit[..n],
-            &mut s.snear[..n],
-            &mut s.sfar[..n],
+            &mut s.sclose[..n],
         );
         // the stored boxes, gathered once for every variant
         {
             let ([a, b, c], [d, e, f]) = (&mut s.boxes.min, &mut s.boxes.max);
             gather(Kernel::Avx512Fp16, &self.recs, blk, false, |r| &r.s, [a, b, c, d, e, f].map(|x| &mut x[..]));
         }
-        // the exact decision of each lane, computed at most once for all variants (0: not yet);
-        // whether the golden interval is too close to empty to trust, once for all variants
+        // the exact decision of each lane, computed at most once for all variants (0: not yet)
         s.exact[..n].fill(0);
-        for ((close, &near), &far) in s.sclose[..n].iter_mut().zip(&s.snear[..n]).zip(&s.sfar[..n]) {
-            let scale = 1.0f64.max(near.abs()).max(if far.is_finite() { far.abs() } else { 0.0 });
-            *close = (far - near).abs() <= 1e-9 * scale;
-        }
         // the golden hits and the close lanes as bit masks, word by word, once for all variants
         let (mut gw, mut cw) = ([0u64; BLOCK / 64], [0u64; BLOCK / 64]);
         for (x, (w, len)) in words(n).enumerate() {
