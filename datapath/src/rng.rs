@@ -1,6 +1,17 @@
 //! SplitMix64: the small seeded generator every random stream of raypipe uses, so that a seed
 //! reproduces a run exactly on any machine.
 
+/// What the state advances by per draw (SplitMix64's golden-ratio increment).
+pub const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// SplitMix64's output function of a state.
+#[inline(always)]
+pub const fn mix(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
 /// SplitMix64 (Steele, Lea, Flood 2014).
 #[derive(Clone, Debug)]
 pub struct SplitMix64(u64);
@@ -20,13 +31,18 @@ impl SplitMix64 {
         r.next_u64();
         r
     }
-    /// Next 64 random bits.
+    /// Next 64 random bits: the state advanced by [`GAMMA`], then [`mix`]ed.
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        self.0 = self.0.wrapping_add(GAMMA);
+        mix(self.0)
+    }
+    /// The state: draw k from here (k = 1, 2, …) is `mix(state + k · GAMMA)`.
+    pub fn state(&self) -> u64 {
+        self.0
+    }
+    /// Moves on as `k` draws would.
+    pub fn skip(&mut self, k: u64) {
+        self.0 = self.0.wrapping_add(k.wrapping_mul(GAMMA));
     }
     /// Uniform in [0, 1) with 53 random bits.
     pub fn unit(&mut self) -> f64 {

@@ -1372,3 +1372,79 @@ mod gather {
         }
     }
 }
+
+mod draw {
+    use datapath::rng::SplitMix64;
+    use datapath::simd::draw::below_column;
+    use datapath::simd::{kernels_here, with_kernel_cap};
+
+    /// A column of draws equals the same draws taken one by one (every length up to 70, bounds
+    /// from 1 to u32::MAX, states anywhere), and leaves the generator where they leave it.
+    #[test]
+    fn a_column_of_draws_equals_the_draws_one_by_one() {
+        let mut g = SplitMix64::new(99);
+        for round in 0..3000 {
+            let n = match round % 5 {
+                0 => 1,
+                1 => u64::from(u32::MAX),
+                2 => 1 + g.below(10),
+                _ => 1 + g.below(u64::from(u32::MAX)),
+            };
+            let len = (round % 71) as usize;
+            let seed = g.next_u64();
+            let mut one = SplitMix64::new(seed);
+            let want: Vec<u32> = (0..len).map(|_| one.below(n) as u32).collect();
+            let after = one.next_u64();
+            for k in kernels_here() {
+                let mut r = SplitMix64::new(seed);
+                let mut got = vec![7u32; len];
+                with_kernel_cap(k, || below_column(k, &mut r, n, &mut got));
+                assert_eq!(got, want, "{k:?} n {n} len {len}");
+                assert_eq!(r.next_u64(), after, "{k:?}: the generator left elsewhere");
+            }
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "below_column")]
+    fn a_bound_above_u32_is_refused() {
+        below_column(datapath::simd::Kernel::Scalar, &mut SplitMix64::new(1), 1 << 32, &mut [0; 3]);
+    }
+}
+
+mod widen {
+    use datapath::rng::SplitMix64;
+    use datapath::simd::widen::f32_to_f64;
+    use datapath::simd::{kernels_here, with_kernel_cap};
+
+    /// Every binary32 class (zeros, subnormals, normals, infinities, NaNs) widens to the
+    /// one-value cast's f64 on every kernel, at every length up to 100.
+    #[test]
+    fn a_widened_column_equals_the_cast_of_each_value() {
+        let mut g = SplitMix64::new(5);
+        let specials =
+            [0u32, 0x8000_0000, 1, 0x807f_ffff, 0x0080_0000, 0x7f7f_ffff, 0x7f80_0000, 0xff80_0000, 0x7fc0_0000];
+        for len in 0..100 {
+            let src: Vec<f32> = (0..len)
+                .map(|i| {
+                    if i % 3 == 0 {
+                        f32::from_bits(specials[g.below(9) as usize])
+                    } else {
+                        f32::from_bits(g.next_u64() as u32)
+                    }
+                })
+                .collect();
+            for k in kernels_here() {
+                let mut dst = vec![0.5; len];
+                with_kernel_cap(k, || f32_to_f64(k, &src, &mut dst));
+                for (i, (&x, &y)) in src.iter().zip(&dst).enumerate() {
+                    let want = x as f64;
+                    assert!(
+                        y.to_bits() == want.to_bits() || (y.is_nan() && want.is_nan()),
+                        "{k:?} lane {i}: {x:?} -> {y:?}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -28,6 +28,7 @@ use datapath::bound::{self, BlockOpts, BlockRay};
 use datapath::bound_filter::{verdict_block_filtered, verdict_lanes_filtered};
 use datapath::rng::SplitMix64;
 use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
+use datapath::simd::draw::below_column;
 use datapath::simd::gather::gather;
 use datapath::simd::mask::{bits, ones, words};
 use datapath::simd::{self, Kernel};
@@ -70,7 +71,8 @@ pub fn test_list(n: usize, sample: usize, seed: u64, i: u64, target: usize, out:
     }
     out.push(target as u32);
     let mut r = SplitMix64::for_item(seed, LIST_STREAM, i);
-    out.extend((1..sample).map(|_| r.below(n as u64) as u32));
+    out.resize(sample, 0);
+    below_column(Kernel::Avx512Fp16, &mut r, n as u64, &mut out[1..]);
 }
 
 /// The `explain` command line of one test, in the scene's normalised coordinates (with

@@ -108,9 +108,14 @@ impl IeeeBackend for F32Native {
     fn to_f64(&self, v: f32) -> f64 {
         v as f64
     }
+    #[inline]
+    fn to_f64_column(&self, src: &[f32], dst: &mut [f64]) {
+        // the same `as f64` on the widest lanes the machine has
+        crate::simd::widen::f32_to_f64(crate::simd::Kernel::Avx512Fp16, src, dst)
+    }
     #[inline(always)]
     fn fast_f64_column(&self) -> bool {
-        true // a widening conversion the compiler vectorises
+        true
     }
     #[inline(always)]
     fn lt(&self, a: f32, b: f32) -> bool {

@@ -43,6 +43,7 @@
 //! ones, on an emulated machine with both (`emu/avx512`, Bochs 3.0) when the host has neither.
 
 mod batch;
+pub mod draw;
 mod entries;
 pub mod fixed;
 pub mod gather;
@@ -54,6 +55,7 @@ pub mod mask;
 mod select;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests;
+pub mod widen;
 
 pub use batch::*;
 pub use entries::*;

@@ -1,0 +1,62 @@
+//! Random draws in lanes: a run of [`SplitMix64::below`] draws written to a column at once,
+//! the same numbers in the same order as drawing them one by one. SplitMix64's state moves by
+//! a constant per draw, so draw k is `mix(state + k · GAMMA)` whatever came before it, and
+//! the lanes are independent (AVX-512F + DQ: 8 lanes, AVX2: 4, else the compiler's baseline).
+
+use super::select::best_kernel;
+use super::Kernel;
+use crate::rng::{mix, SplitMix64, GAMMA};
+
+/// `out[k] = r.below(n)` for k = 0, 1, … in turn (and `r` moved on as those draws move it),
+/// on the widest lanes `cap`, the thread's cap and the machine allow.
+///
+/// # Panics
+/// If `n` is 0 or above `u32::MAX` (the draws are `u32` indices).
+pub fn below_column(cap: Kernel, r: &mut SplitMix64, n: u64, out: &mut [u32]) {
+    assert!(n > 0 && n <= u64::from(u32::MAX), "below_column: n = {n} is not in 1..=u32::MAX");
+    let s = r.state();
+    let k = best_kernel(true, cap);
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::is_x86_feature_detected as has;
+        if k >= Kernel::Avx512 && has!("avx512f") && has!("avx512dq") {
+            // SAFETY: AVX-512F and DQ are present (checked above)
+            unsafe { avx512(s, n, out) };
+        } else if k >= Kernel::Avx2 && has!("avx2") {
+            // SAFETY: AVX2 is present (checked above)
+            unsafe { avx2(s, n, out) };
+        } else {
+            body(s, n, out);
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = k;
+        body(s, n, out);
+    }
+    r.skip(out.len() as u64);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq")]
+fn avx512(s: u64, n: u64, out: &mut [u32]) {
+    body(s, n, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn avx2(s: u64, n: u64, out: &mut [u32]) {
+    body(s, n, out)
+}
+
+/// Draw k + 1 from state `s` into `out[k]`: ⌊x · n / 2^64⌋ of x = `mix(s + (k + 1) · GAMMA)`,
+/// taken in 32-bit halves (n < 2^32): ⌊(x_hi · n + ⌊x_lo · n / 2^32⌋) / 2^32⌋, which is the
+/// same integer (the dropped fraction is below 1) and never overflows 64 bits.
+#[inline(always)]
+fn body(s: u64, n: u64, out: &mut [u32]) {
+    for (k, o) in out.iter_mut().enumerate() {
+        let x = mix(s.wrapping_add((k as u64 + 1).wrapping_mul(GAMMA)));
+        let (hi, lo) = (x >> 32, x & 0xffff_ffff);
+        *o = ((hi * n + ((lo * n) >> 32)) >> 32) as u32;
+    }
+}
