@@ -8,11 +8,14 @@
 //!    (the format's values in f64) into nine f64 columns — converted from the model's columns
 //!    where the format converts a column at vector speed, else gathered;
 //! 2. model: the fastest bit-identical batch path ([`datapath::simd::rti_batch`]);
-//! 3. golden: Möller–Trumbore in f64 lanes ([`golden::block::intersect_block`]) and the error
-//!    bound in f64 lanes ([`datapath::bound::verdict_block`]), each equal to its scalar code;
-//! 4. judge: per lane the counts, the t-error histograms and the first violation, by the one
-//!    rule [`crate::judge::violation`]; the min-capture unit and the golden
-//!    closest hit run along the ray's blocks;
+//! 3. bound: the error bound in f64 lanes ([`datapath::bound::verdict_block`], the static
+//!    filter first), equal to its scalar code: per lane decisive or not, and the exact decision;
+//! 4. judge: a lane that is a decisive miss of both the model and the bound only counts (as a
+//!    test, decisive, and a skipped divide when it is one); every other lane gets the golden
+//!    Möller–Trumbore ([`golden::block::intersect_block`], equal to [`golden::intersect`]'s hit
+//!    and t; no counted-only lane reads it) and is judged: the counts, the t-error histograms
+//!    and the first violation, by the one rule [`crate::judge::violation`]; the min-capture
+//!    unit and the golden closest hit run along the ray's blocks;
 //! 5. slab: the boxes of the same triangles through every variant's batch path, against the
 //!    f64 slab test's decision in lanes ([`golden::block::slab_block_flags`], shared by the
 //!    variants) and the exact rational decision where f64 cannot decide (an interval within
@@ -305,8 +308,8 @@ where
         explain_cmd(&self.name, ray, tri, self.scene.scale, self.cfg.inject.map(|x| x.name))
     }
 
-    /// One block of a ray's RTI tests: gather, model, golden, bound (static filter first), then
-    /// the judge. A lane that is decisive with neither the model nor the bound's exact decision
+    /// One block of a ray's RTI tests: gather, model, bound (static filter first), then the
+    /// golden on the lanes judged one by one, and the judge. A lane that is decisive with neither the model nor the bound's exact decision
     /// hitting (most lanes) only counts as a test, a decisive test and, when the model's divide
     /// was skipped, a skipped divide (it has no disagreement, no violation — `judge::violation`
     /// of such a lane is `None` — no shared hit, and neither the capture unit nor the golden
@@ -373,7 +376,6 @@ where
             }
         }
         acc.model_ns += self.clock.since(t0);
-        intersect_block(self.level, rq, self.faces, cols(&s.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
         let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
         // the static filter first: a lane its block constants certify gets the per-test
         // bound's verdict without running it (datapath::bound_filter); after a block where it
@@ -417,16 +419,39 @@ where
             &mut s.fhit[..n],
             &mut s.fterr[..n],
         );
-        for (w, len) in words(n) {
+        // the lanes judged one by one: all but the decisive misses of both the model and the
+        // bound's exact decision (those only count)
+        let mut judged = [0u64; BLOCK / 64];
+        let mut k = 0;
+        for (x, (w, len)) in words(n).enumerate() {
             let r = w..w + len;
-            let (dec, mhit, ehit, valid) =
-                (bits(&s.dec[r.clone()]), bits(&s.out.hit[r.clone()]), bits(&s.ehit[r.clone()]), bits(&s.out.valid[r]));
+            let (dec, mhit, ehit) = (bits(&s.dec[r.clone()]), bits(&s.out.hit[r.clone()]), bits(&s.ehit[r]));
+            judged[x] = (u64::MAX >> (64 - len)) & !(dec & !mhit & !ehit);
+            k += judged[x].count_ones() as usize;
+        }
+        // the golden Möller–Trumbore on the judged lanes only: no other lane reads it (its
+        // reference is the bound's decisive miss, its t is never compared); the whole block
+        // in lanes when many are judged, else lane by lane (the same function on one lane)
+        if k > n / 8 {
+            intersect_block(self.level, rq, self.faces, cols(&s.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
+        } else {
+            for (x, (w, _)) in words(n).enumerate() {
+                for j in ones(judged[x]) {
+                    let i = w + j;
+                    let c: [&[f64]; 9] = std::array::from_fn(|c| &s.cols[c][i..i + 1]);
+                    intersect_block(self.level, rq, self.faces, c, &mut s.ghit[i..i + 1], &mut s.gt[i..i + 1]);
+                }
+            }
+        }
+        for (x, (w, len)) in words(n).enumerate() {
+            let r = w..w + len;
+            let (dec, valid) = (bits(&s.dec[r.clone()]), bits(&s.out.valid[r]));
             let all = u64::MAX >> (64 - len);
             let c = &mut acc.counts;
             c.tests += len as u64;
             c.decisive += u64::from(dec.count_ones());
             c.divide_skipped += u64::from((all & !valid).count_ones());
-            for j in ones(all & !(dec & !mhit & !ehit)) {
+            for j in ones(judged[x]) {
                 self.rti_lane(s, acc, ray, rq, blk, base, w + j, ray_index, cap, gbest);
             }
         }
