@@ -309,11 +309,12 @@ where
     }
 
     /// One block of a ray's RTI tests: gather, model, bound (static filter first), then the
-    /// golden on the lanes judged one by one, and the judge. A lane that is decisive with neither the model nor the bound's exact decision
-    /// hitting (most lanes) only counts as a test, a decisive test and, when the model's divide
-    /// was skipped, a skipped divide (it has no disagreement, no violation — `judge::violation`
-    /// of such a lane is `None` — no shared hit, and neither the capture unit nor the golden
-    /// closest hit takes it); those counts are taken on bit masks, every other lane is judged
+    /// golden on the lanes judged one by one, and the judge. A lane that is decisive with
+    /// neither the model nor the bound's exact decision hitting (most lanes) only counts as a
+    /// test, a decisive test and, when the model's divide was skipped, a skipped divide (it
+    /// has no disagreement, no violation — `judge::violation` of such a lane is `None` — no
+    /// shared hit, and neither the capture unit nor the golden closest hit takes it, nor reads
+    /// the golden's hit or t); those counts are taken on bit masks, every other lane is judged
     /// one by one in lane order.
     #[allow(clippy::too_many_arguments)]
     fn rti_block(
