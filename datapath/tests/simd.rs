@@ -1414,7 +1414,7 @@ mod draw {
 
 mod widen {
     use datapath::rng::SplitMix64;
-    use datapath::simd::widen::f32_to_f64;
+    use datapath::simd::widen::{bf16_to_f64, f32_to_f64};
     use datapath::simd::{kernels_here, with_kernel_cap};
 
     /// Every binary32 class (zeros, subnormals, normals, infinities, NaNs) widens to the
@@ -1443,6 +1443,23 @@ mod widen {
                         y.to_bits() == want.to_bits() || (y.is_nan() && want.is_nan()),
                         "{k:?} lane {i}: {x:?} -> {y:?}"
                     );
+                }
+            }
+        }
+    }
+
+    /// Every bfloat16 encoding widens to its binary32 value's f64 (the encoding shifted into
+    /// binary32's upper half) on every kernel, whole and at ragged lengths.
+    #[test]
+    fn every_bfloat16_encoding_widens_to_its_value() {
+        let src: Vec<u16> = (0..=u16::MAX).collect();
+        for k in kernels_here() {
+            for len in [src.len(), 0, 1, 7, 8, 9, 17, 1000] {
+                let mut dst = vec![0.5; len];
+                with_kernel_cap(k, || bf16_to_f64(k, &src[..len], &mut dst));
+                for (&x, &y) in src.iter().zip(&dst) {
+                    let want = f32::from_bits(u32::from(x) << 16) as f64;
+                    assert!(y.to_bits() == want.to_bits() || (y.is_nan() && want.is_nan()), "{k:?} {x:#06x} -> {y:?}");
                 }
             }
         }

@@ -247,9 +247,14 @@ impl IeeeBackend for Bf16 {
     fn to_f64(&self, v: u16) -> f64 {
         Self::wide(v) as f64
     }
+    #[inline]
+    fn to_f64_column(&self, src: &[u16], dst: &mut [f64]) {
+        // the same shift and widening on the widest lanes the machine has
+        crate::simd::widen::bf16_to_f64(crate::simd::Kernel::Avx512Fp16, src, dst)
+    }
     #[inline(always)]
     fn fast_f64_column(&self) -> bool {
-        true // a shift and a widening conversion the compiler vectorises
+        true
     }
     #[inline(always)]
     fn lt(&self, a: u16, b: u16) -> bool {
