@@ -420,14 +420,20 @@ where
             &mut s.fhit[..n],
             &mut s.fterr[..n],
         );
-        // the lanes judged one by one: all but the decisive misses of both the model and the
-        // bound's exact decision (those only count)
+        // every lane's counts on masks, and the lanes judged one by one: all but the decisive
+        // misses of both the model and the bound's exact decision (those only count)
         let mut judged = [0u64; BLOCK / 64];
         let mut k = 0;
         for (x, (w, len)) in words(n).enumerate() {
             let r = w..w + len;
-            let (dec, mhit, ehit) = (bits(&s.dec[r.clone()]), bits(&s.out.hit[r.clone()]), bits(&s.ehit[r]));
-            judged[x] = (u64::MAX >> (64 - len)) & !(dec & !mhit & !ehit);
+            let (dec, mhit, ehit, valid) =
+                (bits(&s.dec[r.clone()]), bits(&s.out.hit[r.clone()]), bits(&s.ehit[r.clone()]), bits(&s.out.valid[r]));
+            let all = u64::MAX >> (64 - len);
+            let c = &mut acc.counts;
+            c.tests += len as u64;
+            c.decisive += u64::from(dec.count_ones());
+            c.divide_skipped += u64::from((all & !valid).count_ones());
+            judged[x] = all & !(dec & !mhit & !ehit);
             k += judged[x].count_ones() as usize;
         }
         // the golden Möller–Trumbore on the judged lanes only: no other lane reads it (its
@@ -444,14 +450,7 @@ where
                 }
             }
         }
-        for (x, (w, len)) in words(n).enumerate() {
-            let r = w..w + len;
-            let (dec, valid) = (bits(&s.dec[r.clone()]), bits(&s.out.valid[r]));
-            let all = u64::MAX >> (64 - len);
-            let c = &mut acc.counts;
-            c.tests += len as u64;
-            c.decisive += u64::from(dec.count_ones());
-            c.divide_skipped += u64::from((all & !valid).count_ones());
+        for (x, (w, _)) in words(n).enumerate() {
             for j in ones(judged[x]) {
                 self.rti_lane(s, acc, ray, rq, blk, base, w + j, ray_index, cap, gbest);
             }

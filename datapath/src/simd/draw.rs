@@ -3,8 +3,7 @@
 //! a constant per draw, so draw k is `mix(state + k · GAMMA)` whatever came before it, and
 //! the lanes are independent (AVX-512F + DQ: 8 lanes, AVX2: 4, else the compiler's baseline).
 
-use super::select::best_kernel;
-use super::Kernel;
+use super::{f64_lanes, F64Lanes, Kernel};
 use crate::rng::{mix, SplitMix64, GAMMA};
 
 /// `out[k] = r.below(n)` for k = 0, 1, … in turn (and `r` moved on as those draws move it),
@@ -15,24 +14,17 @@ use crate::rng::{mix, SplitMix64, GAMMA};
 pub fn below_column(cap: Kernel, r: &mut SplitMix64, n: u64, out: &mut [u32]) {
     assert!(n > 0 && n <= u64::from(u32::MAX), "below_column: n = {n} is not in 1..=u32::MAX");
     let s = r.state();
-    let k = best_kernel(true, cap);
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::is_x86_feature_detected as has;
-        if k >= Kernel::Avx512 && has!("avx512f") && has!("avx512dq") {
-            // SAFETY: AVX-512F and DQ are present (checked above)
-            unsafe { avx512(s, n, out) };
-        } else if k >= Kernel::Avx2 && has!("avx2") {
-            // SAFETY: AVX2 is present (checked above)
-            unsafe { avx2(s, n, out) };
-        } else {
-            body(s, n, out);
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        let _ = k;
-        body(s, n, out);
+    match f64_lanes(cap) {
+        // SAFETY: AVX-512F and DQ are present (f64_lanes detected F, DQ checked here)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 if std::arch::is_x86_feature_detected!("avx512dq") => unsafe { avx512(s, n, out) },
+        // SAFETY: AVX2 is present (f64_lanes detected it, or checked here under AVX-512F)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx2 => unsafe { avx2(s, n, out) },
+        // SAFETY: as above
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 if std::arch::is_x86_feature_detected!("avx2") => unsafe { avx2(s, n, out) },
+        _ => body(s, n, out),
     }
     r.skip(out.len() as u64);
 }

@@ -3,8 +3,7 @@
 //! a NaN, as Rust's cast leaves it: the same as the one-value cast), on the widest lanes the
 //! machine has (AVX-512F: 8, AVX2: 4, else the compiler's baseline).
 
-use super::select::best_kernel;
-use super::Kernel;
+use super::{f64_lanes, F64Lanes, Kernel};
 
 /// `dst[k] = src[k] as f64` for every `k`, on the widest lanes `cap`, the thread's cap and
 /// the machine allow (the same bits on every one).
@@ -12,22 +11,7 @@ use super::Kernel;
 /// # Panics
 /// If the lengths differ.
 pub fn f32_to_f64(cap: Kernel, src: &[f32], dst: &mut [f64]) {
-    assert_eq!(src.len(), dst.len(), "f32_to_f64: columns of different lengths");
-    let k = best_kernel(true, cap);
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::is_x86_feature_detected as has;
-        if k >= Kernel::Avx512 && has!("avx512f") {
-            // SAFETY: AVX-512F is present (checked above)
-            return unsafe { avx512(src, dst) };
-        }
-        if k >= Kernel::Avx2 && has!("avx2") {
-            // SAFETY: AVX2 is present (checked above)
-            return unsafe { avx2(src, dst) };
-        }
-    }
-    let _ = k;
-    body(src, dst)
+    widen_column(cap, src, dst)
 }
 
 /// `dst[k] = f32::from_bits((src[k] as u32) << 16) as f64` for every `k` (bfloat16
@@ -36,22 +20,21 @@ pub fn f32_to_f64(cap: Kernel, src: &[f32], dst: &mut [f64]) {
 /// # Panics
 /// If the lengths differ.
 pub fn bf16_to_f64(cap: Kernel, src: &[u16], dst: &mut [f64]) {
-    assert_eq!(src.len(), dst.len(), "bf16_to_f64: columns of different lengths");
-    let k = best_kernel(true, cap);
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::is_x86_feature_detected as has;
-        if k >= Kernel::Avx512 && has!("avx512f") {
-            // SAFETY: AVX-512F is present (checked above)
-            return unsafe { avx512(src, dst) };
-        }
-        if k >= Kernel::Avx2 && has!("avx2") {
-            // SAFETY: AVX2 is present (checked above)
-            return unsafe { avx2(src, dst) };
-        }
+    widen_column(cap, src, dst)
+}
+
+/// Either column on the binary64 lanes [`f64_lanes`] picks.
+fn widen_column<T: Widen>(cap: Kernel, src: &[T], dst: &mut [f64]) {
+    assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
+    match f64_lanes(cap) {
+        // SAFETY: AVX-512F is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 => unsafe { avx512(src, dst) },
+        // SAFETY: AVX2 is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx2 => unsafe { avx2(src, dst) },
+        _ => body(src, dst),
     }
-    let _ = k;
-    body(src, dst)
 }
 
 /// A value widened to binary64 exactly.
