@@ -1136,9 +1136,46 @@ fn ops_on_every_kernel<F: Format>(
     }
 }
 
+/// Operand pairs of a wide `eEmM` format whose sums and differences land where the lanes'
+/// rounding has its edges (random pairs almost never do): 2^k ± 2^(k − j) for j up to 60,
+/// just above a power of two (within 2^−S of it: the two-operation rounding's binade below)
+/// and just below one (rounding up into the next binade), ties to even and zeros of either
+/// sign, at exponents from emin to emax and both signs.
+fn rounding_edges(f: &datapath::format::Ieee<datapath::format::Soft>) -> Vec<(u64, u64)> {
+    use datapath::format::IeeeBackend as _;
+    use datapath::Format as _;
+    let lay = f.backend.layout();
+    let (emin, emax, m) = (lay.emin(), lay.emax(), lay.man_bits as i32);
+    let p2 = |e: i32| (e as f64).exp2();
+    let mut out = Vec::new();
+    for k in [emin, emin + 1, emin + m + 2, -3, 0, 1, 7, emax - 1, emax] {
+        for j in 1..=60 {
+            for sa in [1.0, -1.0] {
+                for sb in [1.0, -1.0] {
+                    // 2^k, the value above and below it, ±2^(k − j) (held where the format can)
+                    let a = [p2(k), p2(k) * (1.0 + p2(-m)), p2(k) * (2.0 - p2(-m))];
+                    for a in a {
+                        for b in [p2(k - j), p2(k - j) * 3.0, p2(k - j) * (1.0 + p2(-m))] {
+                            let (x, y) = (f.from_f64(sa * a), f.from_f64(sb * b));
+                            if f.to_f64(x) == sa * a && f.to_f64(y) == sb * b {
+                                out.push((x, y));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for (x, y) in [(0.0, 0.0), (-0.0, -0.0), (-0.0, 0.0), (0.0, -0.0), (-0.0, 1.0), (1.0, -0.0), (-1.0, 0.0)] {
+        out.push((f.from_f64(x), f.from_f64(y)));
+    }
+    out
+}
+
 /// The double-rounding argument of `datapath::format::narrow`, checked exhaustively: every
 /// operand pair of e5m4, e4m3, e3m2 and e2m1 (every subnormal and division mode) and 2^20
-/// random pairs of e8m16 and e10m24 (fewer under emu/avx512, see below), through + − × ÷ in binary64 lanes then rounded to the
+/// random pairs of e8m16 and e10m24 (fewer under emu/avx512, see below) with their
+/// [`rounding_edges`], through + − × ÷ in binary64 lanes then rounded to the
 /// format, equals the soft-float model's correctly rounded operation, bit for bit.
 #[test]
 fn narrow_ops_in_binary64_lanes_equal_the_soft_float_model_exhaustively() {
@@ -1157,7 +1194,10 @@ fn narrow_ops_in_binary64_lanes_equal_the_soft_float_model_exhaustively() {
             } else {
                 let mut r = SplitMix64::new(0x0b5);
                 let n = if emulated { 1 << 12 } else { 1 << 20 };
-                (0..n).map(|_| (f.from_bits(r.next_u64()), f.from_bits(r.next_u64()))).unzip()
+                let mut pairs: Vec<(u64, u64)> =
+                    (0..n).map(|_| (f.from_bits(r.next_u64()), f.from_bits(r.next_u64()))).collect();
+                pairs.extend(rounding_edges(&f));
+                pairs.into_iter().unzip()
             };
             for k in kernels_here() {
                 let ran = with_kernel_cap(k, || op_kernel_soft(&f));

@@ -26,10 +26,25 @@
 //!
 //! **Rounding in the lanes** (`round_full` in `datapath::simd`): each binary64 result x is
 //! rounded to the target, nearest-even, with its whole range:
-//! * 2^emin ≤ |x| < max + ulp(max)/2: Veltkamp's splitting, g = x·(2^S + 1), r = g − (g − x)
-//!   (with nearest-even binary64 arithmetic, r is x rounded to 53 − S = p bits, ties to even;
-//!   g − (g − x) rather than g + (x − g) keeps the sign of −0). Below the overflow threshold
-//!   the p-bit rounding never exceeds max (a value in [max, max + ulp/2) rounds to max);
+//! * 2^emin ≤ |x| < max + ulp(max)/2: two fused operations, with S = 53 − p:
+//!   g = RN(x·(2^S − 1) + 0), then r = RN(x·2^S − g) (each a single-rounding multiply-add,
+//!   its product exact). r is x rounded to p bits, ties to even. Proof, for x > 0 in
+//!   [2^e, 2^(e+1)) with 53-bit integer significand X (x = X·2^(e−52)), u = 2^(e−p+1) its
+//!   p-bit spacing: x·2^S = X·u, and (2^S − 1)·x < 2^(e+S+1), so g is a multiple of u (or of
+//!   u/2, below), r = X·u − g is exact in binary64 (a multiple of u/2 near x), and
+//!   r − x = −(g − (2^S − 1)x), minus g's rounding error. (a) When (2^S − 1)x ≥ 2^(e+S), g's
+//!   spacing is u, so |r − x| ≤ u/2 and r is a multiple of u: a nearest p-bit value. At a
+//!   tie, x = (k + ½)u, X = (2k + 1)·2^(52−p) is even, g's nearest-even choice between
+//!   (X − k − 1)u and (X − k)u takes the even one, so r = k′u with k′ even: ties to even.
+//!   (b) When (2^S − 1)x < 2^(e+S), i.e. x < 2^e·(1 + 1/(2^S − 1)), g's spacing is u/2 and r
+//!   is the multiple of u/2 nearest x, which is 2^e (x − 2^e < 2^e/(2^S − 1) ≤ u/4 when
+//!   S ≥ p + 2, i.e. p ≤ 25): x's p-bit rounding too. Negative x by symmetry. Zeros: x = ±0
+//!   gives g = +0 (the exact sum ±0 + +0 is +0 under nearest-even) and r = ±0 − +0 = ±0, the
+//!   sign kept (the "+ 0" is there for −0: without it g = −0 and r = +0). Below the overflow
+//!   threshold the p-bit rounding never exceeds max (a value in [max, max + ulp/2) rounds
+//!   to max). (Veltkamp's splitting, g = x·(2^S + 1), r = g − (g − x), gives the same value
+//!   in three operations; its fused form r = g − 2^S·x fails just below a power of two,
+//!   where x·(2^S + 1) crosses into the next binade.)
 //! * |x| < 2^emin: the subnormal grid, `(|x| + C) − C` with C = 2^(emin − M + 52) (the sum lies
 //!   in [C, 2C), where binary64's spacing is the target's subnormal step 2^(emin − M), so
 //!   binary64's nearest-even addition is the target's rounding, 2^emin included; the
@@ -64,15 +79,17 @@
 //! components in [2^−20, 2^40]). Otherwise stages 1–6 are recomputed with the full
 //! rounding. A NaN or an infinity among the twelve fails the filter (the unfiltered stage 1
 //! turns an infinite difference into a NaN, so both must take the full road). The reciprocal
-//! or division and the three final multiplies always round in full.
+//! or division and the three final multiplies always round in full. (The AVX2 filter checks
+//! the rounded sum of the twelve magnitudes against `fast_hi` instead of each: the sum is at
+//! least H, so it passes fewer vectors, never more; AVX-512 checks H itself.)
 //!
 //! **Products on the filtered path** (`split_mul` in `datapath::simd`): a product a·b of two
-//! target values is exact in binary64 (2p ≤ 50 bits), and so is b·(2^S + 1) (b's p bits and
-//! their copy S = 53 − p places up span 53 bits). So g = RN(a·(b·(2^S + 1))) is the split's
-//! g = RN(x·(2^S + 1)) of x = a·b, and one negative multiply-add RN(g − a·b) (its product exact)
-//! is the split's RN(g − x): the same three values, the same bits, one operation fewer, with
-//! b·(2^S + 1) formed once for the products that share b (the 18 products of stages 2–5 with a
-//! factor of d or s). The fused operation fuses none of the modelled datapath's roundings.
+//! target values is exact in binary64 (2p ≤ 50 bits), and so are b·(2^S − 1) and b·2^S (b's
+//! p bits times an S-bit constant span at most 53 bits). So RN(a·(b·(2^S − 1)) + 0) is the
+//! rounding's g for x = a·b and RN(a·(b·2^S) − g) its r: the same two values, the same bits,
+//! without forming a·b, with the two factors of b formed once for the products that share b
+//! (the 18 products of stages 2–5 with a factor of d or s). The fused operations fuse none of
+//! the modelled datapath's roundings (their products are exact).
 //!
 //! **e8mM loads** (E = 8, M ≤ 23, binary32's exponent field and bias): an encoding shifted
 //! left by 23 − M is the binary32 encoding of the same value (subnormals, ±∞ and NaNs
@@ -102,8 +119,10 @@ pub struct Narrow {
     pub quantum: f64,
     /// 2^(M − emin), the inverse of the step (encode).
     pub inv_step: f64,
-    /// 2^S + 1 with S = 52 − M, Veltkamp's splitting constant for rounding to p = 53 − S bits.
-    pub split: f64,
+    /// 2^S − 1 with S = 52 − M: the multiplier of the rounding to p = 53 − S bits.
+    pub split_lo: f64,
+    /// 2^S: the rounding's scale.
+    pub split_hi: f64,
     /// C = 2^(emin − M + 52): `(|x| + C) − C` is |x| < 2^emin rounded to the subnormal grid.
     pub sub_grid: f64,
     /// max + ulp(max)/2: the magnitude from which a result rounds to ±∞.
@@ -133,7 +152,8 @@ impl Narrow {
             step: super::layout::pow2(lay.emin() - m),
             quantum: super::layout::pow2(-m),
             inv_step: super::layout::pow2(m - lay.emin()),
-            split: super::layout::pow2(52 - m) + 1.0,
+            split_lo: super::layout::pow2(52 - m) - 1.0,
+            split_hi: super::layout::pow2(52 - m),
             sub_grid: super::layout::pow2(lay.emin() - m + 52),
             overflow_at: lay.max_finite() + super::layout::pow2(lay.emax() - m - 1),
             fast_lo: super::layout::pow2(((lay.emin() + 4 * m) as f64 / 3.0).ceil() as i32),
@@ -154,20 +174,20 @@ mod tests {
     }
 
     /// The constants are the documented ones, worked by hand from the formulas in the module
-    /// docs: split 2^(52 − M) + 1, fast_lo 2^⌈(emin + 4M)/3⌉, fast_hi 2^⌊(emax − 6)/3⌋, e8 for
-    /// E = 8 and M ≤ 23 with shift 23 − M.
+    /// docs: split_lo 2^(52 − M) − 1 and split_hi 2^(52 − M), fast_lo 2^⌈(emin + 4M)/3⌉,
+    /// fast_hi 2^⌊(emax − 6)/3⌋, e8 for E = 8 and M ≤ 23 with shift 23 − M.
     #[test]
     fn the_constants_are_the_documented_ones() {
         let x = |v: f64, k: i32| assert_eq!(v, (k as f64).exp2(), "2^{k}");
         // e8m16: emin −126, emax 127: ⌈−62/3⌉ = −20, ⌊121/3⌋ = 40
         let n = of(8, 16);
-        assert_eq!(n.split, 68_719_476_737.0); // 2^36 + 1
+        assert_eq!((n.split_lo, n.split_hi), (68_719_476_735.0, 68_719_476_736.0)); // 2^36 − 1, 2^36
         x(n.fast_lo, -20);
         x(n.fast_hi, 40);
         assert!(n.e8 && n.e8_shift == 7);
         // e10m24: emin −510, emax 511: ⌈−414/3⌉ = −138, ⌊505/3⌋ = 168
         let n = of(10, 24);
-        assert_eq!(n.split, 268_435_457.0); // 2^28 + 1
+        assert_eq!((n.split_lo, n.split_hi), (268_435_455.0, 268_435_456.0)); // 2^28 − 1, 2^28
         x(n.fast_lo, -138);
         x(n.fast_hi, 168);
         assert!(!n.e8);

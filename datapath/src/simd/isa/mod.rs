@@ -95,35 +95,35 @@ pub(super) fn step_up16x32(b: std::arch::x86_64::__m512i) -> std::arch::x86_64::
 /// The narrow formats' rounding, filter and flush, in the ops of the ISA module that
 /// invokes it (`v4d`, `v8d`: binary64 lanes).
 macro_rules! narrow_ops {
-    ($feat:literal, $fmafeat:literal, $v:ty, $fnmadd:ident) => {
-        /// Every lane rounded to the format's precision p, nearest-even, by Veltkamp's
-        /// splitting (g = x·(2^S + 1), then g − (g − x)); correct for |x| in [2^emin, max]
-        /// and for zeros ([`round_full`] handles the rest of the range).
+    ($feat:literal, $fmafeat:literal, $v:ty, $fmadd:ident, $fmsub:ident) => {
+        /// Every lane rounded to the format's precision p, nearest-even, in two fused
+        /// operations (see "Rounding in the lanes" in [`crate::format::narrow`]):
+        /// g = RN(x·(2^S − 1) + 0), then r = RN(x·2^S − g), S = 53 − p; correct for |x| in
+        /// [2^emin, max] and for zeros (−0 kept: g is +0, and −0 − +0 is −0; [`round_full`]
+        /// handles the rest of the range).
         #[inline]
-        #[target_feature(enable = $feat)]
+        #[target_feature(enable = $fmafeat)]
         pub fn split(x: $v, n: &Narrow) -> $v {
-            let g = mul(x, splat(n.split));
-            // g − (g − x) is g + (x − g) (nearest-even rounding is symmetric) with -0 kept
-            sub(g, sub(g, x))
+            let g = $fmadd(x, splat(n.split_lo), splat(0.0));
+            $fmsub(x, splat(n.split_hi), g)
         }
-        /// b·(2^S + 1), exact in every lane holding a format value (its p significant bits
-        /// and their copy S = 53 − p places up span at most 53 bits): the factor
+        /// (b·(2^S − 1), b·2^S), both exact in every lane holding a format value (b's p
+        /// significant bits times an S-bit constant span at most 53 bits): the factors
         /// [`split_mul`] takes for b.
         #[inline]
         #[target_feature(enable = $feat)]
-        pub fn split_k(b: $v, n: &Narrow) -> $v {
-            mul(b, splat(n.split))
+        pub fn split_k(b: $v, n: &Narrow) -> ($v, $v) {
+            (mul(b, splat(n.split_lo)), mul(b, splat(n.split_hi)))
         }
         /// [`split`] of the product a·b of two format values, with bk = [`split_k`]`(b)`:
-        /// the same three values without forming a·b first. a·b is exact in binary64
-        /// (2p ≤ 53 bits), so g = RN(a·bk) is RN(a·b·(2^S + 1)), split's g; the negative
-        /// multiply-add RN(g − a·b) is split's RN(g − x) (its product is exact: no rounding
-        /// of the modelled datapath is fused away); g minus it is split's result, bit for bit.
+        /// a·b is exact in binary64 (2p ≤ 53 bits), so RN(a·(b·(2^S − 1)) + 0) is split's g
+        /// for x = a·b and RN(a·(b·2^S) − g) its result, bit for bit, without forming a·b
+        /// (the fused products are exact: no rounding of the modelled datapath is fused away).
         #[inline]
         #[target_feature(enable = $fmafeat)]
-        pub fn split_mul(a: $v, b: $v, bk: $v) -> $v {
-            let g = mul(a, bk);
-            sub(g, $fnmadd(a, b, g))
+        pub fn split_mul(a: $v, _b: $v, bk: ($v, $v)) -> $v {
+            let g = $fmadd(a, bk.0, splat(0.0));
+            $fmsub(a, bk.1, g)
         }
         /// Every lane rounded to the format, nearest-even, with its range (see "Rounding in
         /// the lanes" in [`crate::format::narrow`]): [`split`] where |x| ≥ 2^emin; the
@@ -131,14 +131,12 @@ macro_rules! narrow_ops {
         /// restored), then under FTZ a subnormal result flushed to zero of its sign; ±∞ where
         /// |x| ≥ max + ulp(max)/2 (infinities included). A NaN stays a NaN.
         #[inline]
-        #[target_feature(enable = $feat)]
+        #[target_feature(enable = $fmafeat)]
         pub fn round_full(x: $v, n: &Narrow) -> $v {
             let a = abs(x);
-            // the common vector: every lane ±0 or normal-range (the binary64 just below
-            // |x| is below 2^emin only for a nonzero |x| < 2^emin; for ±0 it is a NaN),
-            // where the split is the rounding
-            let odd = or_m(le(splat(n.overflow_at), a), lt(pred(a), splat(n.min_normal)));
-            if bits(odd) == 0 {
+            // the common vector: every lane ±0 or normal-range, where the split is the
+            // rounding
+            if !any_outside_normal(a, n) {
                 return split(x, n);
             }
             let sgn = sign(x);

@@ -129,24 +129,41 @@ fn exponent(x: __m256d) -> __m256d {
 /// leaves {±0} ∪ [2^emin, max]. A NaN fails (the unfiltered stage 1 turns an infinite
 /// difference into a NaN, which must take the filtered road).
 ///
-/// Five operations a value, on a = |x|: the upper limit on a's encoding as a signed
-/// integer (a NaN's is above +∞'s, so it fails there); the lower limit on the binary64
-/// just below a (encoding − 1: order kept for a > 0, and ±0 becomes the all-ones NaN,
-/// which `vminpd` skips, returning its second operand, the running minimum).
+/// Four operations a value, on a = |x|: the upper limit on the sum of the magnitudes (a
+/// rounded sum of nonnegative terms is at least each term; a NaN or an infinity makes it
+/// fail), which is stricter than the limit on each; the lower limit on the binary64 just
+/// below a (encoding − 1: order kept for a > 0, and ±0 becomes the all-ones NaN, which
+/// `vminpd` skips, returning its second operand, the running minimum). Four running sums
+/// and minima, joined last.
 #[inline]
 #[target_feature(enable = "avx2")]
 pub fn fast_ok(v: &[__m256d; 12], n: &Narrow) -> bool {
-    let top = _mm256_set1_epi64x(n.fast_hi.to_bits() as i64);
-    let mut over = _mm256_setzero_si256();
-    let mut lo = splat(f64::INFINITY);
-    for &x in v {
-        let a = _mm256_castpd_si256(abs(x));
-        over = _mm256_or_si256(over, _mm256_cmpgt_epi64(a, top));
-        lo = _mm256_min_pd(_mm256_castsi256_pd(_mm256_sub_epi64(a, int(1))), lo);
+    let mut sum = [splat(0.0); 4];
+    let mut lo = [splat(f64::INFINITY); 4];
+    for (k, &x) in v.iter().enumerate() {
+        let a = abs(x);
+        sum[k % 4] = add(sum[k % 4], a);
+        lo[k % 4] = _mm256_min_pd(pred(a), lo[k % 4]);
     }
-    _mm256_testz_si256(over, over) == 1 && bits(le(pred(splat(n.fast_lo)), lo)) == (1 << LANES) - 1
+    let sum = add(add(sum[0], sum[1]), add(sum[2], sum[3]));
+    let lo = _mm256_min_pd(_mm256_min_pd(lo[0], lo[1]), _mm256_min_pd(lo[2], lo[3]));
+    bits(and_m(le(sum, splat(n.fast_hi)), le(pred(splat(n.fast_lo)), lo))) == (1 << LANES) - 1
 }
-narrow_ops!("avx2", "avx2,fma", __m256d, _mm256_fnmadd_pd);
+/// Whether a lane of magnitudes `a` lies outside {0} ∪ [2^emin, max + ulp(max)/2) (a NaN
+/// included): [`fast_ok`]'s integer compares on the encodings, with `n.min_normal` and
+/// `n.overflow_at` for its limits (a ≥ overflow_at is a > its encoding − 1).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn any_outside_normal(a: __m256d, n: &Narrow) -> bool {
+    let a = _mm256_castpd_si256(a);
+    let flip = i64::MAX;
+    let floor = _mm256_set1_epi64x((n.min_normal.to_bits() as i64).wrapping_add(flip));
+    let small = _mm256_cmpgt_epi64(floor, _mm256_add_epi64(a, _mm256_set1_epi64x(flip)));
+    let big = _mm256_cmpgt_epi64(a, _mm256_set1_epi64x(n.overflow_at.to_bits() as i64 - 1));
+    let odd = _mm256_or_si256(small, big);
+    _mm256_testz_si256(odd, odd) == 0
+}
+narrow_ops!("avx2", "avx2,fma", __m256d, _mm256_fmadd_pd, _mm256_fmsub_pd);
 /// Loads 4 `eEmM` encodings as binary64 (exact).
 ///
 /// # Safety
