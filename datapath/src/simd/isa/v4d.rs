@@ -149,18 +149,17 @@ pub fn fast_ok(v: &[__m256d; 12], n: &Narrow) -> bool {
     let lo = _mm256_min_pd(_mm256_min_pd(lo[0], lo[1]), _mm256_min_pd(lo[2], lo[3]));
     bits(and_m(le(sum, splat(n.fast_hi)), le(pred(splat(n.fast_lo)), lo))) == (1 << LANES) - 1
 }
-/// Whether a lane of magnitudes `a` lies outside {0} ∪ [2^emin, max + ulp(max)/2) (a NaN
-/// included): [`fast_ok`]'s integer compares on the encodings, with `n.min_normal` and
-/// `n.overflow_at` for its limits (a ≥ overflow_at is a > its encoding − 1).
+/// Whether a lane of magnitudes `a` lies outside [2^emin, max + ulp(max)/2) (±0 and a NaN
+/// included: they take [`round_full`]'s full road, which keeps them): a's encoding minus
+/// 2^emin's is at least the range's width as unsigned integers (order kept for magnitudes;
+/// ±0 and a < 2^emin wrap to the top), read by AVX2's signed compare after adding 2^63 —
+/// one wrapping add of 2^63 − 2^emin's encoding.
 #[inline]
 #[target_feature(enable = "avx2")]
 fn any_outside_normal(a: __m256d, n: &Narrow) -> bool {
-    let a = _mm256_castpd_si256(a);
-    let flip = i64::MAX;
-    let floor = _mm256_set1_epi64x((n.min_normal.to_bits() as i64).wrapping_add(flip));
-    let small = _mm256_cmpgt_epi64(floor, _mm256_add_epi64(a, _mm256_set1_epi64x(flip)));
-    let big = _mm256_cmpgt_epi64(a, _mm256_set1_epi64x(n.overflow_at.to_bits() as i64 - 1));
-    let odd = _mm256_or_si256(small, big);
+    let (lo, hi) = (n.min_normal.to_bits(), n.overflow_at.to_bits());
+    let t = _mm256_add_epi64(_mm256_castpd_si256(a), int((1u64 << 63).wrapping_sub(lo)));
+    let odd = _mm256_cmpgt_epi64(t, int((hi - lo - 1) ^ (1u64 << 63)));
     _mm256_testz_si256(odd, odd) == 0
 }
 narrow_ops!("avx2", "avx2,fma", __m256d, _mm256_fmadd_pd, _mm256_fmsub_pd);

@@ -159,13 +159,15 @@ pub fn fast_ok(v: &[__m512d; 12], n: &Narrow) -> bool {
         _mm512_cmp_pd_mask::<_CMP_LE_OQ>(h, splat(n.fast_hi)) & _mm512_cmp_pd_mask::<_CMP_GE_OQ>(l, splat(n.fast_lo));
     ok == u8::MAX
 }
-/// Whether a lane of magnitudes `a` lies outside {0} ∪ [2^emin, max + ulp(max)/2) (a NaN
-/// excluded: it stays a NaN through the split): the binary64 just below a is below 2^emin
-/// only for a nonzero a < 2^emin (for ±0 it is a NaN, which compares false).
+/// Whether a lane of magnitudes `a` lies outside [2^emin, max + ulp(max)/2) (±0 and a NaN
+/// included: they take [`round_full`]'s full road, which keeps them): one unsigned compare
+/// of a's encoding minus 2^emin's (order kept for magnitudes; ±0 and a < 2^emin wrap to
+/// the top) against the width of the range.
 #[inline]
 #[target_feature(enable = "avx512f")]
 fn any_outside_normal(a: __m512d, n: &Narrow) -> bool {
-    bits(or_m(le(splat(n.overflow_at), a), lt(pred(a), splat(n.min_normal)))) != 0
+    let (lo, hi) = (n.min_normal.to_bits(), n.overflow_at.to_bits());
+    _mm512_cmpge_epu64_mask(_mm512_sub_epi64(ib(a), int(lo)), int(hi - lo)) != 0
 }
 narrow_ops!("avx512f", "avx512f", __m512d, _mm512_fmadd_pd, _mm512_fmsub_pd);
 /// Loads 8 `eEmM` encodings as binary64 (exact).
