@@ -1137,7 +1137,8 @@ fn ops_on_every_kernel<F: Format>(
 }
 
 /// Operand pairs of a wide `eEmM` format whose sums and differences land where the lanes'
-/// rounding has its edges (random pairs almost never do): 2^k ± 2^(k − j) for j up to 60,
+/// rounding has its edges (random pairs almost never do): 2^k ± 2^(k − j) for j up to 60
+/// (around M and S = 52 − M especially),
 /// just above a power of two (within 2^−S of it: the two-operation rounding's binade below)
 /// and just below one (rounding up into the next binade), ties to even and zeros of either
 /// sign, at exponents from emin to emax and both signs.
@@ -1148,8 +1149,11 @@ fn rounding_edges(f: &datapath::format::Ieee<datapath::format::Soft>) -> Vec<(u6
     let (emin, emax, m) = (lay.emin(), lay.emax(), lay.man_bits as i32);
     let p2 = |e: i32| (e as f64).exp2();
     let mut out = Vec::new();
-    for k in [emin, emin + 1, emin + m + 2, -3, 0, 1, 7, emax - 1, emax] {
-        for j in 1..=60 {
+    // S = 52 − M: the rounding's binade edge lies within 2^−S of a power of two
+    let s = 52 - m;
+    let js = [1, 2, 3, m, m + 1, m + 2, m + 3, s - 2, s - 1, s, s + 1, s + 2, s + 3, 45, 52, 53, 60];
+    for k in [emin, emin + m + 2, -3, 0, 1, emax - 1, emax] {
+        for j in js {
             for sa in [1.0, -1.0] {
                 for sb in [1.0, -1.0] {
                     // 2^k, the value above and below it, ±2^(k − j) (held where the format can)
