@@ -134,8 +134,8 @@ macro_rules! narrow_ops {
         #[target_feature(enable = $fmafeat)]
         pub fn round_full(x: $v, n: &Narrow) -> $v {
             let a = abs(x);
-            // the common vector: every lane normal-range (on AVX2 also ±0), where the split
-            // is the rounding
+            // the common vector: every lane in the normal range, where the split is the
+            // rounding (±0 and NaN lanes take the road below, which keeps them)
             if !any_outside_normal(a, n) {
                 return split(x, n);
             }
