@@ -1329,9 +1329,10 @@ fn fixed_point_formats_wider_than_32_bits_run_the_scalar_model() {
 }
 
 /// `simd::gather::gather` on every kernel is the plain copy `cols[c][k] = pick(&recs[idx[k]])[c]`
-/// bit for bit: 4- and 8-byte numbers (the AVX-512F gathers), 2-byte ones (always scalar), a
-/// field at an offset within its record, every length up to 70 (whole 16-lane steps and
-/// tails), NaN payloads copied as they are; an index out of range and a short column panic.
+/// bit for bit: 4- and 8-byte numbers (the AVX-512F and AVX2 gathers), 2-byte ones (always
+/// scalar), a field at an offset within its record, every length up to 70 (whole 16- and
+/// 8-lane steps and tails), NaN payloads copied as they are; an index out of range (in the
+/// first, second and fourth 8-lane step) and a short column panic.
 mod gather {
     use super::*;
     use datapath::simd::gather::gather;

@@ -1,7 +1,7 @@
 //! Gathers: fields of records picked by index copied into columns (`cols[c][k] =
 //! pick(recs[idx[k]])[c]`), the step that turns a block of test indices into the kernels' SoA
 //! columns. Scalar, or with AVX-512F gather instructions for 4- and 8-byte values (16 lanes a
-//! step); the same values either way: a gather only copies bits.
+//! step), or AVX2's (8 lanes a step); the same values either way: a gather only copies bits.
 
 use super::select::best_kernel;
 use super::Kernel;
@@ -13,8 +13,8 @@ pub const AHEAD: usize = 16;
 
 /// Column by column, `cols[c][k] = pick(&recs[idx[k]])[c]` for every lane `k` of `idx`. With
 /// `fetch` each record [`AHEAD`] lanes on is prefetched, all its lines (a hint). The widest
-/// copy `cap`, the thread's cap and the machine allow: AVX-512F gathers when `T` is a 4- or
-/// 8-byte number (`f32`, `u32`, `i32`, `f64`, `u64`, `i64`), else scalar.
+/// copy `cap`, the thread's cap and the machine allow: AVX-512F, else AVX2 gathers when `T` is
+/// a 4- or 8-byte number (`f32`, `u32`, `i32`, `f64`, `u64`, `i64`), else scalar.
 ///
 /// # Panics
 /// If a column is shorter than `idx`, or an index is out of range.
@@ -30,7 +30,7 @@ pub fn gather<R, T: Copy + 'static, const C: usize>(
     assert!(cols.iter().all(|c| c.len() >= idx.len()), "gather: a column is shorter than the block");
     let mut done = 0;
     #[cfg(target_arch = "x86_64")]
-    if idx.len() >= 16 && best_kernel(true, cap) >= Kernel::Avx512 && fits_i32::<R>(recs.len()) {
+    if idx.len() >= 16 && best_kernel(true, cap) >= Kernel::Avx2 && fits_i32::<R>(recs.len()) {
         // the field's byte offset in its record (the same in every record)
         let off = (pick(&recs[0]) as *const [T; C] as usize) - (&recs[0] as *const R as usize);
         let wide = if is::<T, f32>() || is::<T, u32>() || is::<T, i32>() {
@@ -46,7 +46,11 @@ pub fn gather<R, T: Copy + 'static, const C: usize>(
             // idx.len() values; the byte offsets fit in i32 (fits_i32) and every index is
             // checked against recs.len() before its records are read; T is a plain number of
             // w bytes, so copying its bits copies it
-            done = unsafe { avx512(recs, idx, fetch, off, w, ptrs) };
+            done = if best_kernel(true, cap) >= Kernel::Avx512 {
+                unsafe { avx512(recs, idx, fetch, off, w, ptrs) }
+            } else {
+                unsafe { avx2(recs, idx, fetch, off, w, ptrs) }
+            };
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
@@ -148,6 +152,64 @@ unsafe fn avx512<R, T, const C: usize>(
             }
         }
         k += 16;
+    }
+    whole
+}
+
+/// [`avx512`] with AVX2 gathers: 8 lanes a step (4-byte values in one gather, 8-byte values in
+/// two of 4); returns the lanes done (a multiple of 8).
+///
+/// # Safety
+/// As [`avx512`], with AVX2 present.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn avx2<R, T, const C: usize>(
+    recs: &[R],
+    idx: &[u32],
+    fetch: bool,
+    off: usize,
+    w: usize,
+    cols: [*mut T; C],
+) -> usize {
+    use std::arch::x86_64::*;
+    let whole = idx.len() - idx.len() % 8;
+    let base = recs.as_ptr().cast::<u8>();
+    let stride = _mm256_set1_epi32(std::mem::size_of::<R>() as i32);
+    assert!(whole == 0 || !recs.is_empty(), "gather: index out of range");
+    let n = recs.len() as u32;
+    let mut k = 0;
+    while k < whole {
+        // SAFETY: k + 8 <= idx.len()
+        let ix = unsafe { _mm256_loadu_si256(idx.as_ptr().add(k).cast()) };
+        // every index below recs.len() (unsigned: max(ix, n − 1) == n − 1 on every lane)
+        let top = _mm256_set1_epi32(n.wrapping_sub(1) as i32);
+        assert!(
+            _mm256_movemask_epi8(_mm256_cmpeq_epi32(_mm256_max_epu32(ix, top), top)) == -1,
+            "gather: index out of range"
+        );
+        if fetch {
+            for &j in idx.get(k + AHEAD..(k + AHEAD + 8).min(idx.len())).unwrap_or(&[]) {
+                prefetch(&recs[j as usize]);
+            }
+        }
+        let offs = _mm256_mullo_epi32(ix, stride);
+        for (c, &col) in cols.iter().enumerate() {
+            // SAFETY: every offset is a record's start (index checked above, the block's bytes
+            // fit i32: checked by the caller) plus the field's offset; the column holds k + 8
+            unsafe {
+                let p = base.add(off + c * w);
+                if w == 4 {
+                    let v = _mm256_i32gather_epi32::<1>(p.cast(), offs);
+                    _mm256_storeu_si256(col.add(k).cast(), v);
+                } else {
+                    let lo = _mm256_i32gather_epi64::<1>(p.cast(), _mm256_castsi256_si128(offs));
+                    let hi = _mm256_i32gather_epi64::<1>(p.cast(), _mm256_extracti128_si256::<1>(offs));
+                    _mm256_storeu_si256(col.add(k).cast(), lo);
+                    _mm256_storeu_si256(col.add(k + 4).cast(), hi);
+                }
+            }
+        }
+        k += 8;
     }
     whole
 }
