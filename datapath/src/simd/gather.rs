@@ -103,6 +103,25 @@ pub fn prefetch<R>(r: &R) {
     let _ = r;
 }
 
+/// The whole `lanes`-lane steps of `idx`, in order: `step(k)` checks and copies lanes
+/// k .. k + lanes, then, with `fetch`, the records [`AHEAD`] lanes on are prefetched; returns
+/// the lanes done (a multiple of `lanes`; the rest are the caller's).
+#[inline(always)]
+fn steps<R>(recs: &[R], idx: &[u32], fetch: bool, lanes: usize, mut step: impl FnMut(usize)) -> usize {
+    let whole = idx.len() - idx.len() % lanes;
+    let mut k = 0;
+    while k < whole {
+        step(k);
+        if fetch {
+            for &j in idx.get(k + AHEAD..(k + AHEAD + lanes).min(idx.len())).unwrap_or(&[]) {
+                prefetch(&recs[j as usize]);
+            }
+        }
+        k += lanes;
+    }
+    whole
+}
+
 /// The whole 16-lane steps of [`gather`] with AVX-512F gathers of `w`-byte values (4 or 8) at
 /// byte offset `off` of each record; returns the lanes done (the rest are the caller's).
 ///
@@ -120,20 +139,13 @@ unsafe fn avx512<R, T, const C: usize>(
     cols: [*mut T; C],
 ) -> usize {
     use std::arch::x86_64::*;
-    let whole = idx.len() - idx.len() % 16;
     let base = recs.as_ptr().cast::<u8>();
     let stride = _mm512_set1_epi32(std::mem::size_of::<R>() as i32);
     let len = _mm512_set1_epi32(recs.len() as i32);
-    let mut k = 0;
-    while k < whole {
+    steps(recs, idx, fetch, 16, |k| {
         // SAFETY: k + 16 <= idx.len()
         let ix = unsafe { _mm512_loadu_si512(idx.as_ptr().add(k).cast()) };
         assert!(_mm512_cmpge_epu32_mask(ix, len) == 0, "gather: index out of range");
-        if fetch {
-            for &j in idx.get(k + AHEAD..(k + AHEAD + 16).min(idx.len())).unwrap_or(&[]) {
-                prefetch(&recs[j as usize]);
-            }
-        }
         let offs = _mm512_mullo_epi32(ix, stride);
         for (c, &col) in cols.iter().enumerate() {
             // SAFETY: every offset + off + c·w + w lies within recs (indices checked, field
@@ -151,9 +163,7 @@ unsafe fn avx512<R, T, const C: usize>(
                 }
             }
         }
-        k += 16;
-    }
-    whole
+    })
 }
 
 /// [`avx512`] with AVX2 gathers: 8 lanes a step (4-byte values in one gather, 8-byte values in
@@ -172,30 +182,19 @@ unsafe fn avx2<R, T, const C: usize>(
     cols: [*mut T; C],
 ) -> usize {
     use std::arch::x86_64::*;
-    let whole = idx.len() - idx.len() % 8;
     let base = recs.as_ptr().cast::<u8>();
     let stride = _mm256_set1_epi32(std::mem::size_of::<R>() as i32);
-    assert!(whole == 0 || !recs.is_empty(), "gather: index out of range");
-    let n = recs.len() as u32;
-    let mut k = 0;
-    while k < whole {
+    // every index below recs.len() (not empty: the caller read recs[0]): unsigned,
+    // max(ix, len − 1) == len − 1 on every lane
+    let top = _mm256_set1_epi32((recs.len() as u32).wrapping_sub(1) as i32);
+    steps(recs, idx, fetch, 8, |k| {
         // SAFETY: k + 8 <= idx.len()
         let ix = unsafe { _mm256_loadu_si256(idx.as_ptr().add(k).cast()) };
-        // every index below recs.len() (unsigned: max(ix, n − 1) == n − 1 on every lane)
-        let top = _mm256_set1_epi32(n.wrapping_sub(1) as i32);
-        assert!(
-            _mm256_movemask_epi8(_mm256_cmpeq_epi32(_mm256_max_epu32(ix, top), top)) == -1,
-            "gather: index out of range"
-        );
-        if fetch {
-            for &j in idx.get(k + AHEAD..(k + AHEAD + 8).min(idx.len())).unwrap_or(&[]) {
-                prefetch(&recs[j as usize]);
-            }
-        }
+        let fits = _mm256_movemask_epi8(_mm256_cmpeq_epi32(_mm256_max_epu32(ix, top), top)) == -1;
+        assert!(fits, "gather: index out of range");
         let offs = _mm256_mullo_epi32(ix, stride);
         for (c, &col) in cols.iter().enumerate() {
-            // SAFETY: every offset is a record's start (index checked above, the block's bytes
-            // fit i32: checked by the caller) plus the field's offset; the column holds k + 8
+            // SAFETY: as in `avx512`, for 8 lanes
             unsafe {
                 let p = base.add(off + c * w);
                 if w == 4 {
@@ -209,7 +208,5 @@ unsafe fn avx2<R, T, const C: usize>(
                 }
             }
         }
-        k += 8;
-    }
-    whole
+    })
 }
