@@ -324,54 +324,24 @@ fn flags_body(
         return;
     }
     let r = d.map(|x| 1.0 / x);
-    let (two_m50, two_m1000, two_1019) = (2f64.powi(-50), 2f64.powi(-1000), 2f64.powi(1019));
     // a group's box planes, copied into fixed arrays (in a block's last group the lanes past
     // its end hold stale planes and are not written back): the lane loop runs without bounds
     // checks and vectorises
     let mut bg = [[0.0f64; FLAG_GROUP]; 6];
     let (mut hg, mut cg, mut ug) = ([false; FLAG_GROUP], [false; FLAG_GROUP], [false; FLAG_GROUP]);
+    // the usual ray has no zero direction component: then no axis is parallel and the group's
+    // lanes run without the parallel-axis test (the same flags: `dead` stays false)
+    let parallel = d.contains(&0.0);
     let mut g = 0;
     while g < hit.len() {
         let m = FLAG_GROUP.min(hit.len() - g);
         for (k, col) in bg.iter_mut().enumerate() {
             col[..m].copy_from_slice(&b[k][g..g + m]);
         }
-        for i in 0..FLAG_GROUP {
-            let mut near = tmin;
-            let mut far = tmax;
-            let mut dead = false;
-            // the largest quotient magnitude (infinite when a quotient is)
-            let mut big = 0.0f64;
-            for a in 0..3 {
-                let (lo_p, hi_p) = (bg[a][i], bg[a + 3][i]);
-                if d[a] == 0.0 {
-                    dead |= (o[a] < lo_p) | (o[a] > hi_p);
-                } else {
-                    let (t0, t1) = ((lo_p - o[a]) * r[a], (hi_p - o[a]) * r[a]);
-                    for m in [t0.abs(), t1.abs()] {
-                        big = if m > big { m } else { big };
-                    }
-                    let sw = t0 <= t1;
-                    let lo = if sw { t0 } else { t1 };
-                    let hi = if sw { t1 } else { t0 };
-                    let n2 = if lo > near { lo } else { near };
-                    let f2 = if hi < far { hi } else { far };
-                    near = if dead { near } else { n2 };
-                    far = if dead { far } else { f2 };
-                }
-            }
-            // E, doubled: 4u of the largest quotient plus 2^-1018 for the quotients below 2^-1020
-            let e = big * two_m50 + two_m1000;
-            let diff = far - near;
-            let lhs = diff.abs();
-            let scale = 1.0f64.max(near.abs()).max(if far.is_finite() { far.abs() } else { 0.0 });
-            let rhs = close_rel * scale;
-            let inside = (near.abs() < two_1019) & (far.abs() < two_1019);
-            let hit_sure = diff.abs() > 4.0 * e;
-            let close_sure = (lhs - rhs).abs() > 8.0 * e + two_m50 * (lhs + rhs);
-            hg[i] = !dead & (near <= far);
-            cg[i] = lhs <= rhs;
-            ug[i] = !(inside & close_sure & (hit_sure | dead));
+        if parallel {
+            flags_group::<true>(o, d, r, tmin, tmax, &bg, close_rel, &mut hg, &mut cg, &mut ug);
+        } else {
+            flags_group::<false>(o, d, r, tmin, tmax, &bg, close_rel, &mut hg, &mut cg, &mut ug);
         }
         hit[g..g + m].copy_from_slice(&hg[..m]);
         close[g..g + m].copy_from_slice(&cg[..m]);
@@ -381,6 +351,67 @@ fn flags_body(
             }
         }
         g += m;
+    }
+}
+
+/// One group of [`flags_body`]'s lanes through the reciprocal products: per lane the two
+/// flags (`hit`, `close`) and whether the lane is unsure (`unsure`: it must take the true
+/// division). `PARALLEL`: some direction component is zero (without it none is, and the
+/// parallel-axis test is left out). The interval's ends are taken as `min`/`max` of the two
+/// quotients, NaN kept as the scalar code keeps it (`lo` the second quotient, `hi` the first,
+/// when one is NaN); two equal quotients may give an end of the other zero's sign, which no
+/// flag reads (`near <= far`, `|far − near|` and the magnitudes are the same for ±0).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn flags_group<const PARALLEL: bool>(
+    o: [f64; 3],
+    d: [f64; 3],
+    r: [f64; 3],
+    tmin: f64,
+    tmax: f64,
+    bg: &[[f64; FLAG_GROUP]; 6],
+    close_rel: f64,
+    hg: &mut [bool; FLAG_GROUP],
+    cg: &mut [bool; FLAG_GROUP],
+    ug: &mut [bool; FLAG_GROUP],
+) {
+    let (two_m50, two_m1000, two_1019) = (2f64.powi(-50), 2f64.powi(-1000), 2f64.powi(1019));
+    for i in 0..FLAG_GROUP {
+        let mut near = tmin;
+        let mut far = tmax;
+        let mut dead = false;
+        // the largest quotient magnitude (infinite when a quotient is)
+        let mut big = 0.0f64;
+        for a in 0..3 {
+            let (lo_p, hi_p) = (bg[a][i], bg[a + 3][i]);
+            if PARALLEL && d[a] == 0.0 {
+                dead |= (o[a] < lo_p) | (o[a] > hi_p);
+            } else {
+                let (t0, t1) = ((lo_p - o[a]) * r[a], (hi_p - o[a]) * r[a]);
+                for m in [t0.abs(), t1.abs()] {
+                    big = if m > big { m } else { big };
+                }
+                // lo = t0 <= t1 ? t0 : t1 and hi = t0 <= t1 ? t1 : t0, as min and max
+                let lo = if t0 < t1 { t0 } else { t1 };
+                let hi = if t1 > t0 { t1 } else { t0 };
+                let n2 = if lo > near { lo } else { near };
+                let f2 = if hi < far { hi } else { far };
+                near = if dead { near } else { n2 };
+                far = if dead { far } else { f2 };
+            }
+        }
+        // E, doubled: 4u of the largest quotient plus 2^-1018 for the quotients below 2^-1020
+        let e = big * two_m50 + two_m1000;
+        let diff = far - near;
+        let lhs = diff.abs();
+        let scale = 1.0f64.max(near.abs()).max(if far.is_finite() { far.abs() } else { 0.0 });
+        let rhs = close_rel * scale;
+        let inside = (near.abs() < two_1019) & (far.abs() < two_1019);
+        let hit_sure = diff.abs() > 4.0 * e;
+        let close_sure = (lhs - rhs).abs() > 8.0 * e + two_m50 * (lhs + rhs);
+        hg[i] = !dead & (near <= far);
+        cg[i] = lhs <= rhs;
+        ug[i] = !(inside & close_sure & (hit_sure | dead));
     }
 }
 
