@@ -10,8 +10,8 @@
 //! term is non-negative and non-decreasing in |x|, |y|, ex, ey, ax, ay; binary64 rounding to
 //! nearest is monotone; and |x ± y| <= |x| + |y|, |x·y| = |x|·|y|. So the same recurrences run on
 //! *magnitudes* — the bound's own recurrences (`Ctx` in magnitude mode, where a difference adds),
-//! from the inputs' largest |value| and the block's largest first differences |v1 − v0|,
-//! |v2 − v0|, |o − v0| per component — give, for every signal, `E = e + 2⁻⁴⁵·a` no smaller than
+//! from an upper bound on the inputs' |value| (the block's largest |x| + |y| of the pairs below)
+//! and the block's largest first differences |v1 − v0|, |v2 − v0|, |o − v0| per component — give, for every signal, `E = e + 2⁻⁴⁵·a` no smaller than
 //! any lane's `err()`, and a range check (`V + E <= max` at every step) that implies every lane's. A lane is
 //! certified when (1) the block's range check holds and no input is NaN, (2) the lane is not
 //! valid (its exact decision is a miss: the per-test verdict's `hit` is false), (3) every
@@ -49,40 +49,50 @@ struct Static {
 
 /// The block's largest magnitudes: per first-difference component (e1 = v1 − v0, e2 = v2 − v0,
 /// s = o − v0, as each lane computes them) its largest |value| and largest monomial sum
-/// |x| + |y|, the largest non-NaN |input|, and whether an input is not finite. Column by
-/// column, branch-free.
+/// |x| + |y|, the largest of those sums (no smaller than any non-NaN |input| of the lanes: each
+/// vertex column is in a sum), and whether an input of the lanes is NaN. Column by column,
+/// branch-free.
 #[inline(always)]
 fn maxima(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
     let (mut ve, mut ae) = ([0.0f64; 9], [0.0f64; 9]);
-    let (mut big, mut bad) = (0.0f64, false);
+    let mut bad = false;
     for a in 0..3 {
         let y = c[a];
         for k in 0..3 {
-            let (vm, am, bm, nf) = if k < 2 { column_maxima(c[3 * (k + 1) + a], y) } else { origin_maxima(r.o[a], y) };
+            // (the vertex columns' NaNs are in the first two pairs)
+            let (vm, am, nan) = if k < 2 {
+                column_maxima(c[3 * (k + 1) + a], y)
+            } else {
+                let (vm, am) = origin_maxima(r.o[a], y);
+                (vm, am, false)
+            };
             ve[3 * k + a] = vm;
             ae[3 * k + a] = am;
-            big = big.max(bm);
-            bad |= nf;
+            bad |= nan;
         }
     }
-    (ve, ae, big, bad)
+    (ve, ae, largest(ae), bad)
 }
 
-/// Over the lanes of columns x and y: the largest |x − y|, |x| + |y| and non-NaN |x| or |y|, and
-/// whether a value is not finite (x·0 is NaN exactly then). Eight independent accumulators
-/// per quantity, so the loop vectorises.
+/// The largest of the monomial-sum maxima (none is NaN: a maximum never takes one).
 #[inline(always)]
-fn column_maxima(x: &[f64], y: &[f64]) -> (f64, f64, f64, bool) {
+fn largest(ae: [f64; 9]) -> f64 {
+    ae.iter().fold(0.0f64, |m, &x| if x > m { x } else { m })
+}
+
+/// Over the lanes of columns x and y: the largest |x − y| and |x| + |y|, and whether a value is
+/// NaN (a running sum of the |x| + |y| is NaN exactly then: a sum of magnitudes is never NaN
+/// otherwise, +∞ plus anything non-negative staying +∞). Eight independent accumulators per
+/// quantity, so the loop vectorises.
+#[inline(always)]
+fn column_maxima(x: &[f64], y: &[f64]) -> (f64, f64, bool) {
     const W: usize = 8;
-    let (mut vm, mut am, mut bm, mut nf) = ([0.0f64; W], [0.0f64; W], [0.0f64; W], [0.0f64; W]);
+    let (mut vm, mut am, mut nf) = ([0.0f64; W], [0.0f64; W], [0.0f64; W]);
     let mut step = |j: usize, xi: f64, yi: f64| {
         let (dv, sv) = ((xi - yi).abs(), xi.abs() + yi.abs());
         vm[j] = if dv > vm[j] { dv } else { vm[j] };
         am[j] = if sv > am[j] { sv } else { am[j] };
-        // each |value| on its own (a NaN is never taken, and never hides its partner)
-        bm[j] = if xi.abs() > bm[j] { xi.abs() } else { bm[j] };
-        bm[j] = if yi.abs() > bm[j] { yi.abs() } else { bm[j] };
-        nf[j] += xi * 0.0 + yi * 0.0;
+        nf[j] += sv;
     };
     let (xc, yc) = (x.chunks_exact(W), y.chunks_exact(W));
     let (xr, yr) = (xc.remainder(), yc.remainder());
@@ -94,20 +104,20 @@ fn column_maxima(x: &[f64], y: &[f64]) -> (f64, f64, f64, bool) {
     for (&xi, &yi) in xr.iter().zip(yr) {
         step(0, xi, yi);
     }
-    fold(vm, am, bm, nf)
+    fold(vm, am, nf)
 }
 
 /// [`column_maxima`] with x one value (the ray's origin on an axis).
+/// [`column_maxima`]'s first two with x one value (the ray's origin on an axis; its range and
+/// NaN are [`statics`]' checks, y's NaNs [`column_maxima`]'s).
 #[inline(always)]
-fn origin_maxima(xi: f64, y: &[f64]) -> (f64, f64, f64, bool) {
+fn origin_maxima(xi: f64, y: &[f64]) -> (f64, f64) {
     const W: usize = 8;
-    let (mut vm, mut am, mut bm, mut nf) = ([0.0f64; W], [0.0f64; W], [0.0f64; W], [0.0f64; W]);
+    let (mut vm, mut am) = ([0.0f64; W], [0.0f64; W]);
     let mut step = |j: usize, yi: f64| {
         let (dv, sv) = ((xi - yi).abs(), xi.abs() + yi.abs());
         vm[j] = if dv > vm[j] { dv } else { vm[j] };
         am[j] = if sv > am[j] { sv } else { am[j] };
-        bm[j] = if yi.abs() > bm[j] { yi.abs() } else { bm[j] };
-        nf[j] += yi * 0.0;
     };
     let yc = y.chunks_exact(W);
     let yr = yc.remainder();
@@ -119,17 +129,17 @@ fn origin_maxima(xi: f64, y: &[f64]) -> (f64, f64, f64, bool) {
     for &yi in yr {
         step(0, yi);
     }
-    let (v, a, b, n) = fold(vm, am, bm, nf);
-    (v, a, b.max(xi.abs()), n | !xi.is_finite())
+    let (v, a, _) = fold(vm, am, [0.0; W]);
+    (v, a)
 }
 
 /// [`maxima`] in explicit vector registers of `V` (its feature present): per axis one pass
 /// over the three vertex columns giving the three components' maxima (e1 = v1 − v0,
-/// e2 = v2 − v0, s = o − v0), the largest |input| and the non-finite flag. Equal to
-/// [`maxima`]: a maximum of non-NaN values does not depend on the order or grouping it is
-/// taken in (every value is an absolute value or a sum of two, never −0; a NaN is never
-/// taken: `maxpd` keeps its second operand, the running maximum, and the scalar compares fail),
-/// and a sum of `x·0` terms is NaN exactly when one of its `x` is not finite, in any order.
+/// e2 = v2 − v0, s = o − v0) and the NaN flag. Equal to [`maxima`]: a maximum of non-NaN
+/// values does not depend on the order or grouping it is taken in (every value is an absolute
+/// value or a sum of two, never −0; a NaN is never taken: `maxpd` keeps its second operand,
+/// the running maximum, and the scalar compares fail), and a sum of magnitudes is NaN exactly
+/// when one of its terms is, in any order.
 ///
 /// # Safety
 /// `V`'s instruction set must be present.
@@ -137,24 +147,23 @@ fn origin_maxima(xi: f64, y: &[f64]) -> (f64, f64, f64, bool) {
 #[inline(always)]
 unsafe fn maxima_v<V: crate::lanes_x86::Vector>(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
     let (mut ve, mut ae) = ([0.0f64; 9], [0.0f64; 9]);
-    let (mut big, mut bad) = (0.0f64, false);
+    let mut bad = false;
     for a in 0..3 {
         // SAFETY: the caller's contract
-        let (vm, am, bm, nf) = unsafe { axis_maxima_v::<V>(r.o[a], c[a], c[3 + a], c[6 + a]) };
+        let (vm, am, nan) = unsafe { axis_maxima_v::<V>(r.o[a], c[a], c[3 + a], c[6 + a]) };
         for k in 0..3 {
             ve[3 * k + a] = vm[k];
             ae[3 * k + a] = am[k];
         }
-        big = big.max(bm);
-        bad |= nf;
+        bad |= nan;
     }
-    (ve, ae, big, bad)
+    (ve, ae, largest(ae), bad)
 }
 
 /// One axis of [`maxima_v`]: over the lanes of v0, v1, v2 (and the origin's value `o`) the
-/// largest |v1 − v0|, |v2 − v0|, |o − v0| and |v1| + |v0|, |v2| + |v0|, |o| + |v0|, the largest
-/// |input| and whether an input is not finite; the lanes past the last whole vector by the
-/// scalar steps ([`column_maxima`], [`origin_maxima`]).
+/// largest |v1 − v0|, |v2 − v0|, |o − v0| and |v1| + |v0|, |v2| + |v0|, |o| + |v0|, and whether
+/// an input is NaN; the lanes past the last whole vector by the scalar steps
+/// ([`column_maxima`], [`origin_maxima`]).
 ///
 /// # Safety
 /// `V`'s instruction set must be present.
@@ -165,13 +174,13 @@ unsafe fn axis_maxima_v<V: crate::lanes_x86::Vector>(
     v0: &[f64],
     v1: &[f64],
     v2: &[f64],
-) -> ([f64; 3], [f64; 3], f64, bool) {
+) -> ([f64; 3], [f64; 3], bool) {
     let n = v0.len();
     assert!(v1.len() == n && v2.len() == n, "column lengths differ");
     let whole = n - n % V::N;
     let zero = V::splat(0.0);
     let (mut vm, mut am) = ([zero; 3], [zero; 3]);
-    let (mut bm, mut nf) = (zero, zero);
+    let mut nf = zero;
     let (ox, oa) = (V::splat(o), V::splat(o.abs()));
     let mut i = 0;
     while i < whole {
@@ -185,8 +194,8 @@ unsafe fn axis_maxima_v<V: crate::lanes_x86::Vector>(
             vm[k] = dv[k].max_of(vm[k]);
             am[k] = sv[k].max_of(am[k]);
         }
-        bm = x2a.max_of(x1a.max_of(ya.max_of(bm)));
-        nf = nf + (y * zero + x1 * zero + x2 * zero);
+        // NaN exactly when one of y, x1, x2 is (the third sum repeats y)
+        nf = nf + (sv[0] + sv[1]);
         i += V::N;
     }
     let lanes = |v: V| {
@@ -200,21 +209,17 @@ unsafe fn axis_maxima_v<V: crate::lanes_x86::Vector>(
     let rn = lanes(nf)[..V::N].iter().any(|l| l.is_nan());
     // the tail by the scalar steps (origin_maxima takes |o| and o's finiteness even on an
     // empty tail)
-    let t = [
-        column_maxima(&v1[whole..], &v0[whole..]),
-        column_maxima(&v2[whole..], &v0[whole..]),
-        origin_maxima(o, &v0[whole..]),
-    ];
+    let (ov, oa) = origin_maxima(o, &v0[whole..]);
+    let t = [column_maxima(&v1[whole..], &v0[whole..]), column_maxima(&v2[whole..], &v0[whole..]), (ov, oa, false)];
     let vmax = std::array::from_fn(|k| fold(vm[k], t[k].0));
     let amax = std::array::from_fn(|k| fold(am[k], t[k].1));
-    let big = t.iter().fold(fold(bm, 0.0), |m, x| max(x.2, m));
-    (vmax, amax, big, rn | t.iter().any(|x| x.3))
+    (vmax, amax, rn | t.iter().any(|x| x.2))
 }
 
-/// The accumulators folded (the non-finite flag: a NaN sum).
-fn fold<const W: usize>(vm: [f64; W], am: [f64; W], bm: [f64; W], nf: [f64; W]) -> (f64, f64, f64, bool) {
+/// The accumulators folded (the NaN flag: a NaN sum).
+fn fold<const W: usize>(vm: [f64; W], am: [f64; W], nf: [f64; W]) -> (f64, f64, bool) {
     let m = |x: [f64; W]| x.iter().fold(0.0f64, |m, &v| m.max(v));
-    (m(vm), m(am), m(bm), nf.iter().any(|v| v.is_nan()))
+    (m(vm), m(am), nf.iter().any(|v| v.is_nan()))
 }
 
 fn statics(o: BlockOpts, r: BlockRay, (ve, ae, big, nan): ([f64; 9], [f64; 9], f64, bool)) -> Option<Static> {
@@ -223,6 +228,8 @@ fn statics(o: BlockOpts, r: BlockRay, (ve, ae, big, nan): ([f64; 9], [f64; 9], f
     }
     // the per-test recurrences on magnitudes (`Ctx` in magnitude mode: a difference adds)
     let mut m = Ctx::<f64>::new(o.em, true);
+    // the lanes' inputs' range: `big` is no smaller than any |input| of theirs (an infinite one
+    // makes it infinite and fails the check); the ray's values are checked on their own
     m.input(big);
     for x in r.o {
         m.input(x.abs());
@@ -412,8 +419,9 @@ fn packed(
 
 /// The block's largest magnitudes the static constants come from, on the widest instruction
 /// level `cap` allows and the machine has: per first-difference component (e1 x, y, z, e2 x,
-/// y, z, s x, y, z) the largest |value| and the largest monomial sum, the largest non-NaN |input|, and
-/// whether an input is not finite. The same bits on every level.
+/// y, z, s x, y, z) the largest |value| and the largest monomial sum, the largest of those sums
+/// (no smaller than any non-NaN |input| of the lanes), and whether an input of the lanes is NaN
+/// (an infinite input makes the sums infinite). The same bits on every level.
 pub fn block_maxima(cap: crate::simd::Kernel, ray: BlockRay, tris: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
     let n = tris[0].len();
     assert!(tris.iter().all(|c| c.len() == n), "column lengths differ");
