@@ -173,7 +173,7 @@ macro_rules! rti_kernel {
 /// the format, `$store(column, i, x)` writes results, `$up` steps up on the format's grid,
 /// `$bcast` broadcasts a ray value.
 macro_rules! slab_kernel {
-    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $bcast:expr) => {{
+    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr) => {{
         // one loop per comparator and batch shape, so that neither is decided per vector
         let tof = $s.cfg.nan == SlabNan::TakeOnFalse;
         if $s.cfg.directed {
@@ -190,10 +190,10 @@ macro_rules! slab_kernel {
             return;
         }
         match ($rays, tof) {
-            (SlabRays::Pairs(r), false) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, false),
-            (SlabRays::Pairs(r), true) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, true),
-            (SlabRays::One(r), false) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, false),
-            (SlabRays::One(r), true) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, true),
+            (SlabRays::Pairs(r), false) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, false),
+            (SlabRays::Pairs(r), true) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, true),
+            (SlabRays::One(r), false) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, false),
+            (SlabRays::One(r), true) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, true),
         }
     }};
     // per-batch preparation, hoisted out of the loop: column pointers; for one ray, each
@@ -340,12 +340,13 @@ macro_rules! slab_kernel {
             unsafe { slab_redo(s, SlabRays::One(r), boxes, (o_hit, o_near, o_far), $full) };
         }
     }};
-    (@loop $x:ident, $s:expr, $shape:ident $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $bcast:expr, $tof:expr) => {{
+    (@loop $x:ident, $s:expr, $shape:ident $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, $tof:expr) => {{
         let (s, boxes, out) = ($s, $boxes, $out);
-        let (load, rd, store, up, bcast) = ($load, $round, $store, $up, $bcast);
-        // next-down is next-up mirrored through the sign (negation is exact)
+        let (load, rd, store, upn, bcast) = ($load, $round, $store, $upn, $bcast);
+        let _ = $up; // the widening steps `n` at once
+        // n steps down are n steps up mirrored through the sign (negation is exact)
         let neg = |v| $x::xor(v, $x::splat(-0.0));
-        let down = |v| neg(up(neg(v)));
+        let down_n = |v, n| neg(upn(neg(v), n));
         let bmin = boxes.min.each_ref().map(|c| c.as_ptr());
         let bmax = boxes.max.each_ref().map(|c| c.as_ptr());
         let prep = slab_kernel!(@prep $x, $shape $r, bmin, bmax, bcast);
@@ -388,14 +389,12 @@ macro_rules! slab_kernel {
                 }
             }
             let ends = (tn, tf);
-            for _ in 0..widen.unsigned_abs() {
-                if widen > 0 {
-                    tn = down(tn);
-                    tf = up(tf);
-                } else {
-                    tn = up(tn);
-                    tf = down(tf);
-                }
+            if widen > 0 {
+                tn = down_n(tn, widen.unsigned_abs());
+                tf = upn(tf, widen.unsigned_abs());
+            } else if widen < 0 {
+                tn = upn(tn, widen.unsigned_abs());
+                tf = down_n(tf, widen.unsigned_abs());
             }
             if guard {
                 let unbounded = $x::unord($x::mul(ends.0, zero), $x::mul(ends.1, zero));
@@ -429,10 +428,10 @@ macro_rules! slab_kernel {
 /// t limit flushed but pass it on as it is, so a limit that is a nonzero subnormal encoding
 /// (`$raw_sub`) sends its lane, or the whole one-ray batch, to the scalar model.
 macro_rules! slab_ftz {
-    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $bcast:expr, $min:expr, $raw_sub:expr) => {{
+    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, $min:expr, $raw_sub:expr) => {{
         let (s, rays, boxes, out, full) = ($s, $rays, $boxes, $out, $full);
         if s.fmt.opts.subnormals != Subnormals::Ftz {
-            slab_kernel!($x, s, rays, boxes, out, full, $load, $round, $store, $up, $bcast);
+            slab_kernel!($x, s, rays, boxes, out, full, $load, $round, $store, $up, $upn, $bcast);
         } else {
             let raw_sub = $raw_sub;
             if let SlabRays::One(r) = rays {
@@ -460,6 +459,7 @@ macro_rules! slab_ftz {
                 |x| flush(round(x)),
                 $store,
                 up_ftz,
+                |v, n: u32| (0..n).fold(v, |v, _| up_ftz(v)),
                 |v| flush(bcast(v))
             );
             if let SlabRays::Pairs(r) = rays {
@@ -525,12 +525,12 @@ macro_rules! kernels_for {
     };
     (@f32 $x:ident, $f32feat:literal) => {
         kernels_for!(@format $x, $f32feat, rti_f32, slab_f32, Ieee<F32Native>, f32, load32, store32,
-            |x| x, |v| $x::next_up(v), |x: f32| $x::splat(x), |r: &Rti<Ieee<F32Native>>| r.det_thr,
+            |x| x, |v| $x::next_up(v), |v, n: u32| $x::next_up_n(v, n), |x: f32| $x::splat(x), |r: &Rti<Ieee<F32Native>>| r.det_thr,
             f32::MIN_POSITIVE, |v: f32| v != 0.0 && v.abs() < f32::MIN_POSITIVE);
     };
     (@f16 $x:ident, $f16feat:literal) => {
         kernels_for!(@format $x, $f16feat, rti_f16, slab_f16, Ieee<F16Half>, f16, load16, store16,
-            |v| $x::round16(v), |v| $x::next_up16(v), |x: f16| $x::splat16(x),
+            |v| $x::round16(v), |v| $x::next_up16(v), |v, n: u32| (0..n).fold(v, |v, _| $x::next_up16(v)), |x: f16| $x::splat16(x),
             |r: &Rti<Ieee<F16Half>>| r.det_thr.to_f32(), f16::MIN_POSITIVE.to_f32(), |v: f16| v.to_bits() & 0x7c00 == 0 && v.to_bits() & 0x3ff != 0);
     };
     // one format's RTI and slab kernels: its column type, loads and stores, rounding, grid
@@ -538,7 +538,7 @@ macro_rules! kernels_for {
     // kernel under FTZ flushes every operand read and every rounded result in the lanes: a
     // lane below it becomes zero of its sign)
     (@format $x:ident, $feat:literal, $rti:ident, $slab:ident, $fmt:ty, $v:ty, $load:ident, $store:ident,
-     $round:expr, $up:expr, $bcast:expr, $thr:expr, $min_normal:expr, $raw_sub:expr) => {
+     $round:expr, $up:expr, $upn:expr, $bcast:expr, $thr:expr, $min_normal:expr, $raw_sub:expr) => {
         #[target_feature(enable = $feat)]
         pub fn $rti(rti: &Rti<$fmt>, rays: &RaysSoa<$v>, tris: &TrisSoa<$v>, out: &mut HitsSoa<$v>, full: usize) {
             // SAFETY (loads and stores): the caller checked that every column holds
@@ -587,6 +587,7 @@ macro_rules! kernels_for {
                 $round,
                 |c: *mut $v, i: usize, x| unsafe { $x::$store(c, i, x) },
                 $up,
+                $upn,
                 $bcast,
                 $min_normal,
                 $raw_sub
@@ -709,6 +710,7 @@ macro_rules! narrow_for {
                     |x| $x::round_full(x, n),
                     |c: *mut u64, i: usize, x| unsafe { $x::store_soft(c, i, x, n) },
                     |v| $x::next_up_soft(v, n),
+                    |v, k: u32| (0..k).fold(v, |v, _| $x::next_up_soft(v, n)),
                     |v: u64| $x::splat(f.to_f64(v)),
                     n.min_normal,
                     |v: u64| n.lay.is_subnormal(v)
@@ -809,6 +811,7 @@ macro_rules! bf16_for {
                     |x| $x::round_bf16(x),
                     |c: *mut u16, i: usize, x| unsafe { $x::store_bf16(c, i, x) },
                     |v| $x::next_up_bf16(v),
+                    |v, n: u32| $x::next_up_bf16_n(v, n),
                     |x: u16| $x::splat(f32::from_bits((x as u32) << 16)),
                     f32::MIN_POSITIVE,
                     |v: u16| v & 0x7f80 == 0 && v & 0x7f != 0

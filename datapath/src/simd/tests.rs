@@ -146,3 +146,93 @@ fn round16_in_lanes_equals_the_conversion_on_every_binary32() {
         assert_eq!(bad, None, "(input, lanes, conversion)");
     }
 }
+
+/// The binary32-lane grid steps — one step ([`isa::v8::next_up`], [`isa::v16::next_up`] and
+/// their bf16-grid forms) and `n` steps at once (`next_up_n`, `next_up_bf16_n`, n = 1 … 6, 64,
+/// 65, the widening of the conservative slab variants) — equal the model's `next_up` taken
+/// n times, on every bf16 encoding and on binary32 encodings dense around ±0, the
+/// subnormal/normal boundary, powers of two, ±max, ±∞ and NaNs, plus random ones: the same
+/// bits, or NaN for NaN.
+#[test]
+fn binary32_lane_steps_equal_the_model_n_times() {
+    use crate::rng::SplitMix64;
+    use std::arch::is_x86_feature_detected as has;
+    use std::arch::x86_64::*;
+    let crate::AnyFormat::F32(f32m) = "f32".parse::<crate::AnyFormat>().unwrap() else { unreachable!() };
+    let crate::AnyFormat::Bf16(bf) = "bf16".parse::<crate::AnyFormat>().unwrap() else { unreachable!() };
+    let mut enc: Vec<u32> = Vec::new();
+    for centre in [0u32, 0x0080_0000, 0x3f80_0000, 0x4000_0000, 0x7f7f_ff00, 0x7f80_0000, 0x7fc0_0000] {
+        for sign in [0, 0x8000_0000u32] {
+            for k in 0..600u32 {
+                enc.push((centre | sign).wrapping_add(k).wrapping_sub(300));
+            }
+        }
+    }
+    let mut r = SplitMix64::new(5);
+    enc.extend((0..20_000).map(|_| r.next_u64() as u32));
+    let bfe: Vec<u32> = (0..1u32 << 16).map(|b| b << 16).collect();
+    let same = |g: f32, w: f32| g.to_bits() == w.to_bits() || (g.is_nan() && w.is_nan());
+    for (grid, encs) in [(1u32, &enc), (16, &bfe)] {
+        let model = |b: u32, n: u32| -> f32 {
+            if grid == 1 {
+                (0..n).fold(f32::from_bits(b), |v, _| f32m.next_up(v))
+            } else {
+                f32::from_bits(((0..n).fold((b >> 16) as u16, |v, _| bf.next_up(v)) as u32) << 16)
+            }
+        };
+        for n in [1u32, 2, 3, 4, 5, 6, 64, 65] {
+            for lanes in encs.chunks(16) {
+                let mut x = [0.0f32; 16];
+                for (k, &b) in lanes.iter().enumerate() {
+                    x[k] = f32::from_bits(b);
+                }
+                let want: Vec<f32> = x.iter().map(|v| model(v.to_bits(), n)).collect();
+                let mut got: Vec<(&str, [f32; 16])> = Vec::new();
+                if has!("avx2") {
+                    // SAFETY: AVX2 was detected; [f32; 8] and __m256 have the same size
+                    let run = |h: [f32; 8]| unsafe {
+                        let v = std::mem::transmute::<[f32; 8], __m256>(h);
+                        let (one, many) = if grid == 1 {
+                            (isa::v8::next_up(v), isa::v8::next_up_n(v, n))
+                        } else {
+                            (isa::v8::next_up_bf16(v), isa::v8::next_up_bf16_n(v, n))
+                        };
+                        let one =
+                            (1..n).fold(
+                                one,
+                                |v, _| if grid == 1 { isa::v8::next_up(v) } else { isa::v8::next_up_bf16(v) },
+                            );
+                        (std::mem::transmute::<__m256, [f32; 8]>(one), std::mem::transmute::<__m256, [f32; 8]>(many))
+                    };
+                    let (a, b) = (run(x[..8].try_into().unwrap()), run(x[8..].try_into().unwrap()));
+                    got.push(("v8 one step", std::array::from_fn(|k| if k < 8 { a.0[k] } else { b.0[k - 8] })));
+                    got.push(("v8 n steps", std::array::from_fn(|k| if k < 8 { a.1[k] } else { b.1[k - 8] })));
+                }
+                if has!("avx512f") {
+                    // SAFETY: AVX-512F was detected; [f32; 16] and __m512 have the same size
+                    let (one, many) = unsafe {
+                        let v = std::mem::transmute::<[f32; 16], __m512>(x);
+                        let step = |v| if grid == 1 { isa::v16::next_up(v) } else { isa::v16::next_up_bf16(v) };
+                        let many = if grid == 1 { isa::v16::next_up_n(v, n) } else { isa::v16::next_up_bf16_n(v, n) };
+                        ((0..n).fold(v, |v, _| step(v)), many)
+                    };
+                    // SAFETY: as above
+                    got.push(("v16 one step", unsafe { std::mem::transmute::<__m512, [f32; 16]>(one) }));
+                    // SAFETY: as above
+                    got.push(("v16 n steps", unsafe { std::mem::transmute::<__m512, [f32; 16]>(many) }));
+                }
+                for (what, g) in got {
+                    for k in 0..lanes.len() {
+                        assert!(
+                            same(g[k], want[k]),
+                            "{what}, grid {grid}, n {n}: {:#x} -> {:#x}, the model {:#x}",
+                            x[k].to_bits(),
+                            g[k].to_bits(),
+                            want[k].to_bits()
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

@@ -194,22 +194,53 @@ pub fn round16(x: __m512) -> __m512 {
 pub fn next_up(v: __m512) -> __m512 {
     next_up_by(v, 1)
 }
-/// The step up by `unit` encodings of binary32 (1: binary32's grid, 2^16: bf16's): NaN
-/// and +inf unchanged, ±0 to `unit`, negative values `unit` encodings toward zero.
+/// The step up by `unit` encodings of binary32 (1: binary32's grid, 2^16: bf16's), as
+/// [`super::v8::next_up_by`]: NaN and +inf unchanged, ±0 to `unit`, negative values `unit`
+/// encodings toward zero.
 #[inline]
 #[target_feature(enable = "avx512f")]
 fn next_up_by(v: __m512, unit: i32) -> __m512 {
-    let b = _mm512_castps_si512(v);
-    let keep = _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(v, v) | _mm512_cmpeq_epi32_mask(b, _mm512_set1_epi32(0x7f80_0000));
-    let zero = _mm512_testn_epi32_mask(b, _mm512_set1_epi32(0x7fff_ffff));
-    // negative: bits - unit, positive: bits + unit
-    let step = _mm512_add_epi32(
-        _mm512_and_si512(_mm512_srai_epi32::<31>(b), _mm512_set1_epi32(-2 * unit)),
-        _mm512_set1_epi32(unit),
-    );
+    let b = _mm512_castps_si512(_mm512_add_ps(v, _mm512_setzero_ps()));
+    let keep = _mm512_cmp_ps_mask::<_CMP_NLT_UQ>(v, _mm512_set1_ps(f32::INFINITY));
+    let one = _mm512_or_si512(_mm512_srai_epi32::<31>(b), _mm512_set1_epi32(1));
+    let step = _mm512_sllv_epi32(one, _mm512_set1_epi32(unit.trailing_zeros() as i32));
     let r = _mm512_add_epi32(b, step);
-    let r = _mm512_mask_blend_epi32(zero, r, _mm512_set1_epi32(unit));
-    _mm512_castsi512_ps(_mm512_mask_blend_epi32(keep, r, b))
+    _mm512_castsi512_ps(_mm512_mask_blend_epi32(keep, r, _mm512_castps_si512(v)))
+}
+/// `n` steps of [`next_up_by`] at once, as [`super::v8::next_up_by_n`].
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn next_up_by_n(v: __m512, units: i32) -> __m512 {
+    debug_assert!((1..=1 << 24).contains(&units));
+    let b = _mm512_castps_si512(v);
+    let sgn = _mm512_srai_epi32::<31>(b);
+    let mag = _mm512_and_si512(b, _mm512_set1_epi32(0x7fff_ffff));
+    let key = _mm512_sub_epi32(_mm512_xor_si512(mag, sgn), sgn);
+    let top = 0x7f80_0000;
+    let k = _mm512_add_epi32(_mm512_min_epi32(key, _mm512_set1_epi32(top - units)), _mm512_set1_epi32(units));
+    let neg = _mm512_cmplt_epi32_mask(k, _mm512_set1_epi32(1));
+    let r = _mm512_mask_or_epi32(_mm512_abs_epi32(k), neg, _mm512_abs_epi32(k), _mm512_set1_epi32(i32::MIN));
+    _mm512_castsi512_ps(_mm512_mask_blend_epi32(_mm512_cmp_ps_mask::<_CMP_UNORD_Q>(v, v), r, b))
+}
+/// `n` steps of [`next_up`].
+#[inline]
+#[target_feature(enable = "avx512f")]
+pub fn next_up_n(v: __m512, n: u32) -> __m512 {
+    if n <= 64 {
+        next_up_by_n(v, n as i32)
+    } else {
+        (0..n).fold(v, |v, _| next_up(v))
+    }
+}
+/// `n` steps of [`next_up_bf16`].
+#[inline]
+#[target_feature(enable = "avx512f")]
+pub fn next_up_bf16_n(v: __m512, n: u32) -> __m512 {
+    if n <= 64 {
+        next_up_by_n(v, (n as i32) << 16)
+    } else {
+        (0..n).fold(v, |v, _| next_up_bf16(v))
+    }
 }
 /// [`next_up`] on the bf16 grid, for lanes that hold bf16 values (a step of 2^16 in the
 /// binary32 encoding; NaN and +inf unchanged, ±0 to the least bf16 subnormal).

@@ -193,24 +193,58 @@ pub fn next_up(v: __m256) -> __m256 {
     next_up_by(v, 1)
 }
 /// The step up by `unit` encodings of binary32 (1: binary32's grid, 2^16: bf16's): NaN
-/// and +inf unchanged, ±0 to `unit`, negative values `unit` encodings toward zero.
+/// and +inf unchanged, ±0 to `unit`, negative values `unit` encodings toward zero. (−0 is
+/// first made +0 by adding +0, exact for every other number; a NaN's bits are kept.)
 #[inline]
 #[target_feature(enable = "avx2")]
 pub(in crate::simd) fn next_up_by(v: __m256, unit: i32) -> __m256 {
-    let b = _mm256_castps_si256(v);
-    let keep = _mm256_or_si256(
-        _mm256_castps_si256(_mm256_cmp_ps::<_CMP_UNORD_Q>(v, v)),
-        _mm256_cmpeq_epi32(b, _mm256_set1_epi32(0x7f80_0000)),
-    );
-    let zero = _mm256_cmpeq_epi32(_mm256_and_si256(b, _mm256_set1_epi32(0x7fff_ffff)), _mm256_setzero_si256());
-    // negative: bits - unit, positive: bits + unit
-    let step = _mm256_add_epi32(
-        _mm256_and_si256(_mm256_srai_epi32::<31>(b), _mm256_set1_epi32(-2 * unit)),
-        _mm256_set1_epi32(unit),
-    );
+    let b = _mm256_castps_si256(_mm256_add_ps(v, _mm256_setzero_ps()));
+    // NaN or +inf: kept
+    let keep = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_NLT_UQ>(v, _mm256_set1_ps(f32::INFINITY)));
+    // negative: bits − unit, positive (+0 included): bits + unit
+    let one = _mm256_or_si256(_mm256_srai_epi32::<31>(b), _mm256_set1_epi32(1));
+    // (unit a power of two: ±1 shifted)
+    let step = _mm256_sllv_epi32(one, _mm256_set1_epi32(unit.trailing_zeros() as i32));
     let r = _mm256_add_epi32(b, step);
-    let r = _mm256_blendv_epi8(r, _mm256_set1_epi32(unit), zero);
-    _mm256_castsi256_ps(_mm256_blendv_epi8(r, b, keep))
+    _mm256_castsi256_ps(_mm256_blendv_epi8(r, _mm256_castps_si256(v), keep))
+}
+/// `n` steps of [`next_up_by`] at once, `unit · n` (`units`) at most 2^24: on the ordered
+/// key k = ±|bits| (the sign's, −0 and +0 both 0) a step adds `unit`, up to +inf's key
+/// 2^31 − 2^23, and a key k ≤ 0 is the negative value of magnitude −k (0: −0, which only a
+/// step from below reaches); NaN kept.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(in crate::simd) fn next_up_by_n(v: __m256, units: i32) -> __m256 {
+    debug_assert!((1..=1 << 24).contains(&units));
+    let b = _mm256_castps_si256(v);
+    let sgn = _mm256_srai_epi32::<31>(b);
+    let mag = _mm256_and_si256(b, _mm256_set1_epi32(0x7fff_ffff));
+    let key = _mm256_sub_epi32(_mm256_xor_si256(mag, sgn), sgn);
+    let top = 0x7f80_0000;
+    let k = _mm256_add_epi32(_mm256_min_epi32(key, _mm256_set1_epi32(top - units)), _mm256_set1_epi32(units));
+    let neg = _mm256_cmpgt_epi32(_mm256_set1_epi32(1), k);
+    let r = _mm256_or_si256(_mm256_abs_epi32(k), _mm256_and_si256(neg, _mm256_set1_epi32(i32::MIN)));
+    _mm256_castsi256_ps(_mm256_blendv_epi8(r, b, _mm256_castps_si256(_mm256_cmp_ps::<_CMP_UNORD_Q>(v, v))))
+}
+/// `n` steps of [`next_up`].
+#[inline]
+#[target_feature(enable = "avx2")]
+pub fn next_up_n(v: __m256, n: u32) -> __m256 {
+    if n <= 64 {
+        next_up_by_n(v, n as i32)
+    } else {
+        (0..n).fold(v, |v, _| next_up(v))
+    }
+}
+/// `n` steps of [`next_up_bf16`].
+#[inline]
+#[target_feature(enable = "avx2")]
+pub fn next_up_bf16_n(v: __m256, n: u32) -> __m256 {
+    if n <= 64 {
+        next_up_by_n(v, (n as i32) << 16)
+    } else {
+        (0..n).fold(v, |v, _| next_up_bf16(v))
+    }
 }
 /// [`next_up`] on the bf16 grid, for lanes that hold bf16 values (a step of 2^16 in the
 /// binary32 encoding; NaN and +inf unchanged, ±0 to the least bf16 subnormal).
