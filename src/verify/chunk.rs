@@ -146,10 +146,11 @@ struct Variant<F: Format> {
 /// defaults. (The quantised triangle is converted from the model's, or kept in
 /// [`Setup::qs`].)
 #[derive(Clone, Copy)]
+#[repr(C, align(64))]
 struct Rec<V> {
     m: [V; 9],
-    b: [f64; 6],
     s: [V; 6],
+    b: [f64; 6],
 }
 
 /// What every chunk of one format's pass shares (O(scene), built once).
