@@ -710,7 +710,7 @@ macro_rules! narrow_for {
                     |x| $x::round_full(x, n),
                     |c: *mut u64, i: usize, x| unsafe { $x::store_soft(c, i, x, n) },
                     |v| $x::next_up_soft(v, n),
-                    |v, k: u32| (0..k).fold(v, |v, _| $x::next_up_soft(v, n)),
+                    |v, k: u32| $x::next_up_soft_n(v, k, n),
                     |v: u64| $x::splat(f.to_f64(v)),
                     n.min_normal,
                     |v: u64| n.lay.is_subnormal(v)

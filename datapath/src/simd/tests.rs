@@ -71,37 +71,49 @@ fn the_range_filter_is_the_documented_predicate() {
 }
 
 /// The lanes' grid step equals the model's `next_up` on every encoding of small formats
-/// (subnormals, ±0, ±max, ±∞ dense), on every binary64-lane ISA here. (Under FTZ the step
-/// goes through `slab_ftz!`, held to the model by the slab proptests in `:ftz`.)
+/// (subnormals, ±0, ±max, ±∞ dense), on every binary64-lane ISA here, and `k` steps at once
+/// (`next_up_soft_n`, k = 1, 2, 4, 5, 64; binary32's key for `e8mM`) the model's `next_up`
+/// taken k times. (Under FTZ the step goes through `slab_ftz!`, held to the model by the slab
+/// proptests in `:ftz`.)
 #[test]
 fn next_up_in_binary64_lanes_equals_the_model_on_every_encoding() {
     use std::arch::is_x86_feature_detected as has;
-    for name in ["e5m4", "e4m3", "e3m2", "e2m1", "e8m7", "e5m10", "e6m9"] {
+    for name in ["e5m4", "e4m3", "e3m2", "e2m1", "e8m7", "e8m2", "e5m10", "e6m9"] {
         let crate::AnyFormat::Soft(f) = name.parse::<crate::AnyFormat>().unwrap() else { unreachable!() };
         let f: Ieee<Soft> = f;
         let n = super::select::narrow_of(&f).unwrap();
         let lay = n.lay;
         let vals: Vec<u64> = (0..1u64 << lay.width()).filter(|&b| !lay.is_nan(b)).collect();
-        for &b in &vals {
-            let want = f.to_f64(f.next_up(f.from_bits(b)));
-            let x = f.to_f64(f.from_bits(b));
-            let mut got = Vec::new();
-            if has!("avx2") && has!("fma") {
-                // SAFETY: the features were detected.
-                let v = unsafe {
-                    std::mem::transmute::<std::arch::x86_64::__m256d, [f64; 4]>(v4d::next_up_soft(v4d::splat(x), &n))
-                };
-                got.push(v[0]);
-            }
-            if has!("avx512f") {
-                // SAFETY: the feature was detected.
-                let v = unsafe {
-                    std::mem::transmute::<std::arch::x86_64::__m512d, [f64; 8]>(v8d::next_up_soft(v8d::splat(x), &n))
-                };
-                got.push(v[0]);
-            }
-            for g in got {
-                assert_eq!(g.to_bits(), want.to_bits(), "{name}: next_up({x:e}) = {g:e}, the model {want:e}");
+        for k in [1u32, 2, 4, 5, 64] {
+            for &b in &vals {
+                let want = f.to_f64((0..k).fold(f.from_bits(b), |v, _| f.next_up(v)));
+                let x = f.to_f64(f.from_bits(b));
+                let mut got = Vec::new();
+                if has!("avx2") && has!("fma") {
+                    // SAFETY: the features were detected.
+                    let (one, many) = unsafe {
+                        let one = (0..k).fold(v4d::splat(x), |v, _| v4d::next_up_soft(v, &n));
+                        let t = |v| std::mem::transmute::<std::arch::x86_64::__m256d, [f64; 4]>(v);
+                        (t(one), t(v4d::next_up_soft_n(v4d::splat(x), k, &n)))
+                    };
+                    got.extend([("v4d one step", one[0]), ("v4d k steps", many[3])]);
+                }
+                if has!("avx512f") {
+                    // SAFETY: the feature was detected.
+                    let (one, many) = unsafe {
+                        let one = (0..k).fold(v8d::splat(x), |v, _| v8d::next_up_soft(v, &n));
+                        let t = |v| std::mem::transmute::<std::arch::x86_64::__m512d, [f64; 8]>(v);
+                        (t(one), t(v8d::next_up_soft_n(v8d::splat(x), k, &n)))
+                    };
+                    got.extend([("v8d one step", one[0]), ("v8d k steps", many[7])]);
+                }
+                for (what, g) in got {
+                    assert_eq!(
+                        g.to_bits(),
+                        want.to_bits(),
+                        "{name} {what}, k {k}: from {x:e} to {g:e}, the model {want:e}"
+                    );
+                }
             }
         }
     }

@@ -241,3 +241,17 @@ pub unsafe fn store_soft(p: *mut u64, i: usize, x: __m256d, n: &Narrow) {
     let r = blend(r, _mm256_castsi256_pd(int(l.canonical_nan())), unord(x, x));
     unsafe { _mm256_storeu_si256(p.add(i) as *mut __m256i, _mm256_castpd_si256(r)) }
 }
+/// [`super::v8d::next_up_soft_n`] on 4 lanes.
+#[inline]
+#[target_feature(enable = "avx2,fma")]
+pub fn next_up_soft_n(x: __m256d, k: u32, n: &Narrow) -> __m256d {
+    if n.e8 && k <= 64 && (k << n.e8_shift) <= 1 << 24 {
+        // exact both ways: the lanes are binary32 values (the upper four binary32 lanes of
+        // the step are don't-care)
+        let f = _mm256_castps128_ps256(_mm256_cvtpd_ps(x));
+        let r = _mm256_castps256_ps128(super::v8::next_up_by_n(f, (k << n.e8_shift) as i32));
+        blend(_mm256_cvtps_pd(r), x, _mm256_cmp_pd::<_CMP_UNORD_Q>(x, x))
+    } else {
+        (0..k).fold(x, |v, _| next_up_soft(v, n))
+    }
+}

@@ -267,3 +267,18 @@ pub unsafe fn store_soft(p: *mut u64, i: usize, x: __m512d, n: &Narrow) {
     let r = blend(r, fb(int(l.canonical_nan())), unord(x, x));
     unsafe { _mm512_storeu_si512(p.add(i) as *mut __m512i, ib(r)) }
 }
+/// `k` steps of [`next_up_soft`] at once (lanes holding `eEmM` values): for `e8mM`
+/// (`n.e8`) with k·2^(23 − M) at most 2^24, on binary32 — which holds every `e8mM` value,
+/// its grid being binary32's every 2^(23 − M)-th encoding, subnormals included — by
+/// [`super::v8::next_up_by_n`] (NaN lanes kept as they are); else k single steps.
+#[inline]
+#[target_feature(enable = "avx512f,avx2")]
+pub fn next_up_soft_n(x: __m512d, k: u32, n: &Narrow) -> __m512d {
+    if n.e8 && k <= 64 && (k << n.e8_shift) <= 1 << 24 {
+        // exact both ways: the lanes are binary32 values
+        let r = super::v8::next_up_by_n(_mm512_cvtpd_ps(x), (k << n.e8_shift) as i32);
+        blend(_mm512_cvtps_pd(r), x, _mm512_cmp_pd_mask::<_CMP_UNORD_Q>(x, x))
+    } else {
+        (0..k).fold(x, |v, _| next_up_soft(v, n))
+    }
+}
