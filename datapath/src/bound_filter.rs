@@ -546,24 +546,29 @@ fn packed(
     let mut cols = [[0.0f64; PACK]; 9];
     let (mut dec, mut hi, mut te) = ([false; PACK], [false; PACK], [0.0f64; PACK]);
     let mut lanes = [0usize; PACK];
+    if let Some((d, h, t)) = fill {
+        // every lane's outputs filled; the lanes not skipped are written again below
+        decisive.fill(d);
+        hit.fill(h);
+        t_err.fill(t);
+    }
     let mut i = 0;
     while i < n {
-        // the next group: up to PACK lanes not skipped
+        // the next group: up to PACK lanes not skipped, their indices appended branch-free
+        // (each lane's index written, the count moved on only past a lane not skipped)
         let mut m = 0;
         while i < n && m < PACK {
-            if !skip[i] {
-                for (c, col) in cols.iter_mut().enumerate() {
-                    col[m] = tris[c][i];
-                }
-                lanes[m] = i;
-                m += 1;
-            } else if let Some(v) = fill {
-                (decisive[i], hit[i], t_err[i]) = v;
-            }
+            lanes[m] = i;
+            m += !skip[i] as usize;
             i += 1;
         }
         if m == 0 {
             break;
+        }
+        for (col, src) in cols.iter_mut().zip(tris) {
+            for (x, &l) in col.iter_mut().zip(&lanes[..m]) {
+                *x = src[l];
+            }
         }
         let c: [&[f64]; 9] = std::array::from_fn(|k| &cols[k][..m]);
         verdict(c, &mut dec[..m], &mut hi[..m], &mut te[..m]);
