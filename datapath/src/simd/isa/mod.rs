@@ -158,6 +158,9 @@ macro_rules! narrow_ops {
         #[inline]
         #[target_feature(enable = $feat)]
         pub fn next_up_soft(x: $v, n: &Narrow) -> $v {
+            if let Some(r) = step_inside(x, n) {
+                return r;
+            }
             let zero = splat(0.0);
             let a = abs(x);
             let toward = lt(x, zero);

@@ -162,6 +162,25 @@ fn any_outside_normal(a: __m256d, n: &Narrow) -> bool {
     let odd = _mm256_cmpgt_epi64(t, int((hi - lo - 1) ^ (1u64 << 63)));
     _mm256_testz_si256(odd, odd) == 0
 }
+/// [`super::v8d::next_up_soft`]'s normal-range step on 4 lanes (the range test as
+/// [`any_outside_normal`] reads it: AVX2's signed compare after adding 2^63).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn step_inside(x: __m256d, n: &Narrow) -> Option<__m256d> {
+    let b = _mm256_castpd_si256(x);
+    let a = _mm256_and_si256(b, int(0x7fff_ffff_ffff_ffff));
+    let (lo, hi) = (n.min_normal.to_bits() + 1, n.max_finite.to_bits());
+    let t = _mm256_add_epi64(a, int((1u64 << 63).wrapping_sub(lo)));
+    let odd = _mm256_cmpgt_epi64(t, int((hi - lo - 1) ^ (1u64 << 63)));
+    if _mm256_testz_si256(odd, odd) == 0 {
+        return None;
+    }
+    // ±2^(52 − M): its negation where the sign bit is set
+    let m = _mm256_sub_epi64(_mm256_setzero_si256(), _mm256_srli_epi64::<63>(b));
+    let step = int(1u64 << (52 - n.lay.man_bits));
+    let signed = _mm256_sub_epi64(_mm256_xor_si256(step, m), m);
+    Some(_mm256_castsi256_pd(_mm256_add_epi64(b, signed)))
+}
 narrow_ops!("avx2", "avx2,fma", __m256d, _mm256_fmadd_pd, _mm256_fmsub_pd);
 /// Loads 4 `eEmM` encodings as binary64 (exact).
 ///

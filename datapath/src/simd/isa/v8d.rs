@@ -169,6 +169,23 @@ fn any_outside_normal(a: __m512d, n: &Narrow) -> bool {
     let (lo, hi) = (n.min_normal.to_bits(), n.overflow_at.to_bits());
     _mm512_cmpge_epu64_mask(_mm512_sub_epi64(ib(a), int(lo)), int(hi - lo)) != 0
 }
+/// [`next_up_soft`] when every lane's magnitude is strictly between 2^emin and the format's
+/// largest (else `None`): there a format value's binary64 encoding has its fraction in the top
+/// M of 52 bits, and the next value up is the encoding plus 2^(52 − M) (a positive lane) or
+/// minus it (a negative one, toward zero) — a carry or borrow into the exponent lands on the
+/// next binade's first or the binade below's last value, both normal.
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn step_inside(x: __m512d, n: &Narrow) -> Option<__m512d> {
+    let b = ib(x);
+    let a = _mm512_and_si512(b, int(0x7fff_ffff_ffff_ffff));
+    let (lo, hi) = (n.min_normal.to_bits() + 1, n.max_finite.to_bits());
+    if _mm512_cmpge_epu64_mask(_mm512_sub_epi64(a, int(lo)), int(hi - lo)) != 0 {
+        return None;
+    }
+    let one = _mm512_or_si512(_mm512_srai_epi64::<63>(b), int(1));
+    Some(fb(_mm512_add_epi64(b, _mm512_sll_epi64(one, count(52 - n.lay.man_bits)))))
+}
 narrow_ops!("avx512f", "avx512f", __m512d, _mm512_fmadd_pd, _mm512_fmsub_pd);
 /// Loads 8 `eEmM` encodings as binary64 (exact).
 ///
