@@ -402,6 +402,10 @@ fn statics(o: BlockOpts, r: BlockRay, (ve, ae, big, nan): ([f64; 9], [f64; 9], f
     (!m.overflow).then(|| Static { det: det.err(), up: up.err(), vp: vp.err(), tp: tp.err(), uv: uv.err(), lane: None })
 }
 
+/// Relative room of [`certify`]'s test for a quotient that surely overflows (a speed choice:
+/// such a lane skips the three one-by-one checks, which it would fail).
+const HOPELESS: f64 = 1.0 / (1u64 << 30) as f64;
+
 /// Relative margin of the quotient check below: it absorbs the per-test bound's roundings of
 /// `q`, `Δ₁`, `mag` and `extra` (at most about ten binary64 roundings, a factor below
 /// 1 + 2⁻⁴⁹) and this check's own (a dozen more).
@@ -729,8 +733,12 @@ fn certify_with<const LANE: bool>(
         let e_num = e[3].max(e[1]).max(e[2]);
         let over = quot_may_overflow(recip, u, eta, max, x, e_num, e[0], d);
         out[i] = cleared & !over;
-        mark[i] = if cleared & over { 1.0 } else { 0.0 };
-        near |= cleared & over;
+        // a lane whose largest quotient surely leaves the range (|num| >= max·|det|, with room)
+        // fails the three checks too: not marked (leaving a lane uncertified is always safe)
+        let hopeless = x >= max * (d + e[0]) * (1.0 + HOPELESS);
+        let again = cleared & over & !hopeless;
+        mark[i] = if again { 1.0 } else { 0.0 };
+        near |= again;
     }
     if near {
         for i in 0..out.len() {
