@@ -1459,7 +1459,7 @@ mod draw {
 
 mod widen {
     use datapath::rng::SplitMix64;
-    use datapath::simd::widen::{bf16_to_f64, f32_to_f64};
+    use datapath::simd::widen::{bf16_to_f64, f16_to_f64, f32_to_f64};
     use datapath::simd::{kernels_here, with_kernel_cap};
 
     /// Every binary32 class (zeros, subnormals, normals, infinities, NaNs) widens to the
@@ -1487,6 +1487,27 @@ mod widen {
                     assert!(
                         y.to_bits() == want.to_bits() || (y.is_nan() && want.is_nan()),
                         "{k:?} lane {i}: {x:?} -> {y:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Every binary16 encoding widens to `half`'s `to_f64` of it (the same bits; a NaN a NaN)
+    /// on every kernel, whole and at ragged lengths.
+    #[test]
+    fn every_binary16_encoding_widens_to_its_value() {
+        let src: Vec<half::f16> = (0..=u16::MAX).map(half::f16::from_bits).collect();
+        for k in kernels_here() {
+            for len in [src.len(), 0, 1, 7, 8, 9, 15, 16, 17, 1000] {
+                let mut dst = vec![0.5; len];
+                with_kernel_cap(k, || f16_to_f64(k, &src[..len], &mut dst));
+                for (&x, &y) in src.iter().zip(&dst) {
+                    let want = x.to_f64();
+                    assert!(
+                        y.to_bits() == want.to_bits() || (y.is_nan() && want.is_nan()),
+                        "{k:?} {:#06x} -> {y:?}",
+                        x.to_bits()
                     );
                 }
             }

@@ -1,4 +1,4 @@
-//! Widening a binary32 or bfloat16 column to binary64: `dst[k] = src[k] as f64` (bfloat16:
+//! Widening a binary32, bfloat16 or binary16 column to binary64: `dst[k] = src[k] as f64` (bfloat16:
 //! its encoding shifted into binary32's upper half first), exact for every value (a NaN stays
 //! a NaN, as Rust's cast leaves it: the same as the one-value cast), on the widest lanes the
 //! machine has (AVX-512F: 8, AVX2: 4, else the compiler's baseline).
@@ -21,6 +21,68 @@ pub fn f32_to_f64(cap: Kernel, src: &[f32], dst: &mut [f64]) {
 /// If the lengths differ.
 pub fn bf16_to_f64(cap: Kernel, src: &[u16], dst: &mut [f64]) {
     widen_column(cap, src, dst)
+}
+
+/// `dst[k] = src[k].to_f64()` for every `k` (binary16, exact; a NaN stays a NaN), by the
+/// hardware conversions where `cap`, the thread's cap and the machine allow (AVX-512F's
+/// `vcvtph2ps`, or F16C's on AVX2, then `vcvtps2pd`), else `half`'s slice conversion.
+///
+/// # Panics
+/// If the lengths differ.
+pub fn f16_to_f64(cap: Kernel, src: &[half::f16], dst: &mut [f64]) {
+    use half::slice::HalfFloatSliceExt;
+    assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
+    let done = match f64_lanes(cap) {
+        // SAFETY: AVX-512F is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 => unsafe { f16_avx512(src, dst) },
+        // SAFETY: AVX2 is present (f64_lanes detected it) and F16C (checked)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx2 if std::arch::is_x86_feature_detected!("f16c") => unsafe { f16_avx2(src, dst) },
+        _ => 0,
+    };
+    src[done..].convert_to_f64_slice(&mut dst[done..]);
+}
+
+/// The whole 16-value steps of [`f16_to_f64`] on AVX-512F; returns the values done.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn f16_avx512(src: &[half::f16], dst: &mut [f64]) -> usize {
+    use std::arch::x86_64::*;
+    let whole = src.len() - src.len() % 16;
+    let mut i = 0;
+    while i < whole {
+        // SAFETY: i + 16 <= both lengths (equal); f16 is 16 bits of plain data
+        unsafe {
+            let h = _mm256_loadu_si256(src.as_ptr().add(i).cast());
+            let f = _mm512_cvtph_ps(h);
+            let lo = _mm512_cvtps_pd(_mm512_castps512_ps256(f));
+            let hi = _mm512_cvtps_pd(_mm256_castpd_ps(_mm512_extractf64x4_pd::<1>(_mm512_castps_pd(f))));
+            _mm512_storeu_pd(dst.as_mut_ptr().add(i), lo);
+            _mm512_storeu_pd(dst.as_mut_ptr().add(i + 8), hi);
+        }
+        i += 16;
+    }
+    whole
+}
+
+/// The whole 8-value steps of [`f16_to_f64`] on AVX2 with F16C; returns the values done.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,f16c")]
+fn f16_avx2(src: &[half::f16], dst: &mut [f64]) -> usize {
+    use std::arch::x86_64::*;
+    let whole = src.len() - src.len() % 8;
+    let mut i = 0;
+    while i < whole {
+        // SAFETY: i + 8 <= both lengths (equal); f16 is 16 bits of plain data
+        unsafe {
+            let f = _mm256_cvtph_ps(_mm_loadu_si128(src.as_ptr().add(i).cast()));
+            _mm256_storeu_pd(dst.as_mut_ptr().add(i), _mm256_cvtps_pd(_mm256_castps256_ps128(f)));
+            _mm256_storeu_pd(dst.as_mut_ptr().add(i + 4), _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(f)));
+        }
+        i += 8;
+    }
+    whole
 }
 
 /// Either column on the binary64 lanes [`f64_lanes`] picks.
