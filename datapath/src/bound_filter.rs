@@ -170,6 +170,7 @@ impl LaneCtx {
 
 /// The per-lane constants of a block from its largest magnitudes (as [`statics`] reads them),
 /// or `None` when the block's range check fails.
+#[inline(always)]
 fn lane_consts(o: BlockOpts, r: BlockRay, big: f64, ve: [f64; 9], ae: [f64; 9]) -> Option<LaneConsts> {
     let mut l = LaneCtx { u: o.em.u, eta: o.em.eta + TAU, add_eta: o.em.add_eta + TAU, max: o.em.max, ok: true };
     // the lanes' inputs and the ray's (as `statics` checks them)
@@ -368,6 +369,7 @@ fn fold<const W: usize>(vm: [f64; W], am: [f64; W], nf: [f64; W]) -> (f64, f64, 
     (m(vm), m(am), nf.iter().any(|v| v.is_nan()))
 }
 
+#[inline(always)]
 fn statics(o: BlockOpts, r: BlockRay, (ve, ae, big, nan): ([f64; 9], [f64; 9], f64, bool)) -> Option<Static> {
     if nan || r.o.iter().chain(&r.d).any(|x| x.is_nan()) {
         return None;
