@@ -1459,7 +1459,7 @@ mod draw {
 
 mod widen {
     use datapath::rng::SplitMix64;
-    use datapath::simd::widen::{bf16_to_f64, f16_to_f64, f32_to_f64};
+    use datapath::simd::widen::{bf16_to_f64, f16_to_f64, f32_to_f64, fixed_to_f64};
     use datapath::simd::{kernels_here, with_kernel_cap};
 
     /// Every binary32 class (zeros, subnormals, normals, infinities, NaNs) widens to the
@@ -1488,6 +1488,28 @@ mod widen {
                         y.to_bits() == want.to_bits() || (y.is_nan() && want.is_nan()),
                         "{k:?} lane {i}: {x:?} -> {y:?}"
                     );
+                }
+            }
+        }
+    }
+
+    /// A fixed-point column widens to the one-value `raw as f64 * 2^-F` on every kernel (the
+    /// same bits): values of every magnitude up to ±2^63, those past 2^53 rounding alike, at
+    /// ragged lengths, for several F.
+    #[test]
+    fn a_fixed_point_column_widens_as_each_value() {
+        let mut g = SplitMix64::new(9);
+        for f in [0, 8, 16, 24, 31, 63] {
+            let scale = 2f64.powi(-f);
+            for len in [0, 1, 7, 8, 9, 17, 256, 300] {
+                let src: Vec<i64> =
+                    (0..len).map(|i| (g.next_u64() as i64) >> (i % 64)).chain([i64::MIN, i64::MAX, 0, -1]).collect();
+                for k in kernels_here() {
+                    let mut dst = vec![0.5; src.len()];
+                    with_kernel_cap(k, || fixed_to_f64(k, &src, scale, &mut dst));
+                    for (&x, &y) in src.iter().zip(&dst) {
+                        assert_eq!(y.to_bits(), (x as f64 * scale).to_bits(), "{k:?} F {f} {x}");
+                    }
                 }
             }
         }

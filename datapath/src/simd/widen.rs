@@ -85,6 +85,49 @@ fn f16_avx2(src: &[half::f16], dst: &mut [f64]) -> usize {
     whole
 }
 
+/// Whether [`fixed_to_f64`] runs in vector lanes here (AVX-512F and AVX-512DQ, within `cap`
+/// and the thread's cap).
+pub fn fixed_in_lanes(cap: Kernel) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        f64_lanes(cap) == F64Lanes::Avx512 && std::arch::is_x86_feature_detected!("avx512dq")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = cap;
+        false
+    }
+}
+
+/// `dst[k] = src[k] as f64 * scale` for every `k` (a fixed-point column, `scale` its step
+/// 2^−F): the same two roundings as the one-value code, in AVX-512DQ lanes where
+/// [`fixed_in_lanes`] says so (`vcvtqq2pd`, `vmulpd`), else one by one.
+///
+/// # Panics
+/// If the lengths differ.
+pub fn fixed_to_f64(cap: Kernel, src: &[i64], scale: f64, dst: &mut [f64]) {
+    assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
+    #[cfg(target_arch = "x86_64")]
+    if fixed_in_lanes(cap) {
+        // SAFETY: AVX-512F and AVX-512DQ are present (checked)
+        return unsafe { fixed_avx512(src, scale, dst) };
+    }
+    fixed_body(src, scale, dst)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq")]
+fn fixed_avx512(src: &[i64], scale: f64, dst: &mut [f64]) {
+    fixed_body(src, scale, dst)
+}
+
+#[inline(always)]
+fn fixed_body(src: &[i64], scale: f64, dst: &mut [f64]) {
+    for (d, &x) in dst.iter_mut().zip(src) {
+        *d = x as f64 * scale;
+    }
+}
+
 /// Either column on the binary64 lanes [`f64_lanes`] picks.
 fn widen_column<T: Widen>(cap: Kernel, src: &[T], dst: &mut [f64]) {
     assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
