@@ -1459,7 +1459,7 @@ mod draw {
 
 mod widen {
     use datapath::rng::SplitMix64;
-    use datapath::simd::widen::{bf16_to_f64, f16_to_f64, f32_to_f64, fixed_to_f64};
+    use datapath::simd::widen::{bf16_to_f64, e8_to_f64, f16_to_f64, f32_to_f64, fixed_to_f64};
     use datapath::simd::{kernels_here, with_kernel_cap};
 
     /// Every binary32 class (zeros, subnormals, normals, infinities, NaNs) widens to the
@@ -1488,6 +1488,45 @@ mod widen {
                         y.to_bits() == want.to_bits() || (y.is_nan() && want.is_nan()),
                         "{k:?} lane {i}: {x:?} -> {y:?}"
                     );
+                }
+            }
+        }
+    }
+
+    /// Every encoding of e8m7 and e8m2, and e8m16 encodings dense at the edges (zeros,
+    /// subnormals, the normal boundary, the largest, ∞, NaNs) and random, widen to the format's
+    /// exact `to_f64` on every kernel (the same bits; a NaN a NaN) — through the format's
+    /// column conversion, which takes this path for `e8mM`.
+    #[test]
+    fn e8_encodings_widen_to_their_values() {
+        use datapath::Format;
+        let mut g = SplitMix64::new(4);
+        for name in ["e8m7", "e8m2", "e8m16", "e8m16:ftz"] {
+            let datapath::AnyFormat::Soft(f) = name.parse::<datapath::AnyFormat>().unwrap() else { unreachable!() };
+            let m = f.backend.0.man_bits;
+            let w = 9 + m;
+            let src: Vec<u64> = if w <= 16 {
+                (0..1u64 << w).collect()
+            } else {
+                // e8m16: zero, the subnormals' ends, the normal boundary, the largest, ∞, NaNs
+                let edges = [0u64, 1, 0xffff, 0x1_0000, 0xfe_ffff, 0xff_0000, 0xff_0001, 0xff_ffff];
+                edges
+                    .iter()
+                    .flat_map(|&e| (0..64u64).flat_map(move |k| [e + k, e.wrapping_sub(k)].map(|x| x & 0xff_ffff)))
+                    .flat_map(|x| [x, x | 0x100_0000])
+                    .chain((0..5000).map(|_| g.next_u64() & 0x1ff_ffff))
+                    .collect()
+            };
+            assert!(f.fast_f64_column(), "{name}");
+            for k in kernels_here() {
+                let mut dst = vec![0.5; src.len()];
+                with_kernel_cap(k, || f.to_f64_column(&src, &mut dst));
+                let mut direct = vec![0.5; src.len()];
+                e8_to_f64(k, &src, 23 - m, &mut direct);
+                for ((&x, &y), &z) in src.iter().zip(&dst).zip(&direct) {
+                    let want = f.to_f64(x);
+                    let ok = |y: f64| y.to_bits() == want.to_bits() || (y.is_nan() && want.is_nan());
+                    assert!(ok(y) && ok(z), "{name} {k:?} {x:#x} -> {y:?} / {z:?}, want {want:?}");
                 }
             }
         }

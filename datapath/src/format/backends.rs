@@ -278,6 +278,22 @@ impl IeeeBackend for Soft {
     fn name(&self) -> String {
         format!("e{}m{}", self.0.exp_bits, self.0.man_bits)
     }
+    fn to_f64_column(&self, src: &[u64], dst: &mut [f64]) {
+        let l = self.0;
+        if l.exp_bits == 8 && l.man_bits <= 23 {
+            // e8mM: the encoding shifted to binary32's fraction width is the same value in
+            // binary32, widened exactly, in the lanes
+            crate::simd::widen::e8_to_f64(crate::simd::Kernel::Avx512Fp16, src, 23 - l.man_bits, dst)
+        } else {
+            assert_eq!(src.len(), dst.len(), "to_f64_column: columns of different lengths");
+            for (d, &x) in dst.iter_mut().zip(src) {
+                *d = l.to_f64(x);
+            }
+        }
+    }
+    fn fast_f64_column(&self) -> bool {
+        self.0.exp_bits == 8 && self.0.man_bits <= 23
+    }
     #[inline(always)]
     fn bits(v: u64) -> u64 {
         v

@@ -85,6 +85,46 @@ fn f16_avx2(src: &[half::f16], dst: &mut [f64]) -> usize {
     whole
 }
 
+/// `dst[k] = f32::from_bits((src[k] as u32) << shift) as f64` for every `k` (`e8mM`
+/// encodings, `shift` = 23 − M: binary32's exponent, so the shifted encoding is the same value
+/// in binary32, subnormals, infinities included; a NaN stays a NaN), on the widest lanes `cap`,
+/// the thread's cap and the machine allow.
+///
+/// # Panics
+/// If the lengths differ.
+pub fn e8_to_f64(cap: Kernel, src: &[u64], shift: u32, dst: &mut [f64]) {
+    assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
+    assert!(shift <= 23, "e8mM: a shift of {shift} bits");
+    match f64_lanes(cap) {
+        // SAFETY: AVX-512F is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 => unsafe { e8_avx512(src, shift, dst) },
+        // SAFETY: AVX2 is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx2 => unsafe { e8_avx2(src, shift, dst) },
+        _ => e8_body(src, shift, dst),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn e8_avx512(src: &[u64], shift: u32, dst: &mut [f64]) {
+    e8_body(src, shift, dst)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn e8_avx2(src: &[u64], shift: u32, dst: &mut [f64]) {
+    e8_body(src, shift, dst)
+}
+
+#[inline(always)]
+fn e8_body(src: &[u64], shift: u32, dst: &mut [f64]) {
+    for (d, &x) in dst.iter_mut().zip(src) {
+        *d = f32::from_bits((x as u32) << shift) as f64;
+    }
+}
+
 /// Whether [`fixed_to_f64`] runs in vector lanes here (AVX-512F and AVX-512DQ, within `cap`
 /// and the thread's cap).
 pub fn fixed_in_lanes(cap: Kernel) -> bool {
