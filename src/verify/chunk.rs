@@ -143,8 +143,10 @@ struct Variant<F: Format> {
 /// One triangle's data as the blocks gather it, in one record (one random access per test):
 /// the model's stored triangle, the triangle's box in f64 and that box stored in the format
 /// (outward-rounded; the same for every variant). The fields a pass does not use hold
-/// defaults. (The quantised triangle is converted from the model's, or kept in
-/// [`Setup::qs`].)
+/// defaults. (The quantised triangle is converted from the model's where the format converts a
+/// column in vector lanes — binary32, binary16, bfloat16, e8mM, fixed point with AVX-512DQ —
+/// or kept in [`Setup::qs`].) 64-byte aligned, the model's triangle and the stored box first:
+/// the RTI gather and the stored-box gather read one line of a record.
 #[derive(Clone, Copy)]
 #[repr(C, align(64))]
 struct Rec<V> {
