@@ -87,8 +87,8 @@ fn f16_avx2(src: &[half::f16], dst: &mut [f64]) -> usize {
 
 /// `dst[k] = f32::from_bits((src[k] as u32) << shift) as f64` for every `k` (`e8mM`
 /// encodings, `shift` = 23 − M: binary32's exponent, so the shifted encoding is the same value
-/// in binary32, subnormals, infinities included; a NaN stays a NaN), on the widest lanes `cap`,
-/// the thread's cap and the machine allow.
+/// in binary32, subnormals, infinities included; a NaN becomes `f64::NAN`, as the format's
+/// `to_f64` gives it), on the widest lanes `cap`, the thread's cap and the machine allow.
 ///
 /// # Panics
 /// If the lengths differ.
@@ -121,7 +121,8 @@ fn e8_avx2(src: &[u64], shift: u32, dst: &mut [f64]) {
 #[inline(always)]
 fn e8_body(src: &[u64], shift: u32, dst: &mut [f64]) {
     for (d, &x) in dst.iter_mut().zip(src) {
-        *d = f32::from_bits((x as u32) << shift) as f64;
+        let y = f32::from_bits((x as u32) << shift) as f64;
+        *d = if y.is_nan() { f64::NAN } else { y };
     }
 }
 
