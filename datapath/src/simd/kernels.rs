@@ -171,7 +171,8 @@ macro_rules! rti_kernel {
 /// The slab stage table on one vector per step, for either batch shape, in the ops of `$x`.
 /// `$load(column, i)` gives the lanes as binary32, `$round(x)` rounds a binary32 result to
 /// the format, `$store(column, i, x)` writes results, `$up` steps up on the format's grid,
-/// `$bcast` broadcasts a ray value.
+/// `$upn(x, n)` steps up `n` times (the conservative variants' widening), `$bcast` broadcasts
+/// a ray value.
 macro_rules! slab_kernel {
     ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr) => {{
         // one loop per comparator and batch shape, so that neither is decided per vector
@@ -190,10 +191,10 @@ macro_rules! slab_kernel {
             return;
         }
         match ($rays, tof) {
-            (SlabRays::Pairs(r), false) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, false),
-            (SlabRays::Pairs(r), true) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, true),
-            (SlabRays::One(r), false) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, false),
-            (SlabRays::One(r), true) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, true),
+            (SlabRays::Pairs(r), false) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $upn, $bcast, false),
+            (SlabRays::Pairs(r), true) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $upn, $bcast, true),
+            (SlabRays::One(r), false) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $upn, $bcast, false),
+            (SlabRays::One(r), true) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $upn, $bcast, true),
         }
     }};
     // per-batch preparation, hoisted out of the loop: column pointers; for one ray, each
@@ -340,10 +341,9 @@ macro_rules! slab_kernel {
             unsafe { slab_redo(s, SlabRays::One(r), boxes, (o_hit, o_near, o_far), $full) };
         }
     }};
-    (@loop $x:ident, $s:expr, $shape:ident $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, $tof:expr) => {{
+    (@loop $x:ident, $s:expr, $shape:ident $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $upn:expr, $bcast:expr, $tof:expr) => {{
         let (s, boxes, out) = ($s, $boxes, $out);
         let (load, rd, store, upn, bcast) = ($load, $round, $store, $upn, $bcast);
-        let _ = $up; // the widening steps `n` at once
         // n steps down are n steps up mirrored through the sign (negation is exact)
         let neg = |v| $x::xor(v, $x::splat(-0.0));
         let down_n = |v, n| neg(upn(neg(v), n));
