@@ -104,6 +104,15 @@ pub fn intersect_exact(ray: &Ray64, tri: &Tri64, faces: Faces) -> Option<bool> {
     exact_in_integers(ray, tri, faces).or_else(|| intersect_exact_rational(ray, tri, faces))
 }
 
+/// Whether the exact decision has its inputs: every coordinate, tmin and the threshold finite,
+/// tmax not NaN (it may be +∞).
+fn exact_inputs_finite(ray: &Ray64, tri: &Tri64, faces: Faces) -> bool {
+    ray.o.iter().chain(&ray.d).chain(tri.v.iter().flatten()).all(|x| x.is_finite())
+        && ray.tmin.is_finite()
+        && !ray.tmax.is_nan()
+        && faces.det_threshold.is_finite()
+}
+
 /// `x = m · 2^e` exactly, `m` odd (or 0, with e = 0); `x` finite.
 fn dyadic(x: f64) -> (i64, i32) {
     let b = x.to_bits();
@@ -130,11 +139,7 @@ const INT_BITS: u32 = 39;
 /// product would not fit.
 pub fn exact_in_integers(ray: &Ray64, tri: &Tri64, faces: Faces) -> Option<bool> {
     use num_bigint::BigInt;
-    let finite = ray.o.iter().chain(&ray.d).chain(tri.v.iter().flatten()).all(|x| x.is_finite())
-        && ray.tmin.is_finite()
-        && !ray.tmax.is_nan()
-        && faces.det_threshold.is_finite();
-    if !finite {
+    if !exact_inputs_finite(ray, tri, faces) {
         return None;
     }
     // one scale per group: its smallest exponent; every value an integer below 2^INT_BITS
@@ -223,11 +228,7 @@ pub fn exact_in_integers(ray: &Ray64, tri: &Tri64, faces: Faces) -> Option<bool>
 pub fn intersect_exact_rational(ray: &Ray64, tri: &Tri64, faces: Faces) -> Option<bool> {
     use num_rational::BigRational;
     use num_traits::{Signed, Zero};
-    let finite = ray.o.iter().chain(&ray.d).chain(tri.v.iter().flatten()).all(|x| x.is_finite())
-        && ray.tmin.is_finite()
-        && !ray.tmax.is_nan()
-        && faces.det_threshold.is_finite();
-    if !finite {
+    if !exact_inputs_finite(ray, tri, faces) {
         return None;
     }
     let q = |x: f64| BigRational::from_float(x).expect("finite");
