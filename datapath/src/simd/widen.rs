@@ -1,7 +1,7 @@
-//! Widening a binary32, bfloat16 or binary16 column to binary64: `dst[k] = src[k] as f64` (bfloat16:
-//! its encoding shifted into binary32's upper half first), exact for every value (a NaN stays
-//! a NaN, as Rust's cast leaves it: the same as the one-value cast), on the widest lanes the
-//! machine has (AVX-512F: 8, AVX2: 4, else the compiler's baseline).
+//! Widening a column to binary64 — binary32 (`dst[k] = src[k] as f64`), bfloat16 and `e8mM`
+//! (the encoding shifted into binary32's fields first), binary16, fixed point (the value times
+//! its step) — the same bits as the one-value conversion, on the widest lanes the machine has
+//! (AVX-512F: 8, AVX2: 4, else the compiler's baseline).
 
 use super::{f64_lanes, F64Lanes, Kernel};
 
@@ -11,7 +11,7 @@ use super::{f64_lanes, F64Lanes, Kernel};
 /// # Panics
 /// If the lengths differ.
 pub fn f32_to_f64(cap: Kernel, src: &[f32], dst: &mut [f64]) {
-    widen_column(cap, src, dst)
+    widen_column(cap, src, (), dst)
 }
 
 /// `dst[k] = f32::from_bits((src[k] as u32) << 16) as f64` for every `k` (bfloat16
@@ -20,7 +20,7 @@ pub fn f32_to_f64(cap: Kernel, src: &[f32], dst: &mut [f64]) {
 /// # Panics
 /// If the lengths differ.
 pub fn bf16_to_f64(cap: Kernel, src: &[u16], dst: &mut [f64]) {
-    widen_column(cap, src, dst)
+    widen_column(cap, src, (), dst)
 }
 
 /// `dst[k] = src[k].to_f64()` for every `k` (binary16, exact; a NaN stays a NaN), by the
@@ -93,37 +93,8 @@ fn f16_avx2(src: &[half::f16], dst: &mut [f64]) -> usize {
 /// # Panics
 /// If the lengths differ.
 pub fn e8_to_f64(cap: Kernel, src: &[u64], shift: u32, dst: &mut [f64]) {
-    assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
     assert!(shift <= 23, "e8mM: a shift of {shift} bits");
-    match f64_lanes(cap) {
-        // SAFETY: AVX-512F is present (f64_lanes detected it)
-        #[cfg(target_arch = "x86_64")]
-        F64Lanes::Avx512 => unsafe { e8_avx512(src, shift, dst) },
-        // SAFETY: AVX2 is present (f64_lanes detected it)
-        #[cfg(target_arch = "x86_64")]
-        F64Lanes::Avx2 => unsafe { e8_avx2(src, shift, dst) },
-        _ => e8_body(src, shift, dst),
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-fn e8_avx512(src: &[u64], shift: u32, dst: &mut [f64]) {
-    e8_body(src, shift, dst)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn e8_avx2(src: &[u64], shift: u32, dst: &mut [f64]) {
-    e8_body(src, shift, dst)
-}
-
-#[inline(always)]
-fn e8_body(src: &[u64], shift: u32, dst: &mut [f64]) {
-    for (d, &x) in dst.iter_mut().zip(src) {
-        let y = f32::from_bits((x as u32) << shift) as f64;
-        *d = if y.is_nan() { f64::NAN } else { y };
-    }
+    widen_column(cap, src, shift, dst)
 }
 
 /// Whether [`fixed_to_f64`] runs in vector lanes here (AVX-512F and AVX-512DQ, within `cap`
@@ -142,82 +113,100 @@ pub fn fixed_in_lanes(cap: Kernel) -> bool {
 
 /// `dst[k] = src[k] as f64 * scale` for every `k` (a fixed-point column, `scale` its step
 /// 2^−F): the same two roundings as the one-value code, in AVX-512DQ lanes where
-/// [`fixed_in_lanes`] says so (`vcvtqq2pd`, `vmulpd`), else one by one.
+/// [`fixed_in_lanes`] says so (`vcvtqq2pd`, `vmulpd`; without AVX-512DQ the same two roundings
+/// do not vectorise).
 ///
 /// # Panics
 /// If the lengths differ.
 pub fn fixed_to_f64(cap: Kernel, src: &[i64], scale: f64, dst: &mut [f64]) {
-    assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
-    #[cfg(target_arch = "x86_64")]
-    if fixed_in_lanes(cap) {
-        // SAFETY: AVX-512F and AVX-512DQ are present (checked)
-        return unsafe { fixed_avx512(src, scale, dst) };
-    }
-    fixed_body(src, scale, dst)
+    widen_column(cap, src, scale, dst)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq")]
-fn fixed_avx512(src: &[i64], scale: f64, dst: &mut [f64]) {
-    fixed_body(src, scale, dst)
-}
-
-#[inline(always)]
-fn fixed_body(src: &[i64], scale: f64, dst: &mut [f64]) {
-    for (d, &x) in dst.iter_mut().zip(src) {
-        *d = x as f64 * scale;
-    }
-}
-
-/// Either column on the binary64 lanes [`f64_lanes`] picks.
-fn widen_column<T: Widen>(cap: Kernel, src: &[T], dst: &mut [f64]) {
+/// Any column on the binary64 lanes [`f64_lanes`] picks (with AVX-512DQ too where the machine
+/// has it: a fixed-point column's conversion vectorises only there); `p` the type's parameter.
+fn widen_column<T: Widen>(cap: Kernel, src: &[T], p: T::P, dst: &mut [f64]) {
     assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
     match f64_lanes(cap) {
+        // SAFETY: AVX-512F is present (f64_lanes detected it), AVX-512DQ too (detected)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 if std::arch::is_x86_feature_detected!("avx512dq") => unsafe { avx512dq(src, p, dst) },
         // SAFETY: AVX-512F is present (f64_lanes detected it)
         #[cfg(target_arch = "x86_64")]
-        F64Lanes::Avx512 => unsafe { avx512(src, dst) },
+        F64Lanes::Avx512 => unsafe { avx512(src, p, dst) },
         // SAFETY: AVX2 is present (f64_lanes detected it)
         #[cfg(target_arch = "x86_64")]
-        F64Lanes::Avx2 => unsafe { avx2(src, dst) },
-        _ => body(src, dst),
+        F64Lanes::Avx2 => unsafe { avx2(src, p, dst) },
+        _ => body(src, p, dst),
     }
 }
 
-/// A value widened to binary64 exactly.
+/// A value widened to binary64, with its type's parameter `P`.
 trait Widen: Copy {
-    fn widen(self) -> f64;
+    type P: Copy;
+    fn widen(self, p: Self::P) -> f64;
 }
 
 impl Widen for f32 {
+    type P = ();
     #[inline(always)]
-    fn widen(self) -> f64 {
+    fn widen(self, _: ()) -> f64 {
         self as f64
     }
 }
 
 impl Widen for u16 {
+    type P = ();
     /// A bfloat16 encoding: binary32's upper half.
     #[inline(always)]
-    fn widen(self) -> f64 {
+    fn widen(self, _: ()) -> f64 {
         f32::from_bits(u32::from(self) << 16) as f64
     }
 }
 
+impl Widen for u64 {
+    type P = u32;
+    /// An `e8mM` encoding shifted by 23 − M into binary32's fields (a NaN as `f64::NAN`).
+    #[inline(always)]
+    fn widen(self, shift: u32) -> f64 {
+        let y = f32::from_bits((self as u32) << shift) as f64;
+        if y.is_nan() {
+            f64::NAN
+        } else {
+            y
+        }
+    }
+}
+
+impl Widen for i64 {
+    type P = f64;
+    /// A fixed-point value, times its step.
+    #[inline(always)]
+    fn widen(self, scale: f64) -> f64 {
+        self as f64 * scale
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq")]
+fn avx512dq<T: Widen>(src: &[T], p: T::P, dst: &mut [f64]) {
+    body(src, p, dst)
+}
+
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn avx512<T: Widen>(src: &[T], dst: &mut [f64]) {
-    body(src, dst)
+fn avx512<T: Widen>(src: &[T], p: T::P, dst: &mut [f64]) {
+    body(src, p, dst)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn avx2<T: Widen>(src: &[T], dst: &mut [f64]) {
-    body(src, dst)
+fn avx2<T: Widen>(src: &[T], p: T::P, dst: &mut [f64]) {
+    body(src, p, dst)
 }
 
 #[inline(always)]
-fn body<T: Widen>(src: &[T], dst: &mut [f64]) {
+fn body<T: Widen>(src: &[T], p: T::P, dst: &mut [f64]) {
     for (d, &x) in dst.iter_mut().zip(src) {
-        *d = x.widen();
+        *d = x.widen(p);
     }
 }
