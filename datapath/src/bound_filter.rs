@@ -64,18 +64,39 @@ use crate::format::DivMode;
 use crate::rti::Cull;
 use crate::simd::F64Lanes;
 
-/// The block's static constants: each compared signal's `E`, or `None` when the block's range
-/// check fails or an input is NaN (then no lane is certified).
+/// A block's constants (where its range check holds and no input is NaN; else no lane is
+/// certified): each compared signal's `E` (det, u', v', t', u' + v') for every lane, or per
+/// lane (coarse formats, see [`LANE_U`]).
 #[derive(Clone, Copy, Debug)]
-struct Static {
-    det: f64,
-    up: f64,
-    vp: f64,
-    tp: f64,
-    uv: f64,
-    /// The per-lane constants (coarse formats only, see [`LANE_U`]; then the five above are
-    /// +∞, unused).
-    lane: Option<LaneConsts>,
+enum Static {
+    /// The same `E` for every lane.
+    Block([f64; 5]),
+    /// Each lane's `E` from its magnitudes.
+    Lane(LaneConsts),
+}
+
+/// Where a lane's constants `E` (det, u', v', t', u' + v') come from.
+trait LaneE: Copy {
+    /// The constants of the lane with these inputs.
+    fn of(&self, o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5];
+}
+
+/// The block's: every lane's.
+impl LaneE for [f64; 5] {
+    #[inline(always)]
+    fn of(&self, _: [f64; 3], _: [f64; 3], _: [[f64; 3]; 3]) -> [f64; 5] {
+        *self
+    }
+}
+
+/// `g·m + h` of the lane's magnitudes (a NaN magnitude, of a lane whose values are NaN, gives
+/// NaN constants: no compare clears them).
+impl LaneE for LaneConsts {
+    #[inline(always)]
+    fn of(&self, o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5] {
+        let m = lane_magnitudes(o, d, v);
+        std::array::from_fn(|k| self.g[k] * m[k] + self.h[k])
+    }
 }
 
 /// Formats whose unit roundoff is at least this get per-lane constants (`LaneConsts`):
@@ -376,9 +397,7 @@ fn statics(o: BlockOpts, r: BlockRay, (ve, ae, big, nan): ([f64; 9], [f64; 9], f
     }
     if o.em.u >= LANE_U {
         // a coarse format: the per-lane constants alone (the block's would seldom be smaller)
-        let lane = Some(lane_consts(o, r, big, ve, ae)?);
-        let inf = f64::INFINITY;
-        return Some(Static { det: inf, up: inf, vp: inf, tp: inf, uv: inf, lane });
+        return lane_consts(o, r, big, ve, ae).map(Static::Lane);
     }
     // the per-test recurrences on magnitudes (`Ctx` in magnitude mode: a difference adds)
     let mut m = Ctx::<f64>::new(o.em, true);
@@ -401,7 +420,7 @@ fn statics(o: BlockOpts, r: BlockRay, (ve, ae, big, nan): ([f64; 9], [f64; 9], f
     let vp = m.dot(d3, q);
     let tp = m.dot(e2, q);
     let uv = m.add(up, vp);
-    (!m.overflow).then(|| Static { det: det.err(), up: up.err(), vp: vp.err(), tp: tp.err(), uv: uv.err(), lane: None })
+    (!m.overflow).then(|| Static::Block([det.err(), up.err(), vp.err(), tp.err(), uv.err()]))
 }
 
 /// Relative room of [`certify`]'s test for a quotient that surely overflows (a speed choice:
@@ -708,29 +727,21 @@ fn lane_magnitudes(o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5] {
 /// of the block's length).
 #[inline(always)]
 fn certify(o: BlockOpts, r: BlockRay, st: Static, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) {
-    match st.lane {
-        Some(l) => certify_with::<true>(o, r, st, l, c, out, mark),
-        None => certify_with::<false>(o, r, st, LaneConsts { g: [0.0; 5], h: [0.0; 5] }, c, out, mark),
+    match st {
+        Static::Block(e) => certify_with(o, r, e, c, out, mark),
+        Static::Lane(l) => certify_with(o, r, l, c, out, mark),
     }
 }
 
-/// [`certify`], with the per-lane constants `l` (`LANE`) or without.
+/// [`certify`] with the lanes' constants from `k`.
 #[inline(always)]
-fn certify_with<const LANE: bool>(
-    o: BlockOpts,
-    r: BlockRay,
-    st: Static,
-    l: LaneConsts,
-    c: [&[f64]; 9],
-    out: &mut [bool],
-    mark: &mut [f64],
-) {
+fn certify_with<K: LaneE>(o: BlockOpts, r: BlockRay, k: K, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) {
     let (u, eta, max) = (o.em.u, o.em.eta, o.em.max);
     let recip = o.div == DivMode::RecipMul;
     assert_eq!(mark.len(), out.len(), "certify: scratch of another length");
     let mut near = false;
     for i in 0..out.len() {
-        let (cleared, d, [up, vp, tp], e) = lane_cleared::<LANE>(o, r, st, l, c, i);
+        let (cleared, d, [up, vp, tp], e) = lane_cleared(o, r, k, c, i);
         let x = tp.abs().max(up.abs()).max(vp.abs());
         let e_num = e[3].max(e[1]).max(e[2]);
         let over = quot_may_overflow(recip, u, eta, max, x, e_num, e[0], d);
@@ -745,7 +756,7 @@ fn certify_with<const LANE: bool>(
     if near {
         for i in 0..out.len() {
             if mark[i] != 0.0 {
-                let (_, d, [up, vp, tp], e) = lane_cleared::<LANE>(o, r, st, l, c, i);
+                let (_, d, [up, vp, tp], e) = lane_cleared(o, r, k, c, i);
                 out[i] = !(quot_may_overflow(recip, u, eta, max, tp, e[3], e[0], d)
                     | quot_may_overflow(recip, u, eta, max, up, e[1], e[0], d)
                     | quot_may_overflow(recip, u, eta, max, vp, e[2], e[0], d));
@@ -756,27 +767,18 @@ fn certify_with<const LANE: bool>(
 
 /// Lane `i`'s conditions (2) and (3) of the module documentation (not valid, every compared
 /// quantity clear of its constant), its `d = |det| − E_det`, its numerators u', v', t' and its
-/// constants E (det, u', v', t', u' + v'): the block's, or with `LANE` `g·m + h` of the lane's
-/// magnitudes.
+/// constants E (det, u', v', t', u' + v') from `k`.
 #[inline(always)]
-fn lane_cleared<const LANE: bool>(
+fn lane_cleared<K: LaneE>(
     o: BlockOpts,
     r: BlockRay,
-    st: Static,
-    l: LaneConsts,
+    k: K,
     c: [&[f64]; 9],
     i: usize,
 ) -> (bool, f64, [f64; 3], [f64; 5]) {
     let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
     let [det, up, vp, tp, uv] = values(r.o, r.d, v);
-    let e = if LANE {
-        // (a NaN magnitude, of a lane whose values are NaN, gives NaN constants: no compare
-        // clears them)
-        let m = lane_magnitudes(r.o, r.d, v);
-        std::array::from_fn(|k| l.g[k] * m[k] + l.h[k])
-    } else {
-        [st.det, st.up, st.vp, st.tp, st.uv]
-    };
+    let e = k.of(r.o, r.d, v);
     let det_q = if o.cull == Cull::Backface { det - o.det_threshold } else { det.abs() - o.det_threshold };
     let pos = det > 0.0;
     let sgn = |x: f64| if pos { x } else { -x };
