@@ -115,24 +115,6 @@ impl<T: Lane> Ctx<T> {
         let e = e0 + self.u * (v.abs() + e0) + self.eta;
         self.check(Bnd { v, a: x.a * y.a, e })
     }
-    #[inline(always)]
-    pub(crate) fn cross(&mut self, a: [Bnd<T>; 3], b: [Bnd<T>; 3]) -> [Bnd<T>; 3] {
-        let xa = self.mul(a[1], b[2]);
-        let xb = self.mul(a[2], b[1]);
-        let ya = self.mul(a[2], b[0]);
-        let yb = self.mul(a[0], b[2]);
-        let za = self.mul(a[0], b[1]);
-        let zb = self.mul(a[1], b[0]);
-        [self.sub(xa, xb), self.sub(ya, yb), self.sub(za, zb)]
-    }
-    #[inline(always)]
-    pub(crate) fn dot(&mut self, a: [Bnd<T>; 3], b: [Bnd<T>; 3]) -> Bnd<T> {
-        let x = self.mul(a[0], b[0]);
-        let y = self.mul(a[1], b[1]);
-        let z = self.mul(a[2], b[2]);
-        let xy = self.add(x, y);
-        self.add(xy, z)
-    }
     /// The bound of `num / det` (t = t'/det and the barycentrics): see the module docs; +∞
     /// when det is not clear of zero (`ok` false: `denom = |det| − e_det <= 0`).
     #[inline(always)]
@@ -151,6 +133,56 @@ impl<T: Lane> Ctx<T> {
         };
         self.overflow = self.overflow | (ok & (mag + extra).gt(self.max));
         T::select(ok, d1 + extra, T::splat(f64::INFINITY))
+    }
+}
+
+/// The operations of the RTI datapath's cross and dot products, and the two products in the
+/// datapath's order (the order every running bound of this crate must follow: the per-test
+/// bound, the static filter's block and per-lane constants).
+pub(crate) trait Steps {
+    /// One signal.
+    type S: Copy;
+    /// x × y.
+    fn mul(&mut self, x: Self::S, y: Self::S) -> Self::S;
+    /// x + y.
+    fn add(&mut self, x: Self::S, y: Self::S) -> Self::S;
+    /// x − y.
+    fn sub(&mut self, x: Self::S, y: Self::S) -> Self::S;
+    /// a × b: each component's two products, then their differences.
+    #[inline(always)]
+    fn cross(&mut self, a: [Self::S; 3], b: [Self::S; 3]) -> [Self::S; 3] {
+        let xa = self.mul(a[1], b[2]);
+        let xb = self.mul(a[2], b[1]);
+        let ya = self.mul(a[2], b[0]);
+        let yb = self.mul(a[0], b[2]);
+        let za = self.mul(a[0], b[1]);
+        let zb = self.mul(a[1], b[0]);
+        [self.sub(xa, xb), self.sub(ya, yb), self.sub(za, zb)]
+    }
+    /// a · b: the three products, then (x + y) + z.
+    #[inline(always)]
+    fn dot(&mut self, a: [Self::S; 3], b: [Self::S; 3]) -> Self::S {
+        let x = self.mul(a[0], b[0]);
+        let y = self.mul(a[1], b[1]);
+        let z = self.mul(a[2], b[2]);
+        let xy = self.add(x, y);
+        self.add(xy, z)
+    }
+}
+
+impl<T: Lane> Steps for Ctx<T> {
+    type S = Bnd<T>;
+    #[inline(always)]
+    fn mul(&mut self, x: Bnd<T>, y: Bnd<T>) -> Bnd<T> {
+        Ctx::mul(self, x, y)
+    }
+    #[inline(always)]
+    fn add(&mut self, x: Bnd<T>, y: Bnd<T>) -> Bnd<T> {
+        Ctx::add(self, x, y)
+    }
+    #[inline(always)]
+    fn sub(&mut self, x: Bnd<T>, y: Bnd<T>) -> Bnd<T> {
+        Ctx::sub(self, x, y)
     }
 }
 

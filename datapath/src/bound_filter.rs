@@ -59,7 +59,7 @@
 //! against the per-test bound on random and edge blocks (subnormal, huge, ±0, ±∞, NaN inputs),
 //! with block and with per-lane constants (binary16, e8m7 and e5m10 under FTZ).
 
-use crate::bound::{BlockOpts, BlockRay, Bnd, Ctx};
+use crate::bound::{BlockOpts, BlockRay, Bnd, Ctx, Steps};
 use crate::format::DivMode;
 use crate::rti::Cull;
 use crate::simd::F64Lanes;
@@ -174,18 +174,47 @@ impl LaneCtx {
         let h = PHI * ((1.0 + u) * (x.h + y.h) + self.add_eta);
         self.check(Lb { g, h, m: x.m + y.m, a: x.a + y.a })
     }
+}
+
+/// The recurrences' steps (a difference of magnitudes adds), the products in the datapath's
+/// order.
+impl Steps for LaneCtx {
+    type S = Lb;
     #[inline(always)]
-    fn cross(&mut self, a: [Lb; 3], b: [Lb; 3]) -> [Lb; 3] {
-        let (xa, xb) = (self.mul(a[1], b[2]), self.mul(a[2], b[1]));
-        let (ya, yb) = (self.mul(a[2], b[0]), self.mul(a[0], b[2]));
-        let (za, zb) = (self.mul(a[0], b[1]), self.mul(a[1], b[0]));
-        [self.add(xa, xb), self.add(ya, yb), self.add(za, zb)]
+    fn mul(&mut self, x: Lb, y: Lb) -> Lb {
+        LaneCtx::mul(self, x, y)
     }
     #[inline(always)]
-    fn dot(&mut self, a: [Lb; 3], b: [Lb; 3]) -> Lb {
-        let (x, y, z) = (self.mul(a[0], b[0]), self.mul(a[1], b[1]), self.mul(a[2], b[2]));
-        let xy = self.add(x, y);
-        self.add(xy, z)
+    fn add(&mut self, x: Lb, y: Lb) -> Lb {
+        LaneCtx::add(self, x, y)
+    }
+    #[inline(always)]
+    fn sub(&mut self, x: Lb, y: Lb) -> Lb {
+        LaneCtx::add(self, x, y)
+    }
+}
+
+/// The lane values' binary64 operations (`values`), or with `MAG` their absolute-value
+/// evaluation (`lane_magnitudes`: a difference adds), the products in the datapath's order.
+struct F64Steps<const MAG: bool>;
+
+impl<const MAG: bool> Steps for F64Steps<MAG> {
+    type S = f64;
+    #[inline(always)]
+    fn mul(&mut self, x: f64, y: f64) -> f64 {
+        x * y
+    }
+    #[inline(always)]
+    fn add(&mut self, x: f64, y: f64) -> f64 {
+        x + y
+    }
+    #[inline(always)]
+    fn sub(&mut self, x: f64, y: f64) -> f64 {
+        if MAG {
+            x + y
+        } else {
+            x - y
+        }
     }
 }
 
@@ -686,12 +715,10 @@ pub fn values(o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5] {
     let e1 = [v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]];
     let e2 = [v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]];
     let s = [o[0] - v0[0], o[1] - v0[1], o[2] - v0[2]];
-    let cross =
-        |a: [f64; 3], b: [f64; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let p = cross(d, e2);
-    let q = cross(s, e1);
-    let (det, up, vp, tp) = (dot(e1, p), dot(s, p), dot(d, q), dot(e2, q));
+    let mut f = F64Steps::<false>;
+    let p = f.cross(d, e2);
+    let q = f.cross(s, e1);
+    let (det, up, vp, tp) = (f.dot(e1, p), f.dot(s, p), f.dot(d, q), f.dot(e2, q));
     [det, up, vp, tp, up + vp]
 }
 
@@ -706,12 +733,10 @@ fn lane_magnitudes(o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5] {
     let e2 = [(v2[0] - v0[0]).abs(), (v2[1] - v0[1]).abs(), (v2[2] - v0[2]).abs()];
     let s = [(o[0] - v0[0]).abs(), (o[1] - v0[1]).abs(), (o[2] - v0[2]).abs()];
     let d = d.map(f64::abs);
-    let cross =
-        |a: [f64; 3], b: [f64; 3]| [a[1] * b[2] + a[2] * b[1], a[2] * b[0] + a[0] * b[2], a[0] * b[1] + a[1] * b[0]];
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let p = cross(d, e2);
-    let q = cross(s, e1);
-    let (det, up, vp, tp) = (dot(e1, p), dot(s, p), dot(d, q), dot(e2, q));
+    let mut f = F64Steps::<true>;
+    let p = f.cross(d, e2);
+    let q = f.cross(s, e1);
+    let (det, up, vp, tp) = (f.dot(e1, p), f.dot(s, p), f.dot(d, q), f.dot(e2, q));
     [det, up, vp, tp, up + vp]
 }
 
