@@ -1329,10 +1329,13 @@ fn fixed_point_formats_wider_than_32_bits_run_the_scalar_model() {
 }
 
 /// `simd::gather::gather` on every kernel is the plain copy `cols[c][k] = pick(&recs[idx[k]])[c]`
-/// bit for bit: 4- and 8-byte numbers (the AVX-512F and AVX2 gathers), 2-byte ones (always
-/// scalar), a field at an offset within its record, every length up to 70 (whole 16- and
-/// 8-lane steps and tails), NaN payloads copied as they are; an index out of range (in the
-/// first, second and fourth 8-lane step) and a short column panic.
+/// bit for bit: 4- and 8-byte numbers (the AVX-512F and AVX2 gathers), 2-byte ones (`u16`,
+/// `half::f16`, `half::bf16`: pairs by 4-byte gathers; an even and an odd number of columns,
+/// one column with room after it, and one at a record's end — its values: that no byte past a
+/// record is read is `pair_reads_fit`'s rule, not observable here), a field at
+/// an offset within its record, every length up to 70 (whole 16- and 8-lane steps and tails),
+/// NaN payloads copied as they are; an index out of range (in the first, second and fourth
+/// 8-lane step) and a short column panic.
 mod gather {
     use super::*;
     use datapath::simd::gather::gather;
@@ -1345,6 +1348,17 @@ mod gather {
         b: [f64; 3],
         h: [u16; 2],
         q: [i64; 2],
+        m: [half::f16; 9],
+        g: [half::bf16; 3],
+        one: [u16; 1],
+    }
+
+    /// A one-column 2-byte field at the record's end (no 2 bytes after it to read).
+    #[derive(Clone, Copy)]
+    #[repr(C)]
+    struct Tail {
+        a: u16,
+        z: [u16; 1],
     }
 
     fn recs(r: &mut SplitMix64, n: usize) -> Vec<Rec> {
@@ -1355,15 +1369,18 @@ mod gather {
                 b: std::array::from_fn(|_| f64::from_bits(r.next_u64())),
                 h: std::array::from_fn(|_| r.next_u64() as u16),
                 q: std::array::from_fn(|_| r.next_u64() as i64),
+                m: std::array::from_fn(|_| half::f16::from_bits(r.next_u64() as u16)),
+                g: std::array::from_fn(|_| half::bf16::from_bits(r.next_u64() as u16)),
+                one: [r.next_u64() as u16],
             })
             .collect()
     }
 
-    fn check<T: Copy + Default + 'static, const C: usize>(
+    fn check<R, T: Copy + Default + 'static, const C: usize>(
         k: Kernel,
-        recs: &[Rec],
+        recs: &[R],
         idx: &[u32],
-        pick: impl Fn(&Rec) -> &[T; C] + Copy,
+        pick: impl Fn(&R) -> &[T; C] + Copy,
         bits: impl Fn(T) -> u64,
     ) {
         let mut cols: [Vec<T>; C] = std::array::from_fn(|_| vec![T::default(); idx.len() + 3]);
@@ -1390,6 +1407,11 @@ mod gather {
                 check(k, &recs, &idx, |x| &x.b, f64::to_bits);
                 check(k, &recs, &idx, |x| &x.h, u64::from);
                 check(k, &recs, &idx, |x| &x.q, |v: i64| v as u64);
+                check(k, &recs, &idx, |x| &x.m, |v: half::f16| u64::from(v.to_bits()));
+                check(k, &recs, &idx, |x| &x.g, |v: half::bf16| u64::from(v.to_bits()));
+                check(k, &recs, &idx, |x| &x.one, u64::from);
+                let tails: Vec<Tail> = recs.iter().map(|x| Tail { a: x.h[0], z: x.one }).collect();
+                check(k, &tails, &idx, |x| &x.z, u64::from);
             }
         }
     }

@@ -1,7 +1,9 @@
 //! Gathers: fields of records picked by index copied into columns (`cols[c][k] =
 //! pick(recs[idx[k]])[c]`), the step that turns a block of test indices into the kernels' SoA
 //! columns. Scalar, or with AVX-512F gather instructions for 4- and 8-byte values (16 lanes a
-//! step), or AVX2's (8 lanes a step); the same values either way: a gather only copies bits.
+//! step), or AVX2's (8 lanes a step); 2-byte values two columns at a time by 4-byte gathers
+//! (each lane's pair of neighbouring fields, split into the two columns); the same values
+//! either way: a gather only copies bits.
 
 use super::select::best_kernel;
 use super::Kernel;
@@ -14,7 +16,9 @@ pub const AHEAD: usize = 16;
 /// Column by column, `cols[c][k] = pick(&recs[idx[k]])[c]` for every lane `k` of `idx`. With
 /// `fetch` each record [`AHEAD`] lanes on is prefetched, all its lines (a hint). The widest
 /// copy `cap`, the thread's cap and the machine allow: AVX-512F, else AVX2 gathers when `T` is
-/// a 4- or 8-byte number (`f32`, `u32`, `i32`, `f64`, `u64`, `i64`), else scalar.
+/// a 4- or 8-byte number (`f32`, `u32`, `i32`, `f64`, `u64`, `i64`) or a 2-byte one (`u16`,
+/// `i16`, `half::f16`, `half::bf16`: 4-byte gathers of neighbouring pairs, every byte read
+/// within its record), else scalar.
 ///
 /// # Panics
 /// If a column is shorter than `idx`, or an index is out of range.
@@ -37,6 +41,10 @@ pub fn gather<R, T: Copy + 'static, const C: usize>(
             Some(4)
         } else if is::<T, f64>() || is::<T, u64>() || is::<T, i64>() {
             Some(8)
+        } else if (is::<T, u16>() || is::<T, i16>() || is::<T, half::f16>() || is::<T, half::bf16>())
+            && pair_reads_fit::<R>(off, C)
+        {
+            Some(2)
         } else {
             None
         };
@@ -82,6 +90,30 @@ fn fits_i32<R>(n: usize) -> bool {
     n.checked_add(1).and_then(|m| m.checked_mul(std::mem::size_of::<R>())).is_some_and(|b| b <= i32::MAX as usize)
 }
 
+/// Whether the 4-byte reads of a 2-byte field of `c` columns at byte offset `off` ([`pair_read`])
+/// stay within the record: always for `c` ≥ 2 (every read covers two of the field's columns);
+/// for `c` = 1 the 2 bytes after the field must lie in the record.
+#[inline(always)]
+fn pair_reads_fit<R>(off: usize, c: usize) -> bool {
+    c >= 2 || off + 4 <= std::mem::size_of::<R>()
+}
+
+/// The byte offsets (from the field) of the 4-byte reads of a 2-byte field of `c` columns, and
+/// which half of each read a column takes: column `k` reads at `2·(k − k % 2)` (its pair's
+/// first), taking the low half when k is even, the high half when odd; an odd last column
+/// (`c` odd, ≥ 3) reads with its left neighbour at `2·(k − 1)`, high half; `c` = 1 reads at 0,
+/// low half.
+#[inline(always)]
+fn pair_read(k: usize, c: usize) -> (usize, bool) {
+    if k % 2 == 1 {
+        (2 * (k - 1), true)
+    } else if k + 1 < c || c == 1 {
+        (2 * k, false)
+    } else {
+        (2 * (k - 1), true)
+    }
+}
+
 /// Asks the cache for every line of `*r` (a hint: no effect on results).
 #[inline(always)]
 pub fn prefetch<R>(r: &R) {
@@ -122,12 +154,13 @@ fn steps<R>(recs: &[R], idx: &[u32], fetch: bool, lanes: usize, mut step: impl F
     whole
 }
 
-/// The whole 16-lane steps of [`gather`] with AVX-512F gathers of `w`-byte values (4 or 8) at
-/// byte offset `off` of each record; returns the lanes done (the rest are the caller's).
+/// The whole 16-lane steps of [`gather`] with AVX-512F gathers of `w`-byte values (4 or 8; 2:
+/// 4-byte gathers of pairs, [`pair_read`]) at byte offset `off` of each record; returns the
+/// lanes done (the rest are the caller's).
 ///
 /// # Safety
 /// AVX-512F present; `cols[c]` valid for `idx.len()` writes of `T`; `T` a plain `w`-byte
-/// number; `(recs.len() + 1) · size_of::<R>()` at most `i32::MAX`; `off + C·w` within a record.
+/// number; `(recs.len() + 1) · size_of::<R>()` at most `i32::MAX`; `off + C·w` within a record; for `w` = 2, [`pair_reads_fit`].
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 unsafe fn avx512<R, T, const C: usize>(
@@ -147,6 +180,28 @@ unsafe fn avx512<R, T, const C: usize>(
         let ix = unsafe { _mm512_loadu_si512(idx.as_ptr().add(k).cast()) };
         assert!(_mm512_cmpge_epu32_mask(ix, len) == 0, "gather: index out of range");
         let offs = _mm512_mullo_epi32(ix, stride);
+        if w == 2 {
+            let mut c = 0;
+            while c < C {
+                // SAFETY: each 4-byte read lies within its record (pair_read, pair_reads_fit:
+                // the caller); cols[c] + k .. + 16 is within the column (the caller)
+                unsafe {
+                    let (o, high) = pair_read(c, C);
+                    let v = _mm512_i32gather_epi32::<1>(offs, base.add(off + o).cast());
+                    let lo = _mm512_cvtepi32_epi16(v);
+                    let hi = _mm512_cvtepi32_epi16(_mm512_srli_epi32::<16>(v));
+                    if c + 1 < C {
+                        _mm256_storeu_si256(cols[c].add(k).cast(), lo);
+                        _mm256_storeu_si256(cols[c + 1].add(k).cast(), hi);
+                        c += 2;
+                    } else {
+                        _mm256_storeu_si256(cols[c].add(k).cast(), if high { hi } else { lo });
+                        c += 1;
+                    }
+                }
+            }
+            return;
+        }
         for (c, &col) in cols.iter().enumerate() {
             // SAFETY: every offset + off + c·w + w lies within recs (indices checked, field
             // within its record); col + k .. col + k + 16 is within the column (the caller)
@@ -193,6 +248,32 @@ unsafe fn avx2<R, T, const C: usize>(
         let fits = _mm256_movemask_epi8(_mm256_cmpeq_epi32(_mm256_max_epu32(ix, top), top)) == -1;
         assert!(fits, "gather: index out of range");
         let offs = _mm256_mullo_epi32(ix, stride);
+        if w == 2 {
+            // the low halves of 8 lanes, then the high halves, as 16-bit lanes (values below
+            // 2^16: the unsigned saturating pack keeps them), in lane order
+            let mask = _mm256_set1_epi32(0xffff);
+            let mut c = 0;
+            while c < C {
+                // SAFETY: as in `avx512`, for 8 lanes
+                unsafe {
+                    let (o, high) = pair_read(c, C);
+                    let v = _mm256_i32gather_epi32::<1>(base.add(off + o).cast(), offs);
+                    let lh = _mm256_packus_epi32(_mm256_and_si256(v, mask), _mm256_srli_epi32::<16>(v));
+                    // per 128-bit half: 4 low, 4 high; reordered to 8 low, 8 high
+                    let lh = _mm256_permute4x64_epi64::<0b11_01_10_00>(lh);
+                    let (lo, hi) = (_mm256_castsi256_si128(lh), _mm256_extracti128_si256::<1>(lh));
+                    if c + 1 < C {
+                        _mm_storeu_si128(cols[c].add(k).cast(), lo);
+                        _mm_storeu_si128(cols[c + 1].add(k).cast(), hi);
+                        c += 2;
+                    } else {
+                        _mm_storeu_si128(cols[c].add(k).cast(), if high { hi } else { lo });
+                        c += 1;
+                    }
+                }
+            }
+            return;
+        }
         for (c, &col) in cols.iter().enumerate() {
             // SAFETY: as in `avx512`, for 8 lanes
             unsafe {
