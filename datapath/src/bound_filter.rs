@@ -46,9 +46,10 @@
 //! g = (1 + u)(g_x + g_y + g_x·g_y) + u, h = (1 + u)(h_y·M_x·(1 + g_x) + h_x·M_y·(1 + g_y) +
 //! h_x·h_y) + eta. The binary64 evaluation of both the per-test bound and these constants is
 //! absorbed by inflating every step by `PHI` = 1 + 2⁻⁴⁰ (each step rounds a few times, each
-//! within 1 + 2⁻⁵³; `m`'s own rounding too) and adding `TAU` = 2⁻¹⁰²⁰ to every `eta` and
+//! within 1 + 2⁻⁵³; `m`'s own rounding too) and adding `TAU` = 2⁻⁶⁰⁰ to every `eta` and
 //! `add_eta` (binary64 underflow, at most 2⁻¹⁰⁷⁵ an operation, as a normal number so that the
-//! constants round relatively); then `G = g·PHI`, `H = (h + 2⁻⁴⁵·A)·PHI + TAU` (A the block's
+//! constants round relatively: a product of a constant with a magnitude that underflows is
+//! off by at most 2⁻¹⁰⁷⁵, which the `TAU` the step adds absorbs in `PHI`); then `G = g·PHI`, `H = (h + 2⁻⁴⁵·A)·PHI + TAU` (A the block's
 //! monomial sum) give `RN(RN(G·m) + H) >=` the lane's computed `err()`. The range check is the
 //! same recurrence's `(1 + g)·M + h` (times `PHI`) against `max` at every step, which bounds
 //! every lane's `|v| + e`. Conditions (1)–(4) then read the lane's E where they read the
@@ -111,8 +112,11 @@ const PHI: f64 = 1.0 + 1.0 / (1u64 << 40) as f64;
 
 /// Absolute slack added with every `eta` and `add_eta` of the per-lane recurrences: binary64
 /// underflow in the per-test bound's step or the lane's magnitude (2⁻¹⁰⁷⁵ an operation), as a
-/// normal number, so that every constant it enters is rounded relatively.
-const TAU: f64 = 4.0 * f64::MIN_POSITIVE;
+/// normal number far above the underflow range (2⁻⁶⁰⁰), so that every constant it enters is
+/// rounded relatively — and, a speed choice, so that its products with a block's magnitudes
+/// stay normal (binary64 arithmetic with subnormal results is slow on x86: a microcode assist
+/// per operation) for any magnitude above about 2⁻⁴⁰⁰.
+const TAU: f64 = f64::from_bits((1023 - 600) << 52);
 
 /// Per-lane constants: for each compared signal (det, u', v', t', u' + v') `g` and `h` with
 /// every lane's per-test `err() <= g·m + h`, `m` the lane's magnitude of the signal (its
