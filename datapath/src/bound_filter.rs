@@ -776,8 +776,10 @@ fn certify_with<K: LaneE>(o: BlockOpts, r: BlockRay, k: K, c: [&[f64]; 9], out: 
         let over = quot_may_overflow(recip, u, eta, max, x, e_num, e[0], d);
         out[i] = cleared & !over;
         // a lane whose largest quotient surely leaves the range (|num| >= max·|det|, with room)
-        // fails the three checks too: not marked (leaving a lane uncertified is always safe)
-        let hopeless = x >= max * (d + e[0]) * (1.0 + HOPELESS);
+        // fails the three checks too, as does one whose reciprocal check fails (the same
+        // `1/denom <= max` test, on the same d, is in each of the three): not marked (leaving
+        // a lane uncertified is always safe)
+        let hopeless = (x >= max * (d + e[0]) * (1.0 + HOPELESS)) | (recip & !(max * d * (1.0 - QUOT_MARGIN) >= 1.0));
         let again = cleared & over & !hopeless;
         mark[i] = if again { 1.0 } else { 0.0 };
         near |= again;
