@@ -510,42 +510,60 @@ pub(super) fn slab_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, 
     out: &mut SlabOutSoa<i64>,
     full: usize,
 ) {
-    let one = match rays {
-        SlabRays::One(r) => Some(SlabRayV {
-            o: r.o.map(|v| x.splat(v)),
-            inv_d: r.inv_d.map(|v| x.splat(v)),
-            inv_lo: r.inv_lo.map(|v| x.splat(v)),
-            inv_hi: r.inv_hi.map(|v| x.splat(v)),
-            parallel: r.parallel.map(|p| if p { u8::MAX } else { 0 }),
-            tmin: x.splat(r.tmin),
-            tmax: x.splat(r.tmax),
-        }),
-        SlabRays::Pairs(_) => None,
-    };
-    for i in (0..full).step_by(X::L) {
-        let ray = match (one, rays) {
-            (Some(r), _) => r,
-            (None, SlabRays::Pairs(r)) => SlabRayV {
-                o: load3(x, &r.o, i),
-                inv_d: load3(x, &r.inv_d, i),
-                inv_lo: load3(x, &r.inv_lo, i),
-                inv_hi: load3(x, &r.inv_hi, i),
-                parallel: [
-                    x.load_flags(&r.parallel[0], i),
-                    x.load_flags(&r.parallel[1], i),
-                    x.load_flags(&r.parallel[2], i),
-                ],
-                tmin: x.load(&r.tmin, i),
-                tmax: x.load(&r.tmax, i),
-            },
-            (None, SlabRays::One(_)) => unreachable!("the one-ray shape is broadcast above"),
-        };
-        let (bmin, bmax) = (load3(x, &boxes.min, i), load3(x, &boxes.max, i));
-        let (hit, near, far) = slab_vec::<X, R, WRAP>(x, s, &ray, bmin, bmax);
-        store_flags(&mut out.hit, i, X::L, hit);
-        x.store(&mut out.t_near, i, near);
-        x.store(&mut out.t_far, i, far);
+    match rays {
+        SlabRays::One(r) => {
+            // the ray broadcast once, read by reference (a copy of its 14 vectors per step
+            // was a memory copy per vector)
+            let ray = SlabRayV {
+                o: r.o.map(|v| x.splat(v)),
+                inv_d: r.inv_d.map(|v| x.splat(v)),
+                inv_lo: r.inv_lo.map(|v| x.splat(v)),
+                inv_hi: r.inv_hi.map(|v| x.splat(v)),
+                parallel: r.parallel.map(|p| if p { u8::MAX } else { 0 }),
+                tmin: x.splat(r.tmin),
+                tmax: x.splat(r.tmax),
+            };
+            for i in (0..full).step_by(X::L) {
+                slab_step::<X, R, WRAP>(x, s, &ray, boxes, out, i);
+            }
+        }
+        SlabRays::Pairs(r) => {
+            for i in (0..full).step_by(X::L) {
+                let ray = SlabRayV {
+                    o: load3(x, &r.o, i),
+                    inv_d: load3(x, &r.inv_d, i),
+                    inv_lo: load3(x, &r.inv_lo, i),
+                    inv_hi: load3(x, &r.inv_hi, i),
+                    parallel: [
+                        x.load_flags(&r.parallel[0], i),
+                        x.load_flags(&r.parallel[1], i),
+                        x.load_flags(&r.parallel[2], i),
+                    ],
+                    tmin: x.load(&r.tmin, i),
+                    tmax: x.load(&r.tmax, i),
+                };
+                slab_step::<X, R, WRAP>(x, s, &ray, boxes, out, i);
+            }
+        }
     }
+}
+
+/// One vector of [`slab_loop`]: lanes `i..i + L` of the boxes against `ray`, the outputs
+/// stored.
+#[inline(always)]
+fn slab_step<X: Ops, const R: u8, const WRAP: bool>(
+    x: &X,
+    s: &crate::slab::SlabConfig,
+    ray: &SlabRayV<X::V>,
+    boxes: &BoxesSoa<i64>,
+    out: &mut SlabOutSoa<i64>,
+    i: usize,
+) {
+    let (bmin, bmax) = (load3(x, &boxes.min, i), load3(x, &boxes.max, i));
+    let (hit, near, far) = slab_vec::<X, R, WRAP>(x, s, ray, bmin, bmax);
+    store_flags(&mut out.hit, i, X::L, hit);
+    x.store(&mut out.t_near, i, near);
+    x.store(&mut out.t_far, i, far);
 }
 
 /// Lane `i`'s vector of each of three columns. A function, not a closure in `array::map`: a
