@@ -324,27 +324,43 @@ fn flags_body(
         return;
     }
     let r = d.map(|x| 1.0 / x);
-    // a group's box planes, copied into fixed arrays (in a block's last group the lanes past
-    // its end hold stale planes and are not written back): the lane loop runs without bounds
-    // checks and vectorises
-    let mut bg = [[0.0f64; FLAG_GROUP]; 6];
-    let (mut hg, mut cg, mut ug) = ([false; FLAG_GROUP], [false; FLAG_GROUP], [false; FLAG_GROUP]);
+    // a group's box planes and flags as fixed arrays — a whole group's read and written in
+    // place, the block's last partial group copied into local arrays (its lanes past the end
+    // hold stale planes and are not written back): the lane loop runs without bounds checks
+    // and vectorises
+    let mut bl = [[0.0f64; FLAG_GROUP]; 6];
+    let (mut hl, mut cl, mut ug) = ([false; FLAG_GROUP], [false; FLAG_GROUP], [false; FLAG_GROUP]);
     // the usual ray has no zero direction component: then no axis is parallel and the group's
     // lanes run without the parallel-axis test (the same flags: `dead` stays false)
     let parallel = d.contains(&0.0);
+    // (a macro, not a closure: a closure is compiled apart from the target-feature function
+    // that inlines this one)
+    macro_rules! group {
+        ($bg:expr, $hg:expr, $cg:expr) => {
+            if parallel {
+                flags_group::<true>(o, d, r, tmin, tmax, $bg, close_rel, $hg, $cg, &mut ug);
+            } else {
+                flags_group::<false>(o, d, r, tmin, tmax, $bg, close_rel, $hg, $cg, &mut ug);
+            }
+        };
+    }
     let mut g = 0;
     while g < hit.len() {
         let m = FLAG_GROUP.min(hit.len() - g);
-        for (k, col) in bg.iter_mut().enumerate() {
-            col[..m].copy_from_slice(&b[k][g..g + m]);
-        }
-        if parallel {
-            flags_group::<true>(o, d, r, tmin, tmax, &bg, close_rel, &mut hg, &mut cg, &mut ug);
+        if m == FLAG_GROUP {
+            let bg: [&[f64; FLAG_GROUP]; 6] =
+                std::array::from_fn(|k| b[k][g..g + FLAG_GROUP].try_into().expect("a whole group"));
+            let hg: &mut [bool; FLAG_GROUP] = (&mut hit[g..g + FLAG_GROUP]).try_into().expect("a whole group");
+            let cg: &mut [bool; FLAG_GROUP] = (&mut close[g..g + FLAG_GROUP]).try_into().expect("a whole group");
+            group!(bg, hg, cg);
         } else {
-            flags_group::<false>(o, d, r, tmin, tmax, &bg, close_rel, &mut hg, &mut cg, &mut ug);
+            for (k, col) in bl.iter_mut().enumerate() {
+                col[..m].copy_from_slice(&b[k][g..g + m]);
+            }
+            group!(bl.each_ref(), &mut hl, &mut cl);
+            hit[g..g + m].copy_from_slice(&hl[..m]);
+            close[g..g + m].copy_from_slice(&cl[..m]);
         }
-        hit[g..g + m].copy_from_slice(&hg[..m]);
-        close[g..g + m].copy_from_slice(&cg[..m]);
         if ug[..m].iter().any(|&u| u) {
             for (j, _) in ug[..m].iter().enumerate().filter(|&(_, &u)| u) {
                 exact(g + j..g + j + 1, hit, close);
@@ -369,7 +385,7 @@ fn flags_group<const PARALLEL: bool>(
     r: [f64; 3],
     tmin: f64,
     tmax: f64,
-    bg: &[[f64; FLAG_GROUP]; 6],
+    bg: [&[f64; FLAG_GROUP]; 6],
     close_rel: f64,
     hg: &mut [bool; FLAG_GROUP],
     cg: &mut [bool; FLAG_GROUP],
