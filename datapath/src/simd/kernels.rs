@@ -174,7 +174,14 @@ macro_rules! rti_kernel {
 /// `$upn(x, n)` steps up `n` times (the conservative variants' widening), `$bcast` broadcasts
 /// a ray value.
 macro_rules! slab_kernel {
-    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr) => {{
+    // without a deferred rounding: `$round` everywhere
+    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr) => {
+        slab_kernel!($x, $s, $rays, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, defer $round, None::<&std::cell::Cell<$x::M>>)
+    };
+    // `defer $lround, $pending`: the non-directed loops round with `$lround`, which may leave
+    // lanes wrong as long as it notes them in `$pending` (`Some(&Cell<mask>)`): those lanes'
+    // outputs are made NaN, and the scalar model redoes them after the loop (`slab_redo`)
+    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, defer $lround:expr, $pending:expr) => {{
         // one loop per comparator and batch shape, so that neither is decided per vector
         let tof = $s.cfg.nan == SlabNan::TakeOnFalse;
         if $s.cfg.directed {
@@ -191,10 +198,10 @@ macro_rules! slab_kernel {
             return;
         }
         match ($rays, tof) {
-            (SlabRays::Pairs(r), false) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $upn, $bcast, false),
-            (SlabRays::Pairs(r), true) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $round, $store, $upn, $bcast, true),
-            (SlabRays::One(r), false) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $upn, $bcast, false),
-            (SlabRays::One(r), true) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $round, $store, $upn, $bcast, true),
+            (SlabRays::Pairs(r), false) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $lround, $pending, $store, $upn, $bcast, false),
+            (SlabRays::Pairs(r), true) => slab_kernel!(@loop $x, $s, pairs r, $boxes, $out, $full, $load, $lround, $pending, $store, $upn, $bcast, true),
+            (SlabRays::One(r), false) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $lround, $pending, $store, $upn, $bcast, false),
+            (SlabRays::One(r), true) => slab_kernel!(@loop $x, $s, one r, $boxes, $out, $full, $load, $lround, $pending, $store, $upn, $bcast, true),
         }
     }};
     // per-batch preparation, hoisted out of the loop: column pointers; for one ray, each
@@ -341,9 +348,11 @@ macro_rules! slab_kernel {
             unsafe { slab_redo(s, SlabRays::One(r), boxes, (o_hit, o_near, o_far), $full) };
         }
     }};
-    (@loop $x:ident, $s:expr, $shape:ident $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $upn:expr, $bcast:expr, $tof:expr) => {{
+    (@loop $x:ident, $s:expr, $shape:ident $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $pending:expr, $store:expr, $upn:expr, $bcast:expr, $tof:expr) => {{
         let (s, boxes, out) = ($s, $boxes, $out);
         let (load, rd, store, upn, bcast) = ($load, $round, $store, $upn, $bcast);
+        let pending = $pending;
+        let none = $x::lt($x::splat(0.0), $x::splat(0.0));
         // n steps down are n steps up mirrored through the sign (negation is exact)
         let neg = |v| $x::xor(v, $x::splat(-0.0));
         let down_n = |v, n| neg(upn(neg(v), n));
@@ -365,7 +374,7 @@ macro_rules! slab_kernel {
         // (the reciprocal's guard is applied when the ray is prepared)
         let guard = s.cfg.guard;
         let zero = $x::splat(0.0);
-        let check_nan = $tof || prep.4 || guard;
+        let check_nan = $tof || prep.4 || guard || pending.is_some();
         let (r, model) = ($r, s);
         let mut nan_seen = 0;
         let mut i = 0;
@@ -400,6 +409,10 @@ macro_rules! slab_kernel {
                 let unbounded = $x::unord($x::mul(ends.0, zero), $x::mul(ends.1, zero));
                 tn = $x::blend(tn, $x::canonical_nan(), unbounded);
             }
+            if let Some(p) = pending {
+                // the lanes the deferred rounding may have got wrong: redone by the model
+                tn = $x::blend(tn, $x::canonical_nan(), p.replace(none));
+            }
             // SAFETY: lanes i..i + L are in bounds.
             unsafe { $x::flags(o_hit, i, $x::le(tn, tf)) };
             store(o_near, i, tn);
@@ -428,10 +441,14 @@ macro_rules! slab_kernel {
 /// t limit flushed but pass it on as it is, so a limit that is a nonzero subnormal encoding
 /// (`$raw_sub`) sends its lane, or the whole one-ray batch, to the scalar model.
 macro_rules! slab_ftz {
-    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, $min:expr, $raw_sub:expr) => {{
+    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, $min:expr, $raw_sub:expr) => {
+        slab_ftz!($x, $s, $rays, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, $min, $raw_sub, defer $round, None::<&std::cell::Cell<$x::M>>)
+    };
+    // `defer`: as `slab_kernel!`'s, with IEEE subnormals only (under FTZ, `$round`)
+    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, $min:expr, $raw_sub:expr, defer $lround:expr, $pending:expr) => {{
         let (s, rays, boxes, out, full) = ($s, $rays, $boxes, $out, $full);
         if s.fmt.opts.subnormals != Subnormals::Ftz {
-            slab_kernel!($x, s, rays, boxes, out, full, $load, $round, $store, $up, $upn, $bcast);
+            slab_kernel!($x, s, rays, boxes, out, full, $load, $round, $store, $up, $upn, $bcast, defer $lround, $pending);
         } else {
             let raw_sub = $raw_sub;
             if let SlabRays::One(r) = rays {
@@ -697,6 +714,9 @@ macro_rules! narrow_for {
             ) {
                 let n: &Narrow = &super::super::select::narrow_of(&s.fmt).expect("the dispatch checked the format");
                 let f = s.fmt;
+                // the non-directed loops round by the split alone and note the lanes outside
+                // its range (`split_noting`), which the scalar model redoes
+                let pending = std::cell::Cell::new($x::lt($x::splat(0.0), $x::splat(0.0)));
                 // SAFETY (loads and stores): the caller checked that every column holds
                 // `full` lanes.
                 slab_ftz!(
@@ -713,7 +733,9 @@ macro_rules! narrow_for {
                     |v, k: u32| $x::next_up_soft_n(v, k, n),
                     |v: u64| $x::splat(f.to_f64(v)),
                     n.min_normal,
-                    |v: u64| n.lay.is_subnormal(v)
+                    |v: u64| n.lay.is_subnormal(v),
+                    defer | x | $x::split_noting(x, n, &pending),
+                    Some(&pending)
                 );
             }
 

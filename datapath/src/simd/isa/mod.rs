@@ -147,6 +147,15 @@ macro_rules! narrow_ops {
             let r = blend(split(x, n), xor(tiny, sgn), lt(a, splat(n.min_normal)));
             blend(r, xor(splat(f64::INFINITY), sgn), le(splat(n.overflow_at), a))
         }
+        /// [`split`], the lanes where it need not be the format's rounding — those
+        /// [`round_full`] takes the full road for: |x| outside [2^emin, max + ulp(max)/2), ±0
+        /// and NaN included — or'ed into `pending` (a caller redoes them).
+        #[inline]
+        #[target_feature(enable = $fmafeat)]
+        pub fn split_noting(x: $v, n: &Narrow, pending: &std::cell::Cell<M>) -> $v {
+            pending.set(or_m(pending.get(), outside_normal(abs(x), n)));
+            split(x, n)
+        }
         /// The next value above each lane on the format's grid, the model's `next_up` for
         /// lanes holding format values:
         /// a lane x ≥ +0 (−0 included) steps away from zero by its quantum

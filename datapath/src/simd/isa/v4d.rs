@@ -157,10 +157,16 @@ pub fn fast_ok(v: &[__m256d; 12], n: &Narrow) -> bool {
 #[inline]
 #[target_feature(enable = "avx2")]
 fn any_outside_normal(a: __m256d, n: &Narrow) -> bool {
+    let odd = _mm256_castpd_si256(outside_normal(a, n));
+    _mm256_testz_si256(odd, odd) == 0
+}
+/// The lanes [`any_outside_normal`] finds (all ones where outside).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn outside_normal(a: __m256d, n: &Narrow) -> M {
     let (lo, hi) = (n.min_normal.to_bits(), n.overflow_at.to_bits());
     let t = _mm256_add_epi64(_mm256_castpd_si256(a), int((1u64 << 63).wrapping_sub(lo)));
-    let odd = _mm256_cmpgt_epi64(t, int((hi - lo - 1) ^ (1u64 << 63)));
-    _mm256_testz_si256(odd, odd) == 0
+    _mm256_castsi256_pd(_mm256_cmpgt_epi64(t, int((hi - lo - 1) ^ (1u64 << 63))))
 }
 /// [`super::v8d::next_up_soft`]'s normal-range step on 4 lanes (the range test as
 /// [`any_outside_normal`] reads it: AVX2's signed compare after adding 2^63).

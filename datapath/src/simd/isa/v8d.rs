@@ -166,8 +166,14 @@ pub fn fast_ok(v: &[__m512d; 12], n: &Narrow) -> bool {
 #[inline]
 #[target_feature(enable = "avx512f")]
 fn any_outside_normal(a: __m512d, n: &Narrow) -> bool {
+    outside_normal(a, n) != 0
+}
+/// The lanes [`any_outside_normal`] finds.
+#[inline]
+#[target_feature(enable = "avx512f")]
+fn outside_normal(a: __m512d, n: &Narrow) -> M {
     let (lo, hi) = (n.min_normal.to_bits(), n.overflow_at.to_bits());
-    _mm512_cmpge_epu64_mask(_mm512_sub_epi64(ib(a), int(lo)), int(hi - lo)) != 0
+    _mm512_cmpge_epu64_mask(_mm512_sub_epi64(ib(a), int(lo)), int(hi - lo))
 }
 /// [`next_up_soft`] when every lane's magnitude is strictly between 2^emin and the format's
 /// largest (else `None`): there a format value's binary64 encoding has its fraction in the top
