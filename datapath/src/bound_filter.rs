@@ -484,8 +484,13 @@ fn quot_may_overflow(recip: bool, u: f64, eta: f64, max: f64, num: f64, e_num: f
     let lhs_div = m * (1.0 + u) + eta * d2;
     let lhs = if recip { lhs_recip } else { lhs_div };
     let fits = lhs <= max * d2 * (1.0 - QUOT_MARGIN);
-    let recip_fits = !recip | (max * d * (1.0 - QUOT_MARGIN) >= 1.0);
-    !(fits & recip_fits)
+    !(fits & (!recip | recip_fits(max, d)))
+}
+
+/// [`quot_may_overflow`]'s reciprocal-mode check `max·d·(1 − 2⁻⁴⁰) >= 1` (false on NaN).
+#[inline(always)]
+fn recip_fits(max: f64, d: f64) -> bool {
+    max * d * (1.0 - QUOT_MARGIN) >= 1.0
 }
 
 /// As [`crate::bound::verdict_block`] — per lane the verdict's `decisive` and `hit`, and
@@ -779,7 +784,7 @@ fn certify_with<K: LaneE>(o: BlockOpts, r: BlockRay, k: K, c: [&[f64]; 9], out: 
         // fails the three checks too, as does one whose reciprocal check fails (the same
         // `1/denom <= max` test, on the same d, is in each of the three): not marked (leaving
         // a lane uncertified is always safe)
-        let hopeless = (x >= max * (d + e[0]) * (1.0 + HOPELESS)) | (recip & !(max * d * (1.0 - QUOT_MARGIN) >= 1.0));
+        let hopeless = (x >= max * (d + e[0]) * (1.0 + HOPELESS)) | (recip & !recip_fits(max, d));
         let again = cleared & over & !hopeless;
         mark[i] = if again { 1.0 } else { 0.0 };
         near |= again;
