@@ -606,38 +606,53 @@ fn packed(
         decisive.len() == n && hit.len() == n && t_err.len() == n && tris.iter().all(|c| c.len() == n),
         "column lengths differ"
     );
+    assert!(u32::try_from(n).is_ok(), "packed: more lanes than u32 indexes");
     let mut cols = [[0.0f64; PACK]; 9];
     let (mut dec, mut hi, mut te) = ([false; PACK], [false; PACK], [0.0f64; PACK]);
-    let mut lanes = [0usize; PACK];
+    let mut lanes = [0u32; PACK];
     if let Some((d, h, t)) = fill {
         // every lane's outputs filled; the lanes not skipped are written again below
         decisive.fill(d);
         hit.fill(h);
         t_err.fill(t);
     }
-    let mut i = 0;
-    while i < n {
-        // the next group: up to PACK lanes not skipped, their indices appended branch-free
-        // (each lane's index written, the count moved on only past a lane not skipped)
-        let mut m = 0;
-        while i < n && m < PACK {
-            lanes[m] = i;
-            m += !skip[i] as usize;
-            i += 1;
-        }
-        if m == 0 {
-            break;
-        }
+    // one group: its lanes' columns gathered (vector gathers where the machine has them),
+    // the verdict, its outputs written back to their lanes
+    let mut run = |idx: &[u32]| {
+        let m = idx.len();
         for (col, src) in cols.iter_mut().zip(tris) {
-            for (x, &l) in col.iter_mut().zip(&lanes[..m]) {
-                *x = src[l];
-            }
+            crate::simd::gather::gather(
+                crate::simd::Kernel::Avx512Fp16,
+                src,
+                idx,
+                false,
+                std::array::from_ref,
+                [&mut col[..m]],
+            );
         }
         let c: [&[f64]; 9] = std::array::from_fn(|k| &cols[k][..m]);
         verdict(c, &mut dec[..m], &mut hi[..m], &mut te[..m]);
-        for (j, &l) in lanes[..m].iter().enumerate() {
+        for (j, &l) in idx.iter().enumerate() {
+            let l = l as usize;
             (decisive[l], hit[l], t_err[l]) = (dec[j], hi[j], te[j]);
         }
+    };
+    // the lanes not skipped, in lane order, word by word (their bits), PACK to a group
+    let mut m = 0;
+    for (w, len) in crate::simd::mask::words(n) {
+        let mut todo = !crate::simd::mask::bits(&skip[w..w + len]) & (u64::MAX >> (64 - len));
+        while todo != 0 {
+            lanes[m] = (w + todo.trailing_zeros() as usize) as u32;
+            todo &= todo - 1;
+            m += 1;
+            if m == PACK {
+                run(&lanes);
+                m = 0;
+            }
+        }
+    }
+    if m > 0 {
+        run(&lanes[..m]);
     }
 }
 
