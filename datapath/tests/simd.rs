@@ -690,6 +690,69 @@ mod slab {
         }
     }
 
+    /// One-ray `eEmM` slab batches whose box planes sit on the ray's origin, a few grid steps
+    /// from it, the smallest normal from it or at ±max, at an ordinary scale, at the smallest
+    /// normal, among the subnormals and near the largest value — plane differences of zero,
+    /// subnormal, exactly 2^emin and near-overflow size, whose
+    /// rounding and grid steps the kernels leave to the scalar model (they note those lanes
+    /// instead of branching per vector) — in every variant, the directed one included: the
+    /// scalar model's bits on every kernel.
+    #[test]
+    fn soft_float_one_ray_slab_kernels_at_zero_tiny_and_huge_plane_differences() {
+        use datapath::simd::{slab_ray_soft, WIDEST_NARROW};
+        let mut r = SplitMix64::new(0x51ab);
+        for name in ["e8m16", "e5m4", "e8m7", "e5m10", "e8m23:divide", "e6m9"] {
+            let datapath::AnyFormat::Soft(f) = name.parse().unwrap() else { unreachable!() };
+            let e = datapath::format::edges(&f);
+            for v in VARIANTS {
+                let s = Slab::new(f, SlabConfig::named(v).unwrap());
+                for scale in [1.0, e.min_normal, e.least * 8.0, e.max / 4.0] {
+                    let q = |x: f64| f.from_f64(x);
+                    let o = [0.3, -0.7, 0.55].map(|x| q(x * scale));
+                    // (long directions too: |1/d| < 1 keeps a product with a plane difference
+                    // stepped past ±max in range, so only the step can tell)
+                    let long = if r.below(2) == 0 { 1.0 } else { 64.0 };
+                    let d: [f64; 3] = std::array::from_fn(|_| r.range(-1.0, 1.0) * long);
+                    let ray = s.prepare(o.map(|x| f.to_f64(x)), d, 0.0, f64::INFINITY);
+                    // a plane k grid steps from the origin's coordinate (k in -3..=3)
+                    let step = |x, k: i64| {
+                        (0..k.unsigned_abs()).fold(x, |x, _| if k > 0 { f.next_up(x) } else { f.next_down(x) })
+                    };
+                    // or the smallest normal away (a difference of exactly 2^emin), or at ±max
+                    // (a difference that rounds to the largest value)
+                    let mut plane = |a: usize, sign: f64| match r.below(8) {
+                        0 => q(f.to_f64(o[a]) + sign * e.min_normal),
+                        1 => q(sign * e.max),
+                        _ => step(o[a], sign as i64 * r.below(4) as i64),
+                    };
+                    let mut boxes = BoxesSoa::default();
+                    for k in 0..64 {
+                        let lo: [_; 3] = std::array::from_fn(|a| plane(a, -1.0));
+                        let hi: [_; 3] = std::array::from_fn(|a| plane(a, 1.0));
+                        boxes.push(&Aabb { min: lo, max: hi });
+                        if k % 16 == 0 {
+                            // every plane at ±max: each exit's difference rounds to ±max and
+                            // steps out to ±∞ (t_far +∞, where a wrong step leaves it finite)
+                            boxes.push(&Aabb { min: [q(-e.max); 3], max: [q(e.max); 3] });
+                        }
+                    }
+                    let n = boxes.min[0].len();
+                    let mut a = SlabOutSoa::with_len(n);
+                    s.batch_ray(&ray, &boxes, &mut a);
+                    let fresh = || SlabOutSoa::with_len(n);
+                    on_every_kernel(
+                        WIDEST_NARROW,
+                        &a,
+                        |b| slab_ray_soft(&s, &ray, &boxes, b),
+                        fresh,
+                        |a, b| same(&s.fmt, a, b),
+                    )
+                    .unwrap_or_else(|err| panic!("{name} {v} at scale {scale:e}: {err}"));
+                }
+            }
+        }
+    }
+
     /// A seeded fixed-point slab batch within the format's range: origins, directions (some
     /// axis components 0: parallel axes, some tiny: saturated 1/d) and boxes scaled to a
     /// quarter of the range, a quarter of the boxes raw bits (possibly inverted), t intervals
