@@ -712,7 +712,11 @@ mod slab {
                     // (long directions too: |1/d| < 1 keeps a product with a plane difference
                     // stepped past ±max in range, so only the step can tell)
                     let long = if r.below(2) == 0 { 1.0 } else { 64.0 };
-                    let d: [f64; 3] = std::array::from_fn(|_| r.range(-1.0, 1.0) * long);
+                    // (and tiny components, whose 1/d ends stand for ±∞)
+                    let d: [f64; 3] = std::array::from_fn(|_| match r.below(4) {
+                        0 => r.range(-1.0, 1.0) * e.least,
+                        _ => r.range(-1.0, 1.0) * long,
+                    });
                     let ray = s.prepare(o.map(|x| f.to_f64(x)), d, 0.0, f64::INFINITY);
                     // a plane k grid steps from the origin's coordinate (k in -3..=3)
                     let step = |x, k: i64| {

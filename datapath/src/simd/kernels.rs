@@ -321,9 +321,17 @@ macro_rules! slab_kernel {
                 };
                 // the 1/d end by the bracket end's sign: negative → inv_hi (entry) / inv_lo (exit)
                 let inv_e = $x::blend_sign(inv_lo[a], inv_hi[a], x_e);
-                let inv_e_inf = $x::blend_m(m(lo_inf[a]), m(hi_inf[a]), $x::sign_m(x_e));
                 let inv_x = $x::blend_sign(inv_hi[a], inv_lo[a], x_x);
-                let inv_x_inf = $x::blend_m(m(hi_inf[a]), m(lo_inf[a]), $x::sign_m(x_x));
+                // whether the chosen 1/d end stands for ±∞ (the usual ray's ends are finite:
+                // no lane's is, and the uniform test skips the per-lane choice)
+                let (inv_e_inf, inv_x_inf) = if lo_inf[a] || hi_inf[a] {
+                    (
+                        $x::blend_m(m(lo_inf[a]), m(hi_inf[a]), $x::sign_m(x_e)),
+                        $x::blend_m(m(hi_inf[a]), m(lo_inf[a]), $x::sign_m(x_x)),
+                    )
+                } else {
+                    (none, none)
+                };
                 let t_entry = $x::blend(down(rd($x::mul(x_e, inv_e))), vbottom, $x::or_m(x_e_inf, inv_e_inf));
                 let t_exit = $x::blend(up(rd($x::mul(x_x, inv_x))), vtop, $x::or_m(x_x_inf, inv_x_inf));
                 if $tof {
