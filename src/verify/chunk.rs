@@ -268,17 +268,29 @@ where
 {
     fn chunk(&self, s: &mut Scratch<F::V>, rays: std::ops::Range<u64>) -> (RtiAcc, Vec<SlabAcc>) {
         let f = &self.rti.fmt;
-        let q = |x: f64| f.to_f64(f.from_f64(x));
+        let w = |v: F::V| f.to_f64(v);
         let mut acc = RtiAcc::default();
         let mut sacc: Vec<SlabAcc> = self.variants.iter().map(|_| SlabAcc::default()).collect();
         for i in rays {
             let (ray, target) = self.gen.ray(self.scene, i);
             test_list(self.scene.tris.len(), self.cfg.sample, self.cfg.seed, i, target, &mut s.list);
-            let rq = Ray64 { o: ray.o.map(q), d: ray.d.map(q), tmin: q(ray.tmin), tmax: q(ray.tmax) };
+            // the ray in the format once: the model's ray, its values in f64 (the quantised ray)
+            // and every slab variant's stage 0 (`Slab::prepare` is `prepare_faulty` on these
+            // same encodings)
             let mray = self.rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
+            let rq = Ray64 { o: mray.o.map(w), d: mray.d.map(w), tmin: w(mray.tmin), tmax: w(mray.tmax) };
             let mut prepared = std::mem::take(&mut s.prepared);
             prepared.clear();
-            prepared.extend(self.variants.iter().map(|v| v.slab.prepare(ray.o, ray.d, ray.tmin, ray.tmax)));
+            prepared.extend(self.variants.iter().map(|v| {
+                v.slab.prepare_faulty(
+                    mray.o,
+                    mray.d,
+                    mray.tmin,
+                    mray.tmax,
+                    &mut datapath::probe::NoProbe,
+                    &datapath::fault::NoFault,
+                )
+            }));
             let mut cap = Capture::default();
             let mut gbest: Option<(usize, f64)> = None;
             let list = std::mem::take(&mut s.list);
