@@ -426,6 +426,12 @@ impl<F: Format> Slab<F> {
         self.prepare_trace(o, d, tmin, tmax, &mut NoProbe)
     }
 
+    /// Stage 0 on a ray already in the format's encodings, without probing ([`Self::prepare`]
+    /// after its conversions).
+    pub fn prepare_encoded(&self, o: [F::V; 3], d: [F::V; 3], tmin: F::V, tmax: F::V) -> SlabRay<F::V> {
+        self.prepare_faulty(o, d, tmin, tmax, &mut NoProbe, &NoFault)
+    }
+
     /// The float layout the guard checks against, when the guard is on and the format is a float.
     #[inline(always)]
     fn guard_layout(&self) -> Option<crate::format::FloatLayout> {

@@ -275,22 +275,13 @@ where
             let (ray, target) = self.gen.ray(self.scene, i);
             test_list(self.scene.tris.len(), self.cfg.sample, self.cfg.seed, i, target, &mut s.list);
             // the ray in the format once: the model's ray, its values in f64 (the quantised ray)
-            // and every slab variant's stage 0 (`Slab::prepare` is `prepare_faulty` on these
+            // and every slab variant's stage 0 (`Slab::prepare` is `prepare_encoded` on these
             // same encodings)
             let mray = self.rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
             let rq = Ray64 { o: mray.o.map(w), d: mray.d.map(w), tmin: w(mray.tmin), tmax: w(mray.tmax) };
             let mut prepared = std::mem::take(&mut s.prepared);
             prepared.clear();
-            prepared.extend(self.variants.iter().map(|v| {
-                v.slab.prepare_faulty(
-                    mray.o,
-                    mray.d,
-                    mray.tmin,
-                    mray.tmax,
-                    &mut datapath::probe::NoProbe,
-                    &datapath::fault::NoFault,
-                )
-            }));
+            prepared.extend(self.variants.iter().map(|v| v.slab.prepare_encoded(mray.o, mray.d, mray.tmin, mray.tmax)));
             let mut cap = Capture::default();
             let mut gbest: Option<(usize, f64)> = None;
             let list = std::mem::take(&mut s.list);

@@ -23,9 +23,7 @@
 //! `t_near ≤ max(tmin, L_x, L_y, L_z)` and `t_far ≥ min(tmax, H_x, H_y, H_z)`, so an exact
 //! non-empty interval is a hit (`t_near ≤ t_far`, no final widening in this variant).
 
-use datapath::fault::NoFault;
 use datapath::format::FormatKind;
-use datapath::probe::NoProbe;
 use datapath::slab::{Slab, SlabConfig};
 use datapath::Format;
 
@@ -132,7 +130,7 @@ fn enumerate_with<F: Format>(
             if !x.is_finite() {
                 return None;
             }
-            let r = slab.prepare_faulty([zero; 3], [d, one, one], zero, zero, &mut NoProbe, &NoFault);
+            let r = slab.prepare_encoded([zero; 3], [d, one, one], zero, zero);
             (!r.parallel[0]).then_some((b, x, [r.inv_d[0], r.inv_lo[0], r.inv_hi[0]]))
         })
         .collect();
@@ -189,7 +187,7 @@ mod tests {
             if f.is_nan(de) || f.is_nan(d) || !f.to_f64(d).is_finite() {
                 continue;
             }
-            let ray = slab.prepare_faulty([zero; 3], [d, one, one], zero, zero, &mut NoProbe, &NoFault);
+            let ray = slab.prepare_encoded([zero; 3], [d, one, one], zero, zero);
             if ray.parallel[0] {
                 continue;
             }
