@@ -415,6 +415,7 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
                 opts,
                 bray,
                 c9(),
+                None,
                 &mut dec,
                 &mut hit,
                 &mut te,

@@ -56,6 +56,18 @@
 //! block's, and the argument is unchanged. (A finer format keeps the block's constants: they
 //! already certify nearly every lane the per-test bound decides as a miss, at less cost.)
 //!
+//! **Constants over a set.** Every recurrence above is non-decreasing in the magnitudes it
+//! starts from and the range check only stricter, so any upper bounds on the block's largest
+//! differences and sums serve, certifying at most the lanes the block's own would. [`SetMaxima`]
+//! holds such bounds over every triangle of a set (verify: a scene's triangles in a format, as
+//! the columns hold them): per component the largest binary64 |v1 − v0|, |v2 − v0|, |v1| + |v0|,
+//! |v2| + |v0| over the set, and per axis the smallest and largest v0 and the largest |v0|, from
+//! which [`SetMaxima::for_ray`] bounds the origin's terms (binary64 o − v0 is non-increasing in
+//! v0, so over [lo, hi] its magnitude is at most max(|o − lo|, |o − hi|); |o| + |v0| at most
+//! |o| + max |v0|). [`Constants::new`] computes a ray's constants from them once for all of its
+//! blocks (`verdict_block_filtered`'s `pre`); a set with a non-finite coordinate has none, and
+//! its blocks use their own.
+//!
 //! `tests` (here and `datapath/tests/bound_filter.rs`) check the implication lane by lane
 //! against the per-test bound on random and edge blocks (subnormal, huge, ±0, ±∞, NaN inputs),
 //! with block and with per-lane constants (binary16, e8m7 and e5m10 under FTZ).
@@ -497,7 +509,11 @@ fn recip_fits(max: f64, d: f64) -> bool {
 /// `t_err` — with the static filter in front: a certified lane gets `decisive` true, `hit`
 /// false and `t_err` +∞ (it misses: no t to bound), which is the per-test verdict (module
 /// documentation); every other lane is the per-test bound's. Returns the number of certified
-/// lanes. `certified` is scratch space (its length is the block's).
+/// lanes. `certified` is scratch space (its length is the block's). The block's constants are
+/// `pre` where given — [`Constants::new`] for the same `opts` and `ray` from [`SetMaxima`] of a
+/// set holding every triangle of the block (the caller's promise: constants from smaller
+/// magnitudes than the block's would certify wrongly) — else computed from the block's own
+/// maxima ([`block_maxima`]).
 ///
 /// # Panics
 /// If the column lengths differ.
@@ -507,6 +523,7 @@ pub fn verdict_block_filtered(
     opts: BlockOpts,
     ray: BlockRay,
     tris: [&[f64]; 9],
+    pre: Option<&Constants>,
     decisive: &mut [bool],
     hit: &mut [bool],
     t_err: &mut [f64],
@@ -520,11 +537,11 @@ pub fn verdict_block_filtered(
     let ok = match crate::simd::f64_lanes(cap) {
         // SAFETY: AVX-512F is present (f64_lanes detected it)
         #[cfg(target_arch = "x86_64")]
-        F64Lanes::Avx512 => unsafe { filter_avx512(opts, ray, tris, certified, t_err) },
+        F64Lanes::Avx512 => unsafe { filter_avx512(opts, ray, tris, pre, certified, t_err) },
         // SAFETY: AVX2 is present (f64_lanes detected it)
         #[cfg(target_arch = "x86_64")]
-        F64Lanes::Avx2 => unsafe { filter_avx2(opts, ray, tris, certified, t_err) },
-        _ => filter(opts, ray, tris, certified, t_err),
+        F64Lanes::Avx2 => unsafe { filter_avx2(opts, ray, tris, pre, certified, t_err) },
+        _ => filter(opts, ray, tris, pre, certified, t_err),
     };
     if !ok {
         crate::bound::verdict_block(cap, opts, ray, tris, decisive, hit, t_err);
@@ -557,7 +574,8 @@ pub fn verdict_block_filtered(
 
 /// [`verdict_block_filtered`] on the lanes `i` with `skip[i]` false only — their `decisive`,
 /// `hit` and `t_err` written, every other lane's left as it was — the lanes packed into groups
-/// of their own (`packed`: a lane's verdict does not depend on where it sits).
+/// of their own (`packed`: a lane's verdict does not depend on where it sits); `pre` as there
+/// (constants from the block's triangles' set, else each group's own).
 ///
 /// # Panics
 /// If the column lengths differ.
@@ -567,6 +585,7 @@ pub fn verdict_lanes_filtered(
     opts: BlockOpts,
     ray: BlockRay,
     tris: [&[f64]; 9],
+    pre: Option<&Constants>,
     skip: &[bool],
     decisive: &mut [bool],
     hit: &mut [bool],
@@ -574,7 +593,7 @@ pub fn verdict_lanes_filtered(
 ) {
     let mut certified = [false; PACK];
     packed(tris, skip, None, decisive, hit, t_err, |c, d, h, t| {
-        verdict_block_filtered(cap, opts, ray, c, d, h, t, &mut certified[..d.len()]);
+        verdict_block_filtered(cap, opts, ray, c, pre, d, h, t, &mut certified[..d.len()]);
     });
 }
 
@@ -675,6 +694,98 @@ pub fn block_maxima(cap: crate::simd::Kernel, ray: BlockRay, tris: [&[f64]; 9]) 
     }
 }
 
+/// Bounds on the magnitudes a block's static constants come from, over every triangle of a
+/// set (a scene's triangles in a format): for any block of the set's triangles and any ray,
+/// [`SetMaxima::for_ray`] is no smaller, component by component, than the block's
+/// [`block_maxima`] — so the constants computed from it serve every such block. Every
+/// recurrence of the constants is non-decreasing in the magnitudes it starts from, and the
+/// range check only stricter (module documentation), so constants from larger magnitudes are
+/// sound, certifying at most the lanes the block's own would (CGAL's static filters take such
+/// bounds over all of a program's inputs).
+#[derive(Clone, Copy, Debug)]
+pub struct SetMaxima {
+    /// e1 x, y, z, e2 x, y, z: the largest binary64 |v1 − v0| (|v2 − v0|) and |v1| + |v0|
+    /// (|v2| + |v0|) over the set, as a lane computes them.
+    ve: [f64; 6],
+    ae: [f64; 6],
+    /// Per axis the smallest and largest v0 and the largest |v0|.
+    lo: [f64; 3],
+    hi: [f64; 3],
+    a0: [f64; 3],
+    /// Every coordinate of the set finite, and the set not empty.
+    finite: bool,
+}
+
+impl SetMaxima {
+    /// The bounds over these triangles (v0 x, y, z, v1 x, y, z, v2 x, y, z each: the columns'
+    /// order).
+    pub fn of(tris: impl IntoIterator<Item = [f64; 9]>) -> Self {
+        let mut m = SetMaxima {
+            ve: [0.0; 6],
+            ae: [0.0; 6],
+            lo: [f64::INFINITY; 3],
+            hi: [f64::NEG_INFINITY; 3],
+            a0: [0.0; 3],
+            finite: false,
+        };
+        let mut all_finite = true;
+        let mut any = false;
+        for t in tris {
+            any = true;
+            all_finite &= t.iter().all(|x| x.is_finite());
+            for a in 0..3 {
+                let y = t[a];
+                for k in 0..2 {
+                    let x = t[3 * (k + 1) + a];
+                    m.ve[3 * k + a] = m.ve[3 * k + a].max((x - y).abs());
+                    m.ae[3 * k + a] = m.ae[3 * k + a].max(x.abs() + y.abs());
+                }
+                m.lo[a] = m.lo[a].min(y);
+                m.hi[a] = m.hi[a].max(y);
+                m.a0[a] = m.a0[a].max(y.abs());
+            }
+        }
+        m.finite = any && all_finite;
+        m
+    }
+
+    /// The maxima (as [`block_maxima`] gives them) bounding every block of the set's triangles
+    /// against `ray`, or `None` when the set has a non-finite coordinate or no triangle (then
+    /// the blocks' own maxima serve). The origin's components: binary64 o − v0 is
+    /// non-increasing in v0 (rounding is monotone), so over v0 in [lo, hi] its magnitude is at
+    /// most the larger of |o − lo| and |o − hi|; |o| + |v0| at most |o| + max |v0|.
+    pub fn for_ray(&self, ray: BlockRay) -> Option<([f64; 9], [f64; 9], f64, bool)> {
+        if !self.finite {
+            return None;
+        }
+        let mut ve = [0.0; 9];
+        let mut ae = [0.0; 9];
+        ve[..6].copy_from_slice(&self.ve);
+        ae[..6].copy_from_slice(&self.ae);
+        for a in 0..3 {
+            let o = ray.o[a];
+            ve[6 + a] = (o - self.lo[a]).abs().max((o - self.hi[a]).abs());
+            ae[6 + a] = o.abs() + self.a0[a];
+        }
+        // (a NaN origin makes these NaN; the constants refuse a NaN ray on its own)
+        Some((ve, ae, largest(ae), false))
+    }
+}
+
+/// A block's static constants computed ahead ([`Constants::new`]), for
+/// [`verdict_block_filtered`]'s `pre`: every block of a set against one ray shares them.
+#[derive(Clone, Copy, Debug)]
+pub struct Constants(Option<Static>);
+
+impl Constants {
+    /// The constants for `opts` and `ray` from maxima that bound a block's (`SetMaxima::for_ray`
+    /// or [`block_maxima`]); none (no lane certified) where the range check fails or an input
+    /// is NaN.
+    pub fn new(opts: BlockOpts, ray: BlockRay, m: ([f64; 9], [f64; 9], f64, bool)) -> Self {
+        Constants(statics(opts, ray, m))
+    }
+}
+
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 fn maxima_avx512(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
@@ -691,38 +802,59 @@ fn maxima_avx2(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn filter_avx512(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) -> bool {
+fn filter_avx512(
+    o: BlockOpts,
+    r: BlockRay,
+    c: [&[f64]; 9],
+    pre: Option<&Constants>,
+    out: &mut [bool],
+    mark: &mut [f64],
+) -> bool {
     // SAFETY: AVX-512F is enabled on this function
-    let m = unsafe { maxima_v::<crate::lanes_x86::F64x8>(r, c) };
-    filter_with(o, r, c, m, out, mark)
+    let st = pre.map_or_else(|| statics(o, r, unsafe { maxima_v::<crate::lanes_x86::F64x8>(r, c) }), |k| k.0);
+    filter_with(o, r, c, st, out, mark)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn filter_avx2(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) -> bool {
+fn filter_avx2(
+    o: BlockOpts,
+    r: BlockRay,
+    c: [&[f64]; 9],
+    pre: Option<&Constants>,
+    out: &mut [bool],
+    mark: &mut [f64],
+) -> bool {
     // SAFETY: AVX2 is enabled on this function
-    let m = unsafe { maxima_v::<crate::lanes_x86::F64x4>(r, c) };
-    filter_with(o, r, c, m, out, mark)
+    let st = pre.map_or_else(|| statics(o, r, unsafe { maxima_v::<crate::lanes_x86::F64x4>(r, c) }), |k| k.0);
+    filter_with(o, r, c, st, out, mark)
 }
 
-/// The block's constants and each lane's certificate; false when the block has none (range
-/// check, NaN): then no lane is certified.
+/// The block's constants (`pre`, or from the block's maxima) and each lane's certificate;
+/// false when the block has none (range check, NaN): then no lane is certified.
 #[inline(always)]
-fn filter(o: BlockOpts, r: BlockRay, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) -> bool {
-    filter_with(o, r, c, maxima(r, c), out, mark)
+fn filter(
+    o: BlockOpts,
+    r: BlockRay,
+    c: [&[f64]; 9],
+    pre: Option<&Constants>,
+    out: &mut [bool],
+    mark: &mut [f64],
+) -> bool {
+    filter_with(o, r, c, pre.map_or_else(|| statics(o, r, maxima(r, c)), |k| k.0), out, mark)
 }
 
-/// [`filter`] with the block's maxima given.
+/// [`filter`] with the block's constants given.
 #[inline(always)]
 fn filter_with(
     o: BlockOpts,
     r: BlockRay,
     c: [&[f64]; 9],
-    m: ([f64; 9], [f64; 9], f64, bool),
+    st: Option<Static>,
     out: &mut [bool],
     mark: &mut [f64],
 ) -> bool {
-    match statics(o, r, m) {
+    match st {
         Some(st) => {
             certify(o, r, st, c, out, mark);
             true

@@ -5,10 +5,12 @@
 //! (subnormal, near the format's largest, ±0, ±∞, NaN, small integers whose compares tie), in
 //! binary32, binary16, bfloat16-like, FTZ and fixed-point error models, both division modes,
 //! both cull rules, a zero and a nonzero det threshold, on every instruction level the machine
-//! has (under `emu/avx512`: AVX-512F too).
+//! has (under `emu/avx512`: AVX-512F too) — with the block's own constants and with constants
+//! computed ahead from the bounds of a larger set holding the block's triangles
+//! (`SetMaxima`, `Constants`: verify's path, one set per scene and format).
 
 use datapath::bound::{verdict_block, BlockOpts, BlockRay, RtiBound};
-use datapath::bound_filter::verdict_block_filtered;
+use datapath::bound_filter::{verdict_block_filtered, Constants, SetMaxima};
 use datapath::format::DivMode;
 use datapath::rng::SplitMix64;
 use datapath::rti::Cull;
@@ -38,35 +40,72 @@ fn edge(r: &mut SplitMix64, max: f64, finite: bool) -> f64 {
     }
 }
 
-/// Runs both on one block and compares lane by lane; returns the certified lanes and the lanes
-/// the per-test bound finds decisive misses.
-fn same(opts: BlockOpts, ray: BlockRay, cols: &[Vec<f64>; 9]) -> Result<(usize, usize), TestCaseError> {
+/// A set holding every triangle of the block and each again with its vertices rotated (v1, v2,
+/// v0: other first differences, the same values): constants from its bounds (`None` where it
+/// has none: a non-finite coordinate).
+fn set_constants(opts: BlockOpts, ray: BlockRay, cols: &[Vec<f64>; 9]) -> Option<Constants> {
+    let n = cols[0].len();
+    let tris = (0..n).flat_map(|i| {
+        let t: [f64; 9] = std::array::from_fn(|k| cols[k][i]);
+        [t, std::array::from_fn(|k| t[(k + 3) % 9])]
+    });
+    SetMaxima::of(tris).for_ray(ray).map(|m| Constants::new(opts, ray, m))
+}
+
+/// Runs the per-test bound and the filter (the block's own constants, and the set's of
+/// [`set_constants`]) on one block and compares lane by lane; returns the lanes certified by
+/// the block's constants, the lanes the per-test bound finds decisive misses, and the lanes
+/// certified by the set's constants.
+fn same(opts: BlockOpts, ray: BlockRay, cols: &[Vec<f64>; 9]) -> Result<(usize, usize, usize), TestCaseError> {
     let n = cols[0].len();
     let c = || std::array::from_fn(|k| &cols[k][..]);
-    let (mut certified, mut misses) = (0, 0);
+    let set = set_constants(opts, ray, cols);
+    let (mut certified, mut misses, mut by_set) = (0, 0, 0);
     for k in kernels_here() {
         let (mut dec, mut hit, mut te) = (vec![false; n], vec![false; n], vec![0.0; n]);
         verdict_block(k, opts, ray, c(), &mut dec, &mut hit, &mut te);
-        let (mut fdec, mut fhit, mut fte, mut cert) = (vec![false; n], vec![false; n], vec![0.0; n], vec![false; n]);
-        let got = verdict_block_filtered(k, opts, ray, c(), &mut fdec, &mut fhit, &mut fte, &mut cert);
-        for i in 0..n {
-            prop_assert_eq!((fdec[i], fhit[i]), (dec[i], hit[i]), "{:?} lane {}: certified {}", k, i, cert[i]);
-            if cert[i] {
-                prop_assert!(fte[i] == f64::INFINITY && dec[i] && !hit[i], "{:?} lane {}", k, i);
-            } else {
-                prop_assert!(
-                    fte[i].to_bits() == te[i].to_bits() || (fte[i].is_nan() && te[i].is_nan()),
-                    "{:?} lane {}",
+        for (which, pre) in [(0, None), (1, set.as_ref())] {
+            let (mut fdec, mut fhit, mut fte, mut cert) =
+                (vec![false; n], vec![false; n], vec![0.0; n], vec![false; n]);
+            let got = verdict_block_filtered(k, opts, ray, c(), pre, &mut fdec, &mut fhit, &mut fte, &mut cert);
+            for i in 0..n {
+                prop_assert_eq!(
+                    (fdec[i], fhit[i]),
+                    (dec[i], hit[i]),
+                    "{:?} constants {} lane {}: certified {}",
                     k,
-                    i
+                    which,
+                    i,
+                    cert[i]
                 );
+                if cert[i] {
+                    prop_assert!(
+                        fte[i] == f64::INFINITY && dec[i] && !hit[i],
+                        "{:?} constants {} lane {}",
+                        k,
+                        which,
+                        i
+                    );
+                } else {
+                    prop_assert!(
+                        fte[i].to_bits() == te[i].to_bits() || (fte[i].is_nan() && te[i].is_nan()),
+                        "{:?} constants {} lane {}",
+                        k,
+                        which,
+                        i
+                    );
+                }
+            }
+            prop_assert_eq!(got, cert.iter().filter(|&&c| c).count());
+            if which == 0 {
+                certified = got;
+            } else {
+                by_set = got;
             }
         }
-        prop_assert_eq!(got, cert.iter().filter(|&&c| c).count());
-        certified = got;
         misses = (0..n).filter(|&i| dec[i] && !hit[i]).count();
     }
-    Ok((certified, misses))
+    Ok((certified, misses, by_set))
 }
 
 fn opts(r: &mut SplitMix64, fmt: usize, divide: bool, cull: bool) -> BlockOpts {
@@ -78,7 +117,7 @@ fn opts(r: &mut SplitMix64, fmt: usize, divide: bool, cull: bool) -> BlockOpts {
     }
 }
 
-/// One block of edge values (`fin`: finite ones only) through both; (certified, decisive misses).
+/// One block of edge values (`fin`: finite ones only) through both; as [`same`].
 fn edge_block(
     seed: u64,
     n: usize,
@@ -86,7 +125,7 @@ fn edge_block(
     cull: bool,
     fmt: usize,
     fin: bool,
-) -> Result<(usize, usize), TestCaseError> {
+) -> Result<(usize, usize, usize), TestCaseError> {
     let mut r = SplitMix64::new(seed);
     let o = opts(&mut r, fmt, divide, cull);
     let max = o.em.max;
@@ -119,12 +158,14 @@ proptest! {
 /// bound decides it.
 #[test]
 fn finite_edge_blocks_are_certified_as_the_per_test_bound_decides() {
-    let mut certified = 0;
+    let (mut certified, mut by_set) = (0, 0);
     for seed in 0..300u64 {
-        let (k, _) = edge_block(seed, 48, seed % 2 == 0, seed % 3 == 0, (seed % 6) as usize, true).unwrap();
+        let (k, _, ks) = edge_block(seed, 48, seed % 2 == 0, seed % 3 == 0, (seed % 6) as usize, true).unwrap();
         certified += k;
+        by_set += ks;
     }
     assert!(certified > 100, "only {certified} lanes certified");
+    assert!(by_set > 100, "only {by_set} lanes certified by the set's constants");
 }
 
 /// Triangles scattered around a ray, as a scene's block is: every lane gets the per-test
@@ -134,7 +175,7 @@ fn finite_edge_blocks_are_certified_as_the_per_test_bound_decides() {
 /// differences and would leave a fifth to two thirds) by the per-lane constants.
 #[test]
 fn scene_like_blocks_are_mostly_certified() {
-    let mut total = [(0usize, 0usize); 6];
+    let mut total = [(0usize, 0usize, 0usize); 6];
     for seed in 0..48u64 {
         for divide in [false, true] {
             for (fmt, t) in total.iter_mut().enumerate() {
@@ -151,9 +192,10 @@ fn scene_like_blocks_are_mostly_certified() {
                         }
                     }
                 }
-                let (k, misses) = same(o, ray, &cols).unwrap();
+                let (k, misses, ks) = same(o, ray, &cols).unwrap();
                 t.0 += k;
                 t.1 += misses;
+                t.2 += ks;
             }
         }
     }
@@ -165,6 +207,10 @@ fn scene_like_blocks_are_mostly_certified() {
     assert!(share(1) > 0.98, "binary16: {:?}", total[1]);
     assert!(share(5) > 0.9, "e5m10:ftz: {:?}", total[5]);
     assert!(share(2) > 0.9, "e8m7: {:?}", total[2]);
+    // the set's constants (its bounds no smaller than the block's) certify nearly as many
+    for (f, t) in total.iter().enumerate() {
+        assert!(t.2 as f64 >= 0.9 * t.0 as f64, "format {f}: set {} against the block's {}", t.2, t.0);
+    }
 }
 
 /// Far triangles and a slow ray, so that a lane's quotient t = t'/det (or u, v) can leave the
@@ -195,7 +241,7 @@ fn lanes_whose_quotients_overflow_get_the_per_test_verdict() {
                         }
                     }
                 }
-                let (k, _) = same(o, ray, &cols).unwrap();
+                let (k, _, _) = same(o, ray, &cols).unwrap();
                 certified += k;
                 undecided += (0..n).filter(|&i| only_a_quotient_overflows(o, ray, &cols, i)).count();
             }
@@ -244,7 +290,7 @@ fn half_certified_blocks_get_the_per_test_verdict() {
                     }
                 }
             }
-            let (k, _) = same(o, ray, &cols).unwrap();
+            let (k, _, _) = same(o, ray, &cols).unwrap();
             mixed += (n / 4 <= k && n - k > n / 8 + 64) as usize;
         }
     }
@@ -270,19 +316,72 @@ fn lanes_filtered_write_exactly_the_lanes_not_skipped() {
         for k in kernels_here() {
             let (mut dec, mut hit, mut te) = (vec![false; n], vec![false; n], vec![0.0; n]);
             verdict_block(k, o, ray, c, &mut dec, &mut hit, &mut te);
-            let (mut fdec, mut fhit, mut fte) = (vec![true; n], vec![true; n], vec![-7.0; n]);
-            verdict_lanes_filtered(k, o, ray, c, &skip, &mut fdec, &mut fhit, &mut fte);
-            for i in 0..n {
-                if skip[i] {
-                    assert!(fdec[i] && fhit[i] && fte[i] == -7.0, "{k:?} seed {seed}: skipped lane {i} written");
-                } else {
-                    assert_eq!((fdec[i], fhit[i]), (dec[i], hit[i]), "{k:?} seed {seed} lane {i}");
-                    let same = fte[i].to_bits() == te[i].to_bits() || (fte[i].is_nan() && te[i].is_nan());
-                    assert!(same || (fte[i] == f64::INFINITY && dec[i] && !hit[i]), "{k:?} seed {seed} lane {i}");
-                    written += 1;
+            for pre in [None, set_constants(o, ray, &cols)] {
+                let (mut fdec, mut fhit, mut fte) = (vec![true; n], vec![true; n], vec![-7.0; n]);
+                verdict_lanes_filtered(k, o, ray, c, pre.as_ref(), &skip, &mut fdec, &mut fhit, &mut fte);
+                for i in 0..n {
+                    if skip[i] {
+                        assert!(fdec[i] && fhit[i] && fte[i] == -7.0, "{k:?} seed {seed}: skipped lane {i} written");
+                    } else {
+                        assert_eq!((fdec[i], fhit[i]), (dec[i], hit[i]), "{k:?} seed {seed} lane {i}");
+                        let same = fte[i].to_bits() == te[i].to_bits() || (fte[i].is_nan() && te[i].is_nan());
+                        assert!(same || (fte[i] == f64::INFINITY && dec[i] && !hit[i]), "{k:?} seed {seed} lane {i}");
+                        written += 1;
+                    }
                 }
             }
         }
     }
     assert!(written > 10_000, "only {written} lanes written");
+}
+
+/// `SetMaxima::for_ray` is no smaller, component by component, than `block_maxima` of any
+/// block of the set's triangles (whole, single triangles, random subsets), and the NaN flag
+/// clear, on sets of ordinary and edge values (±0, subnormals, powers of two, small integers,
+/// values near binary64's largest, whose differences overflow) and origins among them (±∞
+/// too); `None` exactly when a coordinate of the set is not finite or the set is empty.
+#[test]
+fn set_maxima_bound_every_block_of_the_set() {
+    use datapath::bound_filter::block_maxima;
+    let mut checked = 0;
+    for seed in 0..600u64 {
+        let mut r = SplitMix64::new(seed ^ 0x5e7);
+        let n = r.below(40) as usize;
+        let fin = seed % 5 != 0;
+        let x = |r: &mut SplitMix64| match r.below(6) {
+            0 => edge(r, 1e308, fin),
+            1 => 1.7e308 * r.range(-1.0, 1.0),
+            _ => r.range(-3.0, 3.0),
+        };
+        let tris: Vec<[f64; 9]> = (0..n).map(|_| std::array::from_fn(|_| x(&mut r))).collect();
+        let o: [f64; 3] = std::array::from_fn(|_| match r.below(8) {
+            0 => f64::INFINITY * r.range(-1.0, 1.0).signum(),
+            1 => edge(&mut r, 1e308, true),
+            _ => r.range(-5.0, 5.0),
+        });
+        let ray = BlockRay { o, d: [0.3, -0.2, 1.0], tmin: 0.0, tmax: f64::INFINITY };
+        let m = SetMaxima::of(tris.iter().copied()).for_ray(ray);
+        let finite = n > 0 && tris.iter().flatten().all(|v| v.is_finite());
+        assert_eq!(m.is_some(), finite, "seed {seed}");
+        let Some((ve, ae, big, nan)) = m else { continue };
+        assert!(!nan);
+        for t in 0..6 {
+            let pick: Vec<usize> = match t {
+                0 => (0..n).collect(),
+                1 => vec![r.below(n as u64) as usize],
+                _ => (0..n).filter(|_| r.below(2) == 0).collect(),
+            };
+            let cols: [Vec<f64>; 9] = std::array::from_fn(|k| pick.iter().map(|&i| tris[i][k]).collect());
+            let (bv, ba, bb, bn) =
+                block_maxima(datapath::simd::Kernel::Scalar, ray, std::array::from_fn(|k| &cols[k][..]));
+            assert!(!bn, "seed {seed}");
+            for k in 0..9 {
+                assert!(bv[k] <= ve[k], "seed {seed} block {t}: |difference| {k}: {} > {}", bv[k], ve[k]);
+                assert!(ba[k] <= ae[k], "seed {seed} block {t}: sum {k}: {} > {}", ba[k], ae[k]);
+            }
+            assert!(bb <= big, "seed {seed} block {t}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 1500, "only {checked} blocks checked");
 }

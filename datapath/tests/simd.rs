@@ -1159,7 +1159,7 @@ mod bound_filter_block {
             let cols: [Vec<f64>; 9] = std::array::from_fn(|c| centres.iter().map(|p| x(&mut r, p[c % 3])).collect());
             let run = |k: Kernel| {
                 let (mut dec, mut hit, mut te, mut cert) = (vec![false; n], vec![false; n], vec![0.0; n], vec![false; n]);
-                let got = verdict_block_filtered(k, opts, ray, std::array::from_fn(|c| &cols[c][..]), &mut dec, &mut hit, &mut te, &mut cert);
+                let got = verdict_block_filtered(k, opts, ray, std::array::from_fn(|c| &cols[c][..]), None, &mut dec, &mut hit, &mut te, &mut cert);
                 (got, dec, hit, te.iter().map(|t| if t.is_nan() { u64::MAX } else { t.to_bits() }).collect::<Vec<_>>(), cert)
             };
             let want = run(Kernel::Scalar);

@@ -28,7 +28,7 @@ use super::counts::{RtiCounts, SlabCounts};
 use super::{FormatReport, SlabReport, VerifyConfig};
 use crate::scene::Scene;
 use datapath::bound::{self, BlockOpts, BlockRay};
-use datapath::bound_filter::{verdict_block_filtered, verdict_lanes_filtered};
+use datapath::bound_filter::{verdict_block_filtered, verdict_lanes_filtered, Constants, SetMaxima};
 use datapath::rng::SplitMix64;
 use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
 use datapath::simd::draw::below_column;
@@ -169,6 +169,10 @@ struct Setup<'a, F: Format> {
     qs: Vec<[f64; 9]>,
     /// The quantised columns are converted from the model's ([`Format::fast_f64_column`]).
     q_from_m: bool,
+    /// Bounds over every quantised triangle of the scene: each ray's static-filter constants
+    /// (of the bound and of the reference decision's f64 filter) come from them once, for all
+    /// of its blocks.
+    set: SetMaxima,
     variants: Vec<Variant<F>>,
     opts: BlockOpts,
     /// The reference decision's f64 filter as block options ([`crate::judge::f64_filter_opts`]).
@@ -282,6 +286,11 @@ where
             let mut prepared = std::mem::take(&mut s.prepared);
             prepared.clear();
             prepared.extend(self.variants.iter().map(|v| v.slab.prepare_encoded(mray.o, mray.d, mray.tmin, mray.tmax)));
+            let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
+            let pre = self
+                .set
+                .for_ray(bray)
+                .map(|m| [Constants::new(self.opts, bray, m), Constants::new(self.fopts, bray, m)]);
             let mut cap = Capture::default();
             let mut gbest: Option<(usize, f64)> = None;
             let list = std::mem::take(&mut s.list);
@@ -289,7 +298,7 @@ where
                 let base = b * BLOCK;
                 s.size(blk.len());
                 if self.with_rti {
-                    self.rti_block(s, &mut acc, &ray, &rq, &mray, blk, base, i, &mut cap, &mut gbest);
+                    self.rti_block(s, &mut acc, &ray, &rq, &mray, pre.as_ref(), blk, base, i, &mut cap, &mut gbest);
                 }
                 if !self.variants.is_empty() {
                     self.slab_block(s, &mut sacc, &rq, &prepared, blk);
@@ -330,6 +339,7 @@ where
         ray: &Ray64,
         rq: &Ray64,
         mray: &datapath::rti::Ray<F::V>,
+        pre: Option<&[Constants; 2]>,
         blk: &[u32],
         base: usize,
         ray_index: u64,
@@ -384,7 +394,8 @@ where
         }
         acc.model_ns += self.clock.since(t0);
         let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
-        // the static filter first: a lane its block constants certify gets the per-test
+        // the static filter first (its constants from the scene's bounds, the ray's, where
+        // they exist): a lane its block constants certify gets the per-test
         // bound's verdict without running it (datapath::bound_filter); after a block where it
         // certified few lanes (a coarse format: its constants grow with the block), the next
         // FILTER_REST blocks go straight to the per-test bound — the same verdicts either way
@@ -405,6 +416,7 @@ where
                 self.opts,
                 bray,
                 cols(&s.cols, n),
+                pre.map(|p| &p[0]),
                 &mut s.dec[..n],
                 &mut s.ehit[..n],
                 &mut s.terr[..n],
@@ -421,6 +433,7 @@ where
             self.fopts,
             bray,
             cols(&s.cols, n),
+            pre.map(|p| &p[1]),
             &s.dec[..n],
             &mut s.fdec[..n],
             &mut s.fhit[..n],
@@ -805,7 +818,7 @@ where
             Variant { name, conservative: sc.is_conservative(f), slab: Slab::new(*f, sc) }
         })
         .collect();
-    let recs = scene
+    let recs: Vec<Rec<F::V>> = scene
         .tris
         .iter()
         .map(|t| {
@@ -835,6 +848,14 @@ where
     } else {
         Vec::new()
     };
+    // the static filter's bounds over the quantised triangles: the columns' values exactly
+    let set = if !with_rti {
+        SetMaxima::of(std::iter::empty())
+    } else if q_from_m {
+        SetMaxima::of(recs.iter().map(|r| r.m.map(|v| f.to_f64(v))))
+    } else {
+        SetMaxima::of(qs.iter().copied())
+    };
     let setup = Setup {
         cfg,
         scene,
@@ -843,6 +864,7 @@ where
         recs,
         qs,
         q_from_m,
+        set,
         variants,
         opts: BlockOpts {
             em: f.error_model(),
