@@ -565,8 +565,18 @@ pub fn verdict_block_filtered(
             crate::bound::verdict_block(cap, opts, ray, c, d, h, t)
         });
     } else {
-        for i in 0..n {
-            (decisive[i], hit[i], t_err[i]) = if certified[i] { miss } else { crate::bound::lane(opts, ray, tris, i) };
+        // every lane the certified verdict (vector stores), then the few left one by one,
+        // found from the certificate's bit masks
+        decisive.fill(miss.0);
+        hit.fill(miss.1);
+        t_err.fill(miss.2);
+        for (w, len) in crate::simd::mask::words(n) {
+            let mut todo = !crate::simd::mask::bits(&certified[w..w + len]) & (u64::MAX >> (64 - len));
+            while todo != 0 {
+                let i = w + todo.trailing_zeros() as usize;
+                (decisive[i], hit[i], t_err[i]) = crate::bound::lane(opts, ray, tris, i);
+                todo &= todo - 1;
+            }
         }
     }
     k

@@ -155,6 +155,14 @@ struct Rec<V> {
     b: [f64; 6],
 }
 
+/// A ray's static-filter constants from the scene's bounds (`None` where the scene has none):
+/// the bound's, and the reference decision's f64 filter's once a block needs them.
+struct RayConsts {
+    maxima: Option<([f64; 9], [f64; 9], f64, bool)>,
+    bound: Option<Constants>,
+    f64_filter: std::cell::OnceCell<Option<Constants>>,
+}
+
 /// What every chunk of one format's pass shares (O(scene), built once).
 struct Setup<'a, F: Format> {
     cfg: &'a VerifyConfig,
@@ -287,10 +295,12 @@ where
             prepared.clear();
             prepared.extend(self.variants.iter().map(|v| v.slab.prepare_encoded(mray.o, mray.d, mray.tmin, mray.tmax)));
             let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
-            let pre = self
-                .set
-                .for_ray(bray)
-                .map(|m| [Constants::new(self.opts, bray, m), Constants::new(self.fopts, bray, m)]);
+            let maxima = self.set.for_ray(bray);
+            let pre = RayConsts {
+                maxima,
+                bound: maxima.map(|m| Constants::new(self.opts, bray, m)),
+                f64_filter: std::cell::OnceCell::new(),
+            };
             let mut cap = Capture::default();
             let mut gbest: Option<(usize, f64)> = None;
             let list = std::mem::take(&mut s.list);
@@ -298,7 +308,7 @@ where
                 let base = b * BLOCK;
                 s.size(blk.len());
                 if self.with_rti {
-                    self.rti_block(s, &mut acc, &ray, &rq, &mray, pre.as_ref(), blk, base, i, &mut cap, &mut gbest);
+                    self.rti_block(s, &mut acc, &ray, &rq, &mray, &pre, blk, base, i, &mut cap, &mut gbest);
                 }
                 if !self.variants.is_empty() {
                     self.slab_block(s, &mut sacc, &rq, &prepared, blk);
@@ -339,7 +349,7 @@ where
         ray: &Ray64,
         rq: &Ray64,
         mray: &datapath::rti::Ray<F::V>,
-        pre: Option<&[Constants; 2]>,
+        pre: &RayConsts,
         blk: &[u32],
         base: usize,
         ray_index: u64,
@@ -416,7 +426,7 @@ where
                 self.opts,
                 bray,
                 cols(&s.cols, n),
-                pre.map(|p| &p[0]),
+                pre.bound.as_ref(),
                 &mut s.dec[..n],
                 &mut s.ehit[..n],
                 &mut s.terr[..n],
@@ -428,12 +438,18 @@ where
         }
         // the reference decision's f64 filter on the lanes that are not decisive, packed (each
         // lane's verdict is the scalar one wherever it sits); rti_lane reads it for those lanes
+        // (its constants computed for the ray's first block that has such a lane)
+        let fpre = if s.dec[..n].iter().all(|&d| d) {
+            None
+        } else {
+            pre.f64_filter.get_or_init(|| pre.maxima.map(|m| Constants::new(self.fopts, bray, m))).as_ref()
+        };
         verdict_lanes_filtered(
             Kernel::Avx512Fp16,
             self.fopts,
             bray,
             cols(&s.cols, n),
-            pre.map(|p| &p[1]),
+            fpre,
             &s.dec[..n],
             &mut s.fdec[..n],
             &mut s.fhit[..n],
