@@ -95,8 +95,9 @@ pub struct FormatReport {
     /// Rays whose min-capture result names a different triangle (or hit/miss) than the golden closest hit.
     pub closest_disagreements: u64,
     /// Throughput of the fastest bit-identical batch path (the SIMD kernel for f32 / fp16) inside
-    /// this run: tests over the time spent in the model's batch calls summed over threads,
-    /// million tests per second per thread (the gather into its columns not included).
+    /// this run: tests over the time spent in the model's batch calls summed over threads, on
+    /// the calls of every 8th ray (`chunk::TIME_EVERY`), million tests per second per thread
+    /// (the gather into its columns not included).
     pub mtests_per_s: f64,
     /// Tests per second of wall time for this format's whole pass (rays generated, model,
     /// golden, bound, judging and the slab variants), in millions.
