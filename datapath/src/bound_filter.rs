@@ -534,19 +534,25 @@ pub fn verdict_block_filtered(
         decisive.len() == n && t_err.len() == n && certified.len() == n && tris.iter().all(|c| c.len() == n),
         "column lengths differ"
     );
-    let ok = match crate::simd::f64_lanes(cap) {
-        // SAFETY: AVX-512F is present (f64_lanes detected it)
-        #[cfg(target_arch = "x86_64")]
-        F64Lanes::Avx512 => unsafe { filter_avx512(opts, ray, tris, pre, certified, t_err) },
-        // SAFETY: AVX2 is present (f64_lanes detected it)
-        #[cfg(target_arch = "x86_64")]
-        F64Lanes::Avx2 => unsafe { filter_avx2(opts, ray, tris, pre, certified, t_err) },
-        _ => filter(opts, ray, tris, pre, certified, t_err),
+    // the block's constants: `pre`, or from its own maxima (on the widest vector registers)
+    let st = match pre {
+        Some(k) => k.0,
+        None => statics(opts, ray, block_maxima(cap, ray, tris)),
     };
-    if !ok {
+    let Some(st) = st else {
+        // no constants (range check, NaN): no lane is certified
         crate::bound::verdict_block(cap, opts, ray, tris, decisive, hit, t_err);
         certified.fill(false);
         return 0;
+    };
+    match crate::simd::f64_lanes(cap) {
+        // SAFETY: AVX-512F is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 => unsafe { certify_avx512(opts, ray, st, tris, certified, t_err) },
+        // SAFETY: AVX2 is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx2 => unsafe { certify_avx2(opts, ray, st, tris, certified, t_err) },
+        _ => certify(opts, ray, st, tris, certified, t_err),
     }
     let k = certified.iter().filter(|&&c| c).count();
     // a certified lane's verdict
@@ -810,68 +816,19 @@ fn maxima_avx2(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
     unsafe { maxima_v::<crate::lanes_x86::F64x4>(r, c) }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-fn filter_avx512(
-    o: BlockOpts,
-    r: BlockRay,
-    c: [&[f64]; 9],
-    pre: Option<&Constants>,
-    out: &mut [bool],
-    mark: &mut [f64],
-) -> bool {
-    // SAFETY: AVX-512F is enabled on this function
-    let st = pre.map_or_else(|| statics(o, r, unsafe { maxima_v::<crate::lanes_x86::F64x8>(r, c) }), |k| k.0);
-    filter_with(o, r, c, st, out, mark)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn filter_avx2(
-    o: BlockOpts,
-    r: BlockRay,
-    c: [&[f64]; 9],
-    pre: Option<&Constants>,
-    out: &mut [bool],
-    mark: &mut [f64],
-) -> bool {
-    // SAFETY: AVX2 is enabled on this function
-    let st = pre.map_or_else(|| statics(o, r, unsafe { maxima_v::<crate::lanes_x86::F64x4>(r, c) }), |k| k.0);
-    filter_with(o, r, c, st, out, mark)
-}
-
-/// The block's constants (`pre`, or from the block's maxima) and each lane's certificate;
-/// false when the block has none (range check, NaN): then no lane is certified.
-#[inline(always)]
-fn filter(
-    o: BlockOpts,
-    r: BlockRay,
-    c: [&[f64]; 9],
-    pre: Option<&Constants>,
-    out: &mut [bool],
-    mark: &mut [f64],
-) -> bool {
-    filter_with(o, r, c, pre.map_or_else(|| statics(o, r, maxima(r, c)), |k| k.0), out, mark)
-}
-
-/// [`filter`] with the block's constants given.
-#[inline(always)]
-fn filter_with(
-    o: BlockOpts,
-    r: BlockRay,
-    c: [&[f64]; 9],
-    st: Option<Static>,
-    out: &mut [bool],
-    mark: &mut [f64],
-) -> bool {
-    match st {
-        Some(st) => {
-            certify(o, r, st, c, out, mark);
-            true
+/// [`certify`] compiled for one instruction set (its loops in that set's vector registers).
+macro_rules! certify_on {
+    ($name:ident, $feat:literal) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feat)]
+        fn $name(o: BlockOpts, r: BlockRay, st: Static, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) {
+            certify(o, r, st, c, out, mark)
         }
-        None => false,
-    }
+    };
 }
+
+certify_on!(certify_avx512, "avx512f");
+certify_on!(certify_avx2, "avx2");
 
 /// The values `RtiBound::new` carries for det, u', v', t' and u' + v' (its `v`): the same
 /// binary64 operations in the same order (no error terms; `tests::values_are_the_bounds`).
