@@ -266,7 +266,7 @@ fn lane_consts(o: BlockOpts, r: BlockRay, big: f64, ve: [f64; 9], ae: [f64; 9]) 
 /// vertex column is in a sum), and whether an input of the lanes is NaN. Column by column,
 /// branch-free.
 #[inline(always)]
-fn maxima(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
+fn maxima(r: BlockRay, c: [&[f64]; 9]) -> Maxima {
     let (mut ve, mut ae) = ([0.0f64; 9], [0.0f64; 9]);
     let mut bad = false;
     for a in 0..3 {
@@ -358,7 +358,7 @@ fn origin_maxima(xi: f64, y: &[f64]) -> (f64, f64) {
 /// `V`'s instruction set must be present.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn maxima_v<V: crate::lanes_x86::Vector>(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
+unsafe fn maxima_v<V: crate::lanes_x86::Vector>(r: BlockRay, c: [&[f64]; 9]) -> Maxima {
     let (mut ve, mut ae) = ([0.0f64; 9], [0.0f64; 9]);
     let mut bad = false;
     for a in 0..3 {
@@ -436,7 +436,7 @@ fn fold<const W: usize>(vm: [f64; W], am: [f64; W], nf: [f64; W]) -> (f64, f64, 
 }
 
 #[inline(always)]
-fn statics(o: BlockOpts, r: BlockRay, (ve, ae, big, nan): ([f64; 9], [f64; 9], f64, bool)) -> Option<Static> {
+fn statics(o: BlockOpts, r: BlockRay, (ve, ae, big, nan): Maxima) -> Option<Static> {
     if nan || r.o.iter().chain(&r.d).any(|x| x.is_nan()) {
         return None;
     }
@@ -696,7 +696,7 @@ fn packed(
 /// y, z, s x, y, z) the largest |value| and the largest monomial sum, the largest of those sums
 /// (no smaller than any non-NaN |input| of the lanes), and whether an input of the lanes is NaN
 /// (an infinite input makes the sums infinite). The same bits on every level.
-pub fn block_maxima(cap: crate::simd::Kernel, ray: BlockRay, tris: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
+pub fn block_maxima(cap: crate::simd::Kernel, ray: BlockRay, tris: [&[f64]; 9]) -> Maxima {
     let n = tris[0].len();
     assert!(tris.iter().all(|c| c.len() == n), "column lengths differ");
     match crate::simd::f64_lanes(cap) {
@@ -709,6 +709,11 @@ pub fn block_maxima(cap: crate::simd::Kernel, ray: BlockRay, tris: [&[f64]; 9]) 
         _ => maxima(ray, tris),
     }
 }
+
+/// A block's largest magnitudes, as the static constants read them ([`block_maxima`]): per
+/// first-difference component (e1 x, y, z, e2 x, y, z, s x, y, z) the largest |value| and the
+/// largest monomial sum, the largest of those sums, and whether an input is NaN.
+pub type Maxima = ([f64; 9], [f64; 9], f64, bool);
 
 /// Bounds on the magnitudes a block's static constants come from, over every triangle of a
 /// set (a scene's triangles in a format): for any block of the set's triangles and any ray,
@@ -770,7 +775,7 @@ impl SetMaxima {
     /// the blocks' own maxima serve). The origin's components: binary64 o − v0 is
     /// non-increasing in v0 (rounding is monotone), so over v0 in [lo, hi] its magnitude is at
     /// most the larger of |o − lo| and |o − hi|; |o| + |v0| at most |o| + max |v0|.
-    pub fn for_ray(&self, ray: BlockRay) -> Option<([f64; 9], [f64; 9], f64, bool)> {
+    pub fn for_ray(&self, ray: BlockRay) -> Option<Maxima> {
         if !self.finite {
             return None;
         }
@@ -797,21 +802,21 @@ impl Constants {
     /// The constants for `opts` and `ray` from maxima that bound a block's (`SetMaxima::for_ray`
     /// or [`block_maxima`]); none (no lane certified) where the range check fails or an input
     /// is NaN.
-    pub fn new(opts: BlockOpts, ray: BlockRay, m: ([f64; 9], [f64; 9], f64, bool)) -> Self {
+    pub fn new(opts: BlockOpts, ray: BlockRay, m: Maxima) -> Self {
         Constants(statics(opts, ray, m))
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn maxima_avx512(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
+fn maxima_avx512(r: BlockRay, c: [&[f64]; 9]) -> Maxima {
     // SAFETY: AVX-512F is enabled on this function
     unsafe { maxima_v::<crate::lanes_x86::F64x8>(r, c) }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn maxima_avx2(r: BlockRay, c: [&[f64]; 9]) -> ([f64; 9], [f64; 9], f64, bool) {
+fn maxima_avx2(r: BlockRay, c: [&[f64]; 9]) -> Maxima {
     // SAFETY: AVX2 is enabled on this function
     unsafe { maxima_v::<crate::lanes_x86::F64x4>(r, c) }
 }

@@ -28,7 +28,7 @@ use super::counts::{RtiCounts, SlabCounts};
 use super::{FormatReport, SlabReport, VerifyConfig};
 use crate::scene::Scene;
 use datapath::bound::{self, BlockOpts, BlockRay};
-use datapath::bound_filter::{verdict_block_filtered, verdict_lanes_filtered, Constants, SetMaxima};
+use datapath::bound_filter::{verdict_block_filtered, verdict_lanes_filtered, Constants, Maxima, SetMaxima};
 use datapath::rng::SplitMix64;
 use datapath::rti::{Capture, HitsSoa, RaysSoa, Rti, RtiOut, Tri, TrisSoa};
 use datapath::simd::draw::below_column;
@@ -172,7 +172,9 @@ struct Rec<V> {
 /// A ray's static-filter constants from the scene's bounds (`None` where the scene has none):
 /// the bound's, and the reference decision's f64 filter's once a block needs them.
 struct RayConsts {
-    maxima: Option<([f64; 9], [f64; 9], f64, bool)>,
+    /// The quantised ray, as the bound and the filters read it.
+    bray: BlockRay,
+    maxima: Option<Maxima>,
     bound: Option<Constants>,
     f64_filter: std::cell::OnceCell<Option<Constants>>,
 }
@@ -311,17 +313,18 @@ where
             let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
             let maxima = self.set.for_ray(bray);
             let pre = RayConsts {
+                bray,
                 maxima,
                 bound: maxima.map(|m| Constants::new(self.opts, bray, m)),
                 f64_filter: std::cell::OnceCell::new(),
             };
+            let timed = i % TIME_EVERY == 0;
             let mut cap = Capture::default();
             let mut gbest: Option<(usize, f64)> = None;
             let list = std::mem::take(&mut s.list);
             for (b, blk) in list.chunks(BLOCK).enumerate() {
                 let base = b * BLOCK;
                 s.size(blk.len());
-                let timed = i % TIME_EVERY == 0;
                 if self.with_rti {
                     self.rti_block(s, &mut acc, &ray, &rq, &mray, &pre, blk, base, i, timed, &mut cap, &mut gbest);
                 }
@@ -400,7 +403,7 @@ where
         } else {
             gather(Kernel::Avx512Fp16, &self.qs, blk, true, |r| r, s.cols.each_mut().map(|x| &mut x[..]));
         }
-        let t0 = if timed { self.clock.now() } else { 0 };
+        let t0 = timed.then(|| self.clock.now());
         match self.cfg.inject {
             None => {
                 simd::rti_batch(&self.rti, &s.rays, &s.tris, &mut s.out);
@@ -418,11 +421,11 @@ where
                 }
             }
         }
-        if timed {
+        if let Some(t0) = t0 {
             acc.model_ns += self.clock.since(t0);
             acc.model_tests += n as u64;
         }
-        let bray = BlockRay { o: rq.o, d: rq.d, tmin: rq.tmin, tmax: rq.tmax };
+        let bray = pre.bray;
         // the static filter first (its constants from the scene's bounds, the ray's, where
         // they exist): a lane its block constants certify gets the per-test
         // bound's verdict without running it (datapath::bound_filter); after a block where it
@@ -617,13 +620,11 @@ where
             (gw[x], cw[x]) = (bits(&s.shit[w..w + len]), bits(&s.sclose[w..w + len]));
         }
         for ((v, sr), acc) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()) {
-            if timed {
-                let t0 = self.clock.now();
-                simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
+            let t0 = timed.then(|| self.clock.now());
+            simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
+            if let Some(t0) = t0 {
                 acc.model_ns += self.clock.since(t0);
                 acc.model_tests += n as u64;
-            } else {
-                simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
             }
             let c = &mut acc.counts;
             c.tests += n as u64;
