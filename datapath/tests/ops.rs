@@ -358,8 +358,21 @@ fn column_conversion_equals_the_element_conversion() {
     let e8m16 = Ieee::new(Soft(FloatLayout::new(8, 16)), divide());
     let bits: Vec<u64> = (0..20_000).map(|_| r.next_u64() & 0x1ff_ffff).collect();
     column_is_elementwise(&e8m16, &bits.iter().map(|&b| e8m16.from_bits(b)).collect::<Vec<_>>());
-    let q = Fixed::new(8, 24, FxRound::NearestEven, FxOverflow::Saturate, DivMode::Divide).unwrap();
-    column_is_elementwise(&q, &(0..20_000).map(|_| q.from_bits(r.next_u64())).collect::<Vec<_>>());
+    // fixed point of several widths (up to 52 bits the conversion without AVX-512DQ; 53 and 64
+    // the one with it, or value by value): random encodings, the extremes, 0 and ±1 ulp
+    for (i, fr) in [(8, 24), (1, 15), (16, 16), (1, 31), (26, 26), (27, 26), (32, 32)] {
+        let q = Fixed::new(i, fr, FxRound::NearestEven, FxOverflow::Saturate, DivMode::Divide).unwrap();
+        let w = i + fr;
+        let top = 1u64 << (w - 1);
+        let edges = [0, 1, top - 1, top, top + 1, (top << 1).wrapping_sub(1)];
+        let vals: Vec<i64> = (0..20_000).map(|_| r.next_u64()).chain(edges).map(|b| q.from_bits(b)).collect();
+        column_is_elementwise(&q, &vals);
+        // the hint: up to 52 bits a fixed-point column converts at vector speed on AVX2
+        #[cfg(target_arch = "x86_64")]
+        if w <= 52 && std::arch::is_x86_feature_detected!("avx2") {
+            assert!(q.fast_f64_column(), "q{i}.{fr}");
+        }
+    }
     // the hint: the host's binary32, binary16 and bfloat16 convert at vector speed
     assert!(f32f.fast_f64_column() && fp16.fast_f64_column() && bf16.fast_f64_column());
 }

@@ -1622,19 +1622,24 @@ mod widen {
     }
 
     /// A fixed-point column widens to the one-value `raw as f64 * 2^-F` on every kernel (the
-    /// same bits): values of every magnitude up to ±2^63, those past 2^53 rounding alike, at
-    /// ragged lengths, for several F.
+    /// same bits): values of every magnitude up to ±2^63, those past 2^53 rounding alike, and
+    /// columns within ±2^51 (the conversion without AVX-512DQ: its edges −2^51 and 2^51 − 1, and
+    /// such a column with one value just outside), at ragged lengths, for several F.
     #[test]
     fn a_fixed_point_column_widens_as_each_value() {
         let mut g = SplitMix64::new(9);
+        let edges = [-(1i64 << 51), (1 << 51) - 1, 0, -1, 1];
         for f in [0, 8, 16, 24, 31, 63] {
             let scale = 2f64.powi(-f);
             for len in [0, 1, 7, 8, 9, 17, 256, 300] {
-                let src: Vec<i64> =
+                let wide: Vec<i64> =
                     (0..len).map(|i| (g.next_u64() as i64) >> (i % 64)).chain([i64::MIN, i64::MAX, 0, -1]).collect();
-                for k in kernels_here() {
+                let narrow: Vec<i64> = (0..len).map(|i| (g.next_u64() as i64) >> (12 + i % 52)).chain(edges).collect();
+                let mut outside = narrow.clone();
+                outside[len / 2] = if len % 2 == 0 { (1 << 51) + 12345 } else { -(1 << 51) - 1 }; // past each end
+                for (k, src) in kernels_here().into_iter().flat_map(|k| [(k, &wide), (k, &narrow), (k, &outside)]) {
                     let mut dst = vec![0.5; src.len()];
-                    with_kernel_cap(k, || fixed_to_f64(k, &src, scale, &mut dst));
+                    with_kernel_cap(k, || fixed_to_f64(k, src, scale, &mut dst));
                     for (&x, &y) in src.iter().zip(&dst) {
                         assert_eq!(y.to_bits(), (x as f64 * scale).to_bits(), "{k:?} F {f} {x}");
                     }

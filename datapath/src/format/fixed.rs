@@ -228,11 +228,11 @@ impl Format for Fixed {
         v as f64 * pow2(-(self.frac_bits as i32))
     }
     fn to_f64_column(&self, src: &[i64], dst: &mut [f64]) {
-        // the same two roundings in AVX-512DQ lanes where the machine has them
+        // the same two roundings in vector lanes where the machine has them
         crate::simd::widen::fixed_to_f64(crate::simd::Kernel::Avx512Fp16, src, pow2(-(self.frac_bits as i32)), dst)
     }
     fn fast_f64_column(&self) -> bool {
-        crate::simd::widen::fixed_in_lanes(crate::simd::Kernel::Avx512Fp16)
+        crate::simd::widen::fixed_in_lanes(crate::simd::Kernel::Avx512Fp16, self.w())
     }
     fn to_bits(&self, v: i64) -> u64 {
         (v as u64) & (u64::MAX >> (64 - self.w()))

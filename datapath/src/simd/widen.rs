@@ -97,33 +97,61 @@ pub fn e8_to_f64(cap: Kernel, src: &[u64], shift: u32, dst: &mut [f64]) {
     widen_column(cap, src, shift, dst)
 }
 
-/// Whether [`fixed_to_f64`] runs in vector lanes here (AVX-512F and AVX-512DQ, within `cap`
-/// and the thread's cap).
-pub fn fixed_in_lanes(cap: Kernel) -> bool {
+/// Whether [`fixed_to_f64`] runs in vector lanes here for the values of a `width`-bit
+/// fixed-point format: with AVX-512F and AVX-512DQ (`vcvtqq2pd`) at any width, or on any
+/// binary64 lanes (AVX-512F, AVX2; within `cap` and the thread's cap) at widths up to 52, whose
+/// values lie within ±2^51.
+pub fn fixed_in_lanes(cap: Kernel, width: u32) -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        f64_lanes(cap) == F64Lanes::Avx512 && std::arch::is_x86_feature_detected!("avx512dq")
+        let lanes = f64_lanes(cap);
+        (lanes == F64Lanes::Avx512 && std::arch::is_x86_feature_detected!("avx512dq"))
+            || (width <= 52 && lanes != F64Lanes::Baseline)
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
-        let _ = cap;
+        let _ = (cap, width);
         false
     }
 }
 
 /// `dst[k] = src[k] as f64 * scale` for every `k` (a fixed-point column, `scale` its step
-/// 2^−F): the same two roundings as the one-value code, in AVX-512DQ lanes where
-/// [`fixed_in_lanes`] says so (`vcvtqq2pd`, `vmulpd`; without AVX-512DQ the same two roundings
-/// do not vectorise).
+/// 2^−F): the same two roundings as the one-value code. In AVX-512DQ lanes (`vcvtqq2pd`,
+/// `vmulpd`) where the machine has them; else, when every value of the column lies in
+/// [−2^51, 2^51) (checked first), on the binary64 lanes [`f64_lanes`] picks by the exact
+/// integer-to-binary64 conversion of that range ([`Narrow`]: `x + 1.5·2^52` formed in the
+/// integer bits, then `− 1.5·2^52`, both exact), then the same `× scale`; else value by value.
 ///
 /// # Panics
 /// If the lengths differ.
 pub fn fixed_to_f64(cap: Kernel, src: &[i64], scale: f64, dst: &mut [f64]) {
-    widen_column(cap, src, scale, dst)
+    #[cfg(target_arch = "x86_64")]
+    let dq = f64_lanes(cap) == F64Lanes::Avx512 && std::arch::is_x86_feature_detected!("avx512dq");
+    #[cfg(not(target_arch = "x86_64"))]
+    let dq = false;
+    if !dq && narrow(src) {
+        // SAFETY: Narrow is a transparent i64; every value is in [-2^51, 2^51) (checked)
+        let src = unsafe { std::slice::from_raw_parts(src.as_ptr().cast::<Narrow>(), src.len()) };
+        widen_column(cap, src, scale, dst)
+    } else {
+        widen_column(cap, src, scale, dst)
+    }
 }
 
+/// Every value of `src` lies in [−2^51, 2^51) (a loop the compiler vectorises).
+fn narrow(src: &[i64]) -> bool {
+    src.iter().fold(0u64, |a, &x| a | ((x as u64).wrapping_add(1 << 51) >> 52)) == 0
+}
+
+/// A fixed-point value in [−2^51, 2^51), which converts to binary64 exactly without
+/// AVX-512DQ's `vcvtqq2pd`.
+#[derive(Clone, Copy)]
+#[repr(transparent)]
+struct Narrow(i64);
+
 /// Any column on the binary64 lanes [`f64_lanes`] picks (with AVX-512DQ too where the machine
-/// has it: a fixed-point column's conversion vectorises only there); `p` the type's parameter.
+/// has it: a column of `i64` converts in lanes only there, one of [`Narrow`] on any lanes); `p`
+/// the type's parameter.
 fn widen_column<T: Widen>(cap: Kernel, src: &[T], p: T::P, dst: &mut [f64]) {
     assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
     match f64_lanes(cap) {
@@ -183,6 +211,19 @@ impl Widen for i64 {
     #[inline(always)]
     fn widen(self, scale: f64) -> f64 {
         self as f64 * scale
+    }
+}
+
+impl Widen for Narrow {
+    type P = f64;
+    /// A fixed-point value in [−2^51, 2^51), times its step: `1.5·2^52 + x` has the bits of
+    /// `1.5·2^52` plus `x` (its exponent's unit is 1, and the sum stays within [2^52, 2^53)),
+    /// so subtracting `1.5·2^52` gives `x` exactly — `x as f64`.
+    #[inline(always)]
+    fn widen(self, scale: f64) -> f64 {
+        const MAGIC: f64 = 6755399441055744.0; // 1.5 · 2^52
+        let x = f64::from_bits(MAGIC.to_bits().wrapping_add(self.0 as u64)) - MAGIC;
+        x * scale
     }
 }
 
