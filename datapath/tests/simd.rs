@@ -1418,6 +1418,11 @@ mod gather {
         m: [half::f16; 9],
         g: [half::bf16; 3],
         one: [u16; 1],
+        // fields of several whole and partial 4-, 8- and 16-value rows
+        a9: [f32; 9],
+        b6: [f64; 6],
+        w6: [u16; 6],
+        w17: [u16; 17],
     }
 
     /// A one-column 2-byte field at the record's end (no 2 bytes after it to read).
@@ -1439,6 +1444,10 @@ mod gather {
                 m: std::array::from_fn(|_| half::f16::from_bits(r.next_u64() as u16)),
                 g: std::array::from_fn(|_| half::bf16::from_bits(r.next_u64() as u16)),
                 one: [r.next_u64() as u16],
+                a9: std::array::from_fn(|_| f32::from_bits(r.next_u64() as u32)),
+                b6: std::array::from_fn(|_| f64::from_bits(r.next_u64())),
+                w6: std::array::from_fn(|_| r.next_u64() as u16),
+                w17: std::array::from_fn(|_| r.next_u64() as u16),
             })
             .collect()
     }
@@ -1477,6 +1486,10 @@ mod gather {
                 check(k, &recs, &idx, |x| &x.m, |v: half::f16| u64::from(v.to_bits()));
                 check(k, &recs, &idx, |x| &x.g, |v: half::bf16| u64::from(v.to_bits()));
                 check(k, &recs, &idx, |x| &x.one, u64::from);
+                check(k, &recs, &idx, |x| &x.a9, |v: f32| u64::from(v.to_bits()));
+                check(k, &recs, &idx, |x| &x.b6, f64::to_bits);
+                check(k, &recs, &idx, |x| &x.w6, u64::from);
+                check(k, &recs, &idx, |x| &x.w17, u64::from);
                 let tails: Vec<Tail> = recs.iter().map(|x| Tail { a: x.h[0], z: x.one }).collect();
                 check(k, &tails, &idx, |x| &x.z, u64::from);
             }
