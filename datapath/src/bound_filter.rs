@@ -642,15 +642,19 @@ fn packed(
         "column lengths differ"
     );
     assert!(u32::try_from(n).is_ok(), "packed: more lanes than u32 indexes");
-    let mut cols = [[0.0f64; PACK]; 9];
-    let (mut dec, mut hi, mut te) = ([false; PACK], [false; PACK], [0.0f64; PACK]);
-    let mut lanes = [0u32; PACK];
     if let Some((d, h, t)) = fill {
         // every lane's outputs filled; the lanes not skipped are written again below
         decisive.fill(d);
         hit.fill(h);
         t_err.fill(t);
     }
+    if skip.iter().all(|&s| s) {
+        // no lane to run (often: a block the bound decided whole), no group's space to clear
+        return;
+    }
+    let mut cols = [[0.0f64; PACK]; 9];
+    let (mut dec, mut hi, mut te) = ([false; PACK], [false; PACK], [0.0f64; PACK]);
+    let mut lanes = [0u32; PACK];
     // one group: its lanes' columns gathered (vector gathers where the machine has them),
     // the verdict, its outputs written back to their lanes
     let mut run = |idx: &[u32]| {
