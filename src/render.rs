@@ -6,7 +6,7 @@
 use crate::bvh::build;
 use crate::camera::Camera;
 use crate::scene::Scene;
-use datapath::bvh::history_traverse;
+use datapath::bvh::history_traverse_into;
 use datapath::rti::{Capture, Rti, RtiConfig};
 use datapath::slab::{Slab, SlabConfig};
 use datapath::Format;
@@ -133,22 +133,28 @@ pub fn render<F: Format>(
     // each box test of a ray computed once over the history traversal's passes (its leaves
     // unchanged: datapath::box_memo)
     let mut memo = datapath::box_memo::BoxMemo::new(boxes.len());
+    let mut hres = datapath::bvh::StacklessResult::default();
     for j in 0..height {
         for i in 0..width {
             let ray = Ray64 { o: camera.eye, d: camera.ray_dir(i, j, width, height), tmin: 0.0, tmax: f64::INFINITY };
             // the pipeline: slab-unit traversal, then the leaves' triangles through the min-capture
             let sr = slab.prepare(ray.o, ray.d, ray.tmin, ray.tmax);
             memo.next_ray();
-            let leaves = history_traverse(&hw, usize::MAX, |&n| {
-                memo.get_or(n, || {
-                    let o = slab.test(&sr, &boxes[n as usize]);
-                    o.hit.then(|| f.to_f64(o.t_near))
-                })
-            })
-            .leaves;
+            history_traverse_into(
+                &hw,
+                usize::MAX,
+                |&n| {
+                    memo.get_or(n, || {
+                        let o = slab.test(&sr, &boxes[n as usize]);
+                        o.hit.then(|| f.to_f64(o.t_near))
+                    })
+                },
+                &mut hres,
+            );
+            let leaves = &hres.leaves;
             let mray = rti.ray(ray.o, ray.d, ray.tmin, ray.tmax);
             let mut cap = Capture::default();
-            for &leaf in &leaves {
+            for &leaf in leaves {
                 for &t in &b.leaf_tris[leaf as usize] {
                     let o = rti.test(&mray, &tris[t as usize]);
                     rti.capture(&mut cap, &o, t);

@@ -425,7 +425,7 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     }
     // the traversals on the built-in scene's BVH, f32 slab unit as box tester, first 4 leaves,
     // 4096 rays (M rays/s): the 2-bit history traversal with each box test of a ray remembered
-    // (as `traverse` and `render` run it) against the ordered stack traversal (the speed
+    // and its result's buffers reused (as `traverse` and `render` run it) against the ordered stack traversal (the speed
     // issue's ratio, history >= 0.8 of stack, is these two rows of one run)
     {
         let scene = crate::scene::Scene::builtin();
@@ -442,6 +442,7 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
                 o.hit.then_some(o.t_near as f64)
             };
             let mut memo = datapath::box_memo::BoxMemo::new(boxes.len());
+            let mut res = datapath::bvh::StacklessResult::default();
             let mut sink = 0usize;
             push(row(
                 "traverse: 2-bit history, box tests remembered, f32 slab, N = 4 (M rays/s)",
@@ -451,8 +452,8 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
                 || {
                     for r in &rays {
                         memo.next_ray();
-                        sink +=
-                            datapath::bvh::history_traverse(&hw, 4, |&i| memo.get_or(i, || test(r, i))).leaves.len();
+                        datapath::bvh::history_traverse_into(&hw, 4, |&i| memo.get_or(i, || test(r, i)), &mut res);
+                        sink += res.leaves.len();
                     }
                 },
             ));

@@ -7,7 +7,7 @@ pub mod cover;
 use crate::bvh::{build, SceneBvh};
 use crate::scene::Scene;
 use datapath::box_memo::BoxMemo;
-use datapath::bvh::{history_traverse, trail_traverse, HwTree};
+use datapath::bvh::{history_traverse_into, trail_traverse, HwTree, StacklessResult};
 use datapath::rng::SplitMix64;
 use datapath::slab::{Slab, SlabConfig};
 use datapath::{with_format, AnyFormat, Format};
@@ -353,8 +353,8 @@ fn one_format<F: Format>(
         &progress,
         // each box test of a ray computed once and remembered for the four traversals (their
         // results and counted box tests unchanged: datapath::box_memo)
-        || BoxMemo::new(boxes.len()),
-        |memo, range| {
+        || (BoxMemo::new(boxes.len()), StacklessResult::default(), StacklessResult::default()),
+        |(memo, h, end), range| {
             let mut c = engine::Counts::<COUNTERS>::default();
             for k in range {
                 let ray = gen.ray(k);
@@ -365,9 +365,10 @@ fn one_format<F: Format>(
                 };
                 memo.next_ray();
                 let g = stack_traverse(tree, n, |i| memo.get_or(i, || test(i)));
-                let h = history_traverse(hw, n, |&i| memo.get_or(i, || test(i)));
+                history_traverse_into(hw, n, |&i| memo.get_or(i, || test(i)), h);
                 let skipped = if h.leaves.len() == n {
-                    history_traverse(hw, usize::MAX, |&i| memo.get_or(i, || test(i))).box_tests - h.box_tests
+                    history_traverse_into(hw, usize::MAX, |&i| memo.get_or(i, || test(i)), end);
+                    end.box_tests - h.box_tests
                 } else {
                     0
                 };

@@ -205,6 +205,19 @@ pub struct StacklessResult {
     pub state: Vec<u8>,
 }
 
+impl StacklessResult {
+    /// Empty, with a state of `depth` levels in 00 (the buffers kept).
+    fn reset(&mut self, depth: usize) {
+        // every field named: a new one must be reset here too
+        let StacklessResult { leaves, passes, box_tests, back_distances, ties, state } = self;
+        leaves.clear();
+        (*passes, *box_tests, *ties) = (0, 0, [0; 2]);
+        back_distances.clear();
+        state.clear();
+        state.resize(depth, hist::NEW);
+    }
+}
+
 /// The ray's entry into the tree: tests the root box; a miss, N = 0 or a root leaf (emitted)
 /// finishes the ray (false); otherwise the passes begin (true).
 fn enter<B>(t: &HwTree<B>, n: usize, test: &mut impl FnMut(&B) -> Option<f64>, r: &mut StacklessResult) -> bool {
@@ -305,17 +318,35 @@ pub fn history_traverse<B>(t: &HwTree<B>, n: usize, test: impl FnMut(&B) -> Opti
 pub fn history_traverse_faulty<B, X: crate::fault::Logic>(
     t: &HwTree<B>,
     n: usize,
-    mut test: impl FnMut(&B) -> Option<f64>,
+    test: impl FnMut(&B) -> Option<f64>,
     x: &X,
 ) -> StacklessResult {
-    let mut r = StacklessResult { state: vec![hist::NEW; t.depth()], ..Default::default() };
-    if !enter(t, n, &mut test, &mut r) {
-        return r;
+    let mut r = StacklessResult::default();
+    history_traverse_faulty_into(t, n, test, x, &mut r);
+    r
+}
+
+/// [`history_traverse`] into `r`, whose previous contents are dropped and whose buffers are
+/// reused (no allocation once they have grown: a ray loop's form).
+pub fn history_traverse_into<B>(t: &HwTree<B>, n: usize, test: impl FnMut(&B) -> Option<f64>, r: &mut StacklessResult) {
+    history_traverse_faulty_into(t, n, test, &crate::fault::NoFault, r)
+}
+
+/// [`history_traverse_faulty`] into `r` (as [`history_traverse_into`]).
+pub fn history_traverse_faulty_into<B, X: crate::fault::Logic>(
+    t: &HwTree<B>,
+    n: usize,
+    mut test: impl FnMut(&B) -> Option<f64>,
+    x: &X,
+    r: &mut StacklessResult,
+) {
+    r.reset(t.depth());
+    if !enter(t, n, &mut test, r) {
+        return;
     }
     let n_limit = x.limit("n_limit", n);
     let mut prev_end = None;
-    while history_pass_faulty(t, n_limit, &mut test, &mut r, &mut prev_end, x) {}
-    r
+    while history_pass_faulty(t, n_limit, &mut test, r, &mut prev_end, x) {}
 }
 
 /// One pass of [`history_traverse_faulty`] from the root, on a ray whose root box was hit

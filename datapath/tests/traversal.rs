@@ -3,7 +3,9 @@
 //! tester — on balanced, degenerate (chain) and random trees, with ties, NaN and signed-zero
 //! entry distances, rays hitting one child, both or none; and with the real slab unit.
 
-use datapath::bvh::{history_traverse, trail_traverse, BvhError, HwTree, NodeDesc};
+use datapath::bvh::{
+    hist, history_traverse, history_traverse_into, trail_traverse, BvhError, HwTree, NodeDesc, StacklessResult,
+};
 use datapath::rng::SplitMix64;
 use datapath::slab::{Slab, SlabConfig};
 use datapath::{with_format, AnyFormat, Format};
@@ -88,10 +90,23 @@ fn check_all_n(nodes: &[NodeDesc], outcome: &dyn Fn(u32) -> Option<f64>) -> Resu
     let g = golden_tree(nodes);
     let hw = HwTree::build(nodes, 0, 64, |i, _| Ok::<u32, String>(i)).map_err(|e| e.to_string())?;
     let leaves = nodes.iter().filter(|n| n.children.is_none()).count();
+    // one result reused for every N (as the ray loops run it), holding junk at first
+    let mut reused = StacklessResult {
+        leaves: vec![99; 50],
+        passes: 7,
+        box_tests: 9,
+        back_distances: vec![3; 9],
+        ties: [1, 2],
+        state: vec![hist::DONE; 70],
+    };
     for n in 1..=leaves + 2 {
         let want = stack_traverse(&g, n, outcome);
         let h = history_traverse(&hw, n, |&i| outcome(i));
         let t = trail_traverse(&hw, n, |&i| outcome(i));
+        history_traverse_into(&hw, n, |&i| outcome(i), &mut reused);
+        if reused != h {
+            return Err(format!("history N={n} into a reused result: {reused:?} vs {h:?}"));
+        }
         // with each box test remembered (datapath::box_memo, as `traverse` and `render` run
         // it): the same result, counted box tests included, and each box tested at most once
         let mut memo = datapath::box_memo::BoxMemo::new(nodes.len());
@@ -315,7 +330,7 @@ fn layout_with_real_boxes_in_a_narrow_storage_format() {
 /// Every pass ends at a leaf on level 2, so the back distances are 2 − 0, 2 − 1, 2 − 2.
 #[test]
 fn the_resume_fault_skips_the_subtrees_the_hand_trace_says() {
-    use datapath::bvh::{hist, history_traverse_faulty};
+    use datapath::bvh::history_traverse_faulty;
     use datapath::fault::{Logic, NoFault};
     struct Shallowest;
     impl Logic for Shallowest {
