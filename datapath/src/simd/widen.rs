@@ -125,22 +125,56 @@ pub fn fixed_in_lanes(cap: Kernel, width: u32) -> bool {
 /// # Panics
 /// If the lengths differ.
 pub fn fixed_to_f64(cap: Kernel, src: &[i64], scale: f64, dst: &mut [f64]) {
-    #[cfg(target_arch = "x86_64")]
-    let dq = f64_lanes(cap) == F64Lanes::Avx512 && std::arch::is_x86_feature_detected!("avx512dq");
-    #[cfg(not(target_arch = "x86_64"))]
-    let dq = false;
-    if !dq && narrow(src) {
-        // SAFETY: Narrow is a transparent i64; every value is in [-2^51, 2^51) (checked)
-        let src = unsafe { std::slice::from_raw_parts(src.as_ptr().cast::<Narrow>(), src.len()) };
-        widen_column(cap, src, scale, dst)
-    } else {
-        widen_column(cap, src, scale, dst)
+    assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
+    let done = match f64_lanes(cap) {
+        // SAFETY: AVX-512F is present (f64_lanes detected it), AVX-512DQ too (detected)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 if std::arch::is_x86_feature_detected!("avx512dq") => {
+            unsafe { avx512dq(src, scale, dst) };
+            true
+        }
+        // SAFETY: AVX-512F is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx512 => unsafe { narrow_avx512(src, scale, dst) },
+        // SAFETY: AVX2 is present (f64_lanes detected it)
+        #[cfg(target_arch = "x86_64")]
+        F64Lanes::Avx2 => unsafe { narrow_avx2(src, scale, dst) },
+        _ => false,
+    };
+    if !done {
+        body(src, scale, dst)
     }
 }
 
 /// Every value of `src` lies in [−2^51, 2^51) (a loop the compiler vectorises).
+#[inline(always)]
 fn narrow(src: &[i64]) -> bool {
     src.iter().fold(0u64, |a, &x| a | ((x as u64).wrapping_add(1 << 51) >> 52)) == 0
+}
+
+/// The column through [`Narrow`] when every value is within its range (checked first, in the
+/// same lanes); false, `dst` untouched, otherwise.
+#[inline(always)]
+fn narrow_body(src: &[i64], scale: f64, dst: &mut [f64]) -> bool {
+    if !narrow(src) {
+        return false;
+    }
+    // SAFETY: Narrow is a transparent i64; every value is in [-2^51, 2^51) (checked)
+    let src = unsafe { std::slice::from_raw_parts(src.as_ptr().cast::<Narrow>(), src.len()) };
+    body(src, scale, dst);
+    true
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn narrow_avx512(src: &[i64], scale: f64, dst: &mut [f64]) -> bool {
+    narrow_body(src, scale, dst)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn narrow_avx2(src: &[i64], scale: f64, dst: &mut [f64]) -> bool {
+    narrow_body(src, scale, dst)
 }
 
 /// A fixed-point value in [−2^51, 2^51), which converts to binary64 exactly without
@@ -150,8 +184,7 @@ fn narrow(src: &[i64]) -> bool {
 struct Narrow(i64);
 
 /// Any column on the binary64 lanes [`f64_lanes`] picks (with AVX-512DQ too where the machine
-/// has it: a column of `i64` converts in lanes only there, one of [`Narrow`] on any lanes); `p`
-/// the type's parameter.
+/// has it); `p` the type's parameter.
 fn widen_column<T: Widen>(cap: Kernel, src: &[T], p: T::P, dst: &mut [f64]) {
     assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
     match f64_lanes(cap) {
