@@ -46,8 +46,12 @@ fn avx2(s: u64, n: u64, out: &mut [u32]) {
 /// same integer (the dropped fraction is below 1) and never overflows 64 bits.
 #[inline(always)]
 fn body(s: u64, n: u64, out: &mut [u32]) {
-    for (k, o) in out.iter_mut().enumerate() {
-        let x = mix(s.wrapping_add((k as u64 + 1).wrapping_mul(GAMMA)));
+    // the state before draw k + 1, s + (k + 1) · GAMMA, as a running sum (an induction the
+    // compiler keeps in lanes; no 64-bit multiply per draw)
+    let mut z = s;
+    for o in out.iter_mut() {
+        z = z.wrapping_add(GAMMA);
+        let x = mix(z);
         let (hi, lo) = (x >> 32, x & 0xffff_ffff);
         *o = ((hi * n + ((lo * n) >> 32)) >> 32) as u32;
     }
