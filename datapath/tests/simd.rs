@@ -690,6 +690,155 @@ mod slab {
         }
     }
 
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+        /// The shared one-ray `eEmM` slab batch (`slab_ray_shared`: the round-to-nearest
+        /// variants' planes computed once) gives every variant of the group `slab_ray_soft`'s
+        /// bits — any subset of the four, in either order, rays from the same origin, direction
+        /// and t interval (specials, zero and tiny direction components, NaN limits with
+        /// payloads) — and declines (`None`) exactly when their prepared rays differ or the
+        /// machine (cap) has no kernel.
+        #[test]
+        fn shared_soft_slab_batches_equal_each_variant_alone(seed in any::<u64>(), n in 0usize..300, fmt in 0usize..6, pick in 1u32..16) {
+            use datapath::simd::{slab_ray_shared, slab_ray_soft};
+            let names = ["e8m16", "e5m4", "e10m24:divide", "e8m7", "e6m9:divide", "e8m23:divide"];
+            let datapath::AnyFormat::Soft(f) = names[fmt].parse().unwrap() else { unreachable!() };
+            let all: Vec<Slab<_>> = VARIANTS[..4].iter().map(|v| Slab::new(f, SlabConfig::named(v).unwrap())).collect();
+            let mut idx: Vec<usize> = (0..4).filter(|&j| pick >> j & 1 == 1).collect();
+            if seed % 2 == 1 {
+                idx.reverse();
+            }
+            let group: Vec<&Slab<_>> = idx.iter().map(|&j| &all[j]).collect();
+            let (_, mut boxes) = batch(&all[0], seed, n);
+            let mut r = SplitMix64::new(seed ^ 0x5ead);
+            let e = datapath::format::edges(&f);
+            let o: [f64; 3] = std::array::from_fn(|_| if r.below(8) == 0 { f64_value(&mut r) } else { r.range(-1.0, 1.0) });
+            // (a zero component: 1/d = ±inf, shared by all but embree; a tiny one: embree's
+            // and the conservative guard's rays differ)
+            let d: [f64; 3] = std::array::from_fn(|_| match r.below(10) {
+                0 => 0.0,
+                1 => r.range(-1.0, 1.0) * e.least,
+                2 => f64_value(&mut r),
+                _ => r.range(-2.0, 2.0),
+            });
+            let limit = |r: &mut SplitMix64, usual: f64| if r.below(8) == 0 { f64_value(r) } else { usual };
+            let (tmin, tmax) = (limit(&mut r, 0.0), limit(&mut r, f64::INFINITY));
+            let payload = r.below(4) == 0;
+            let prepared: Vec<_> = group
+                .iter()
+                .map(|s| {
+                    let mut ray = s.prepare(o, d, tmin, tmax);
+                    if payload {
+                        // a NaN t limit with a payload and a sign, as a column could hold
+                        ray.tmax = f.from_bits(f.to_bits(f.from_f64(f64::INFINITY)) | 3 | f.to_bits(f.from_f64(-0.0)));
+                    }
+                    ray
+                })
+                .collect();
+            let refs: Vec<_> = prepared.iter().collect();
+            // planes on the origin every third box (0 · inf is NaN where 1/d is infinite)
+            for i in (0..n).step_by(3) {
+                boxes.min[i % 3][i] = refs[0].o[i % 3];
+                boxes.max[(i + 1) % 3][i] = refs[0].o[(i + 1) % 3];
+            }
+            let same = refs.iter().all(|x| x.o == refs[0].o && x.inv_d == refs[0].inv_d && x.tmin == refs[0].tmin && x.tmax == refs[0].tmax);
+            for k in kernels_here() {
+                let mut outs: Vec<SlabOutSoa<u64>> = (0..group.len()).map(|_| SlabOutSoa::with_len(n)).collect();
+                let got = with_kernel_cap(k, || slab_ray_shared(&group, &refs, &boxes, &mut outs));
+                prop_assert_eq!(got.is_some(), same && k != Kernel::Scalar, "{:?} {:?}", k, idx);
+                if got.is_some() {
+                    for (j, out) in outs.iter().enumerate() {
+                        let mut want = SlabOutSoa::with_len(n);
+                        with_kernel_cap(k, || slab_ray_soft(group[j], refs[j], &boxes, &mut want));
+                        for i in 0..n {
+                            prop_assert_eq!(
+                                (out.hit[i], out.t_near[i], out.t_far[i]),
+                                (want.hit[i], want.t_near[i], want.t_far[i]),
+                                "{} {} lane {} of {} on {:?}", names[fmt], VARIANTS[idx[j]], i, n, k
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// A shared slab batch keeps each variant's comparator where they part: a ray along two
+    /// axes (1/d = +inf on the third) through boxes around it whose plane on that axis is the
+    /// origin's coordinate, a NaN plane (0 · inf) that plain ignores and take-on-false takes,
+    /// and boxes the conservative widening changes; every kernel, against each variant alone.
+    #[test]
+    fn shared_soft_slab_batches_keep_each_comparator() {
+        use datapath::simd::{slab_ray_shared, slab_ray_soft};
+        let datapath::AnyFormat::Soft(f) = "e8m16".parse().unwrap() else { unreachable!() };
+        let group: Vec<Slab<_>> = ["plain", "take-on-false", "conservative"]
+            .iter()
+            .map(|v| Slab::new(f, SlabConfig::named(v).unwrap()))
+            .collect();
+        let group: Vec<&Slab<_>> = group.iter().collect();
+        let o = [0.25, 0.5, -0.5];
+        let rays: Vec<_> = group.iter().map(|s| s.prepare(o, [1.0, 1.0, 0.0], 0.0, f64::INFINITY)).collect();
+        let refs: Vec<_> = rays.iter().collect();
+        let q = |x: f64| f.from_f64(x);
+        let mut boxes = BoxesSoa::default();
+        for k in 0..100 {
+            // x: t in [0.5, 1]; y: every third box entered 3 grid steps after t = 1 (a miss by less
+            // than the widening: plain misses, conservative hits), else around the ray; z
+            // (1/d = +inf): every other box's near plane on the origin, a NaN plane (0 · inf)
+            // plain ignores and take-on-false takes (last in the chain: t_near stays NaN)
+            let y = if k % 3 == 0 { [o[1] + 1.0 + 3.0 * 2f64.powi(-16), o[1] + 2.0] } else { [o[1] - 1.0, o[1] + 2.0] };
+            let z = if k % 2 == 0 { [o[2], o[2] + 1.0] } else { [o[2] - 1.0, o[2] + 1.0] };
+            boxes.push(&Aabb { min: [q(o[0] + 0.5), q(y[0]), q(z[0])], max: [q(o[0] + 1.0), q(y[1]), q(z[1])] });
+        }
+        for k in kernels_here() {
+            let mut outs: Vec<SlabOutSoa<u64>> = (0..3).map(|_| SlabOutSoa::with_len(100)).collect();
+            let got = with_kernel_cap(k, || slab_ray_shared(&group, &refs, &boxes, &mut outs));
+            assert_eq!(got.is_some(), k != Kernel::Scalar, "{k:?}");
+            if got.is_none() {
+                continue;
+            }
+            let mut hits = [0; 3];
+            for (j, out) in outs.iter().enumerate() {
+                let mut want = SlabOutSoa::with_len(100);
+                with_kernel_cap(k, || slab_ray_soft(group[j], refs[j], &boxes, &mut want));
+                for i in 0..100 {
+                    assert_eq!(
+                        (out.hit[i], out.t_near[i], out.t_far[i]),
+                        (want.hit[i], want.t_near[i], want.t_far[i]),
+                        "variant {j} lane {i} on {k:?}"
+                    );
+                }
+                hits[j] = out.hit.iter().filter(|&&h| h).count();
+            }
+            // the comparators part on these boxes (else the test would not tell them apart)
+            assert!(hits[0] != hits[1] && hits[0] != hits[2], "hits {hits:?}");
+        }
+    }
+
+    /// A shared slab batch declines a group with the directed variant, a format that flushes
+    /// subnormals, or mismatched lengths (nothing written).
+    #[test]
+    fn shared_soft_slab_batches_decline_what_they_do_not_share() {
+        use datapath::simd::slab_ray_shared;
+        for (name, v) in [("e8m16", "directed"), ("e8m16:ftz", "plain"), ("e5m10:ftz", "take-on-false")] {
+            let datapath::AnyFormat::Soft(f) = name.parse().unwrap() else { unreachable!() };
+            let (a, b) =
+                (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named(v).unwrap()));
+            let (_, boxes) = batch(&a, 3, 40);
+            let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
+            let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];
+            assert!(slab_ray_shared(&[&a, &b], &[&ray, &ray], &boxes, &mut outs).is_none(), "{name} {v}");
+            assert!(outs.iter().all(|o| !o.hit.iter().any(|&h| h)), "{name} {v}: written");
+        }
+        let datapath::AnyFormat::Soft(f) = "e8m16".parse().unwrap() else { unreachable!() };
+        let a = Slab::new(f, SlabConfig::named("plain").unwrap());
+        let (_, boxes) = batch(&a, 3, 40);
+        let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
+        let mut outs = vec![SlabOutSoa::with_len(40)];
+        assert!(slab_ray_shared(&[&a, &a], &[&ray, &ray], &boxes, &mut outs).is_none(), "two variants, one output");
+    }
+
     /// One-ray `eEmM` slab batches whose box planes sit on the ray's origin, a few grid steps
     /// from it, the smallest normal from it or at ±max, at an ordinary scale, at the smallest
     /// normal, among the subnormals and near the largest value — plane differences of zero,

@@ -198,6 +198,9 @@ struct Setup<'a, F: Format> {
     /// of its blocks.
     set: SetMaxima,
     variants: Vec<Variant<F>>,
+    /// The round-to-nearest variants (indices into `variants`), which one shared batch may
+    /// run together on a ray's blocks ([`simd::slab_ray_shared`]).
+    shared: Vec<usize>,
     opts: BlockOpts,
     /// The reference decision's f64 filter as block options ([`crate::judge::f64_filter_opts`]).
     fopts: BlockOpts,
@@ -237,6 +240,8 @@ struct Scratch<V> {
     prepared: Vec<datapath::slab::SlabRay<V>>,
     boxes: BoxesSoa<V>,
     sout: SlabOutSoa<V>,
+    /// The outputs of a shared batch, one per variant of [`Setup::shared`].
+    souts: Vec<SlabOutSoa<V>>,
 }
 
 impl<V: Copy + Default> Scratch<V> {
@@ -266,6 +271,7 @@ impl<V: Copy + Default> Scratch<V> {
             prepared: Vec::new(),
             boxes: BoxesSoa::default(),
             sout: SlabOutSoa::default(),
+            souts: (0..datapath::slab::SLAB_VARIANTS.len()).map(|_| SlabOutSoa::default()).collect(),
         };
         s.size(BLOCK);
         s
@@ -279,9 +285,11 @@ impl<V: Copy + Default> Scratch<V> {
             self.tris.resize(n, z);
             self.out.resize(n);
             self.boxes.min.iter_mut().chain(self.boxes.max.iter_mut()).for_each(|c| c.resize(n, z));
-            self.sout.hit.resize(n, false);
-            self.sout.t_near.resize(n, z);
-            self.sout.t_far.resize(n, z);
+            for o in std::iter::once(&mut self.sout).chain(&mut self.souts) {
+                o.hit.resize(n, false);
+                o.t_near.resize(n, z);
+                o.t_far.resize(n, z);
+            }
         }
     }
 }
@@ -619,23 +627,39 @@ where
         for (x, (w, len)) in words(n).enumerate() {
             (gw[x], cw[x]) = (bits(&s.shit[w..w + len]), bits(&s.sclose[w..w + len]));
         }
-        for ((v, sr), acc) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()) {
-            let t0 = timed.then(|| self.clock.now());
-            simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
-            if let Some(t0) = t0 {
-                acc.model_ns += self.clock.since(t0);
-                acc.model_tests += n as u64;
-            }
+        // the round-to-nearest variants in one shared batch where it applies (the same bits
+        // as each alone), on the rays not timed: a timed ray runs each variant alone, so that
+        // each keeps its own rate
+        let k = self.shared.len();
+        let shared = !timed && k >= 2 && {
+            let pick = |j: usize| self.shared[j.min(k - 1)];
+            let group: [&Slab<F>; 8] = std::array::from_fn(|j| &self.variants[pick(j)].slab);
+            let rays: [&datapath::slab::SlabRay<F::V>; 8] = std::array::from_fn(|j| &prepared[pick(j)]);
+            simd::slab_ray_shared(&group[..k], &rays[..k], &s.boxes, &mut s.souts[..k]).is_some()
+        };
+        for (i, ((v, sr), acc)) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()).enumerate() {
+            let out = match self.shared.iter().position(|&j| j == i).filter(|_| shared) {
+                Some(j) => &s.souts[j],
+                None => {
+                    let t0 = timed.then(|| self.clock.now());
+                    simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
+                    if let Some(t0) = t0 {
+                        acc.model_ns += self.clock.since(t0);
+                        acc.model_tests += n as u64;
+                    }
+                    &s.sout
+                }
+            };
             let c = &mut acc.counts;
             c.tests += n as u64;
             for (x, (w, len)) in words(n).enumerate() {
-                let (hit, g, close) = (bits(&s.sout.hit[w..w + len]), gw[x], cw[x]);
+                let (hit, g, close) = (bits(&out.hit[w..w + len]), gw[x], cw[x]);
                 let all = u64::MAX >> (64 - len);
                 let settled = all & !close & !(hit ^ g);
                 c.exact_hits += u64::from((settled & g).count_ones());
                 for j in ones(all & !settled) {
                     let k = w + j;
-                    let (hit, g) = (s.sout.hit[k], s.shit[k]);
+                    let (hit, g) = (out.hit[k], s.shit[k]);
                     c.exact_calls += 1;
                     if s.exact[k] == 0 {
                         let b = &self.recs[blk[k] as usize].b;
@@ -907,6 +931,7 @@ where
         qs,
         q_from_m,
         set,
+        shared: (0..variants.len()).filter(|&j| !variants[j].slab.cfg.directed).collect(),
         variants,
         opts: BlockOpts {
             em: f.error_model(),

@@ -99,6 +99,44 @@ where
     )
 }
 
+/// [`slab_ray`] of each `(group[j], rays[j])` into `outs[j]` — the same bits — with the work
+/// the variants do alike done once where a kernel shares it: the round-to-nearest variants
+/// (plain, conservative, take-on-false, embree) of one `eEmM` format with IEEE subnormals
+/// whose prepared rays have the same origin, 1/d and t interval, bit for bit, compute the
+/// planes `(box − o) ⊗ 1/d` once, then each its comparator chains, widening and guard. Returns
+/// the kernel used, or `None`, nothing written, when the group does not qualify (another
+/// format, a directed variant, rays that differ, a machine without the kernel): the caller
+/// runs [`slab_ray`] per variant.
+///
+/// # Panics
+/// If the column lengths differ.
+pub fn slab_ray_shared<F: crate::Format + 'static>(
+    group: &[&Slab<F>],
+    rays: &[&SlabRay<F::V>],
+    boxes: &BoxesSoa<F::V>,
+    outs: &mut [SlabOutSoa<F::V>],
+) -> Option<Kernel>
+where
+    F::V: 'static,
+{
+    use crate::format::{Ieee, Soft};
+    use std::any::TypeId;
+    if TypeId::of::<F>() != TypeId::of::<Ieee<Soft>>() {
+        return None;
+    }
+    // SAFETY: F is Ieee<Soft> (the same type, checked above), so F::V is u64 and each slice
+    // has the element type it is cast to
+    let (group, rays, boxes, outs) = unsafe {
+        (
+            &*(group as *const [&Slab<F>] as *const [&Slab<Ieee<Soft>>]),
+            &*(rays as *const [&SlabRay<F::V>] as *const [&SlabRay<u64>]),
+            &*(boxes as *const BoxesSoa<F::V>).cast::<BoxesSoa<u64>>(),
+            &mut *(outs as *mut [SlabOutSoa<F::V>] as *mut [SlabOutSoa<u64>]),
+        )
+    };
+    slab_ray_shared_soft(group, rays, boxes, outs)
+}
+
 /// Pairs per chunk of [`rti_stream`]: 256 pairs × (15 input + 3 output columns) × 4 bytes plus
 /// two flag columns is 19 KiB, inside a 32 KiB L1 data cache.
 pub const CHUNK: usize = 256;

@@ -4,7 +4,7 @@
 
 use super::kernels;
 use super::select::*;
-use crate::format::{Bf16, F16Half, F32Native, Ieee, IeeeBackend, Soft};
+use crate::format::{Bf16, F16Half, F32Native, Ieee, IeeeBackend, Soft, Subnormals};
 use crate::rti::{HitsSoa, RaysSoa, Rti, TrisSoa};
 use crate::slab::{BoxesSoa, Slab, SlabOutSoa, SlabRay, SlabRaysSoa};
 use crate::Format as _;
@@ -283,6 +283,52 @@ slab_entry!(
     /// [`Slab::batch_ray`] (one ray, many boxes) for an `eEmM` format on the fastest kernel available; the same bits.
     slab_ray_soft, Ieee<Soft>, u64, SlabRay<u64>, One, slab_ray_kernel_soft, v4d, v8d, slab_soft, None
 );
+
+/// A shared slab kernel: several variants on one ray and the same boxes (`@mloop`).
+#[cfg(target_arch = "x86_64")]
+type SharedSoftFn = unsafe fn(&[&Slab<Ieee<Soft>>], &SlabRay<u64>, &BoxesSoa<u64>, &mut [SlabOutSoa<u64>], usize);
+
+/// [`slab_ray_soft`] of each `(group[j], rays[j])` into `outs[j]`, their planes computed once
+/// ([`super::slab_ray_shared`]); `None`, nothing written, when the group does not qualify:
+/// its lengths differ or exceed 8, a variant is directed or is not the first's format, the
+/// format flushes subnormals, a prepared ray's origin, 1/d or t interval is not the first's
+/// bit for bit, a column is not the boxes' length, or the machine has no kernel for it.
+pub fn slab_ray_shared_soft(
+    group: &[&Slab<Ieee<Soft>>],
+    rays: &[&SlabRay<u64>],
+    boxes: &BoxesSoa<u64>,
+    outs: &mut [SlabOutSoa<u64>],
+) -> Option<Kernel> {
+    let (s0, r0) = (group.first()?, rays.first()?);
+    let same_ray = |r: &&SlabRay<u64>| r.o == r0.o && r.inv_d == r0.inv_d && r.tmin == r0.tmin && r.tmax == r0.tmax;
+    let ok = group.len() == rays.len()
+        && group.len() == outs.len()
+        && group.len() <= super::kernels::MAX_SHARED
+        && s0.fmt.opts.subnormals != Subnormals::Ftz
+        && group.iter().all(|s| s.fmt == s0.fmt && !s.cfg.directed && soft_slab_ok(s, true))
+        && rays.iter().all(same_ray);
+    let n = boxes.min[0].len();
+    if !ok || !outs.iter().all(|o| slab_columns_ok(boxes, o, n)) {
+        return None;
+    }
+    let which = slab_ray_kernel_soft(s0);
+    #[cfg(target_arch = "x86_64")]
+    {
+        let table: Table<SharedSoftFn> = (kernels::v4d::slab_soft_shared, kernels::v8d::slab_soft_shared, None);
+        if let Some((kernel, lanes)) = pick(which, table) {
+            let full = n / lanes * lanes;
+            // SAFETY: `which` names a kernel only after run-time feature detection; every
+            // column holds n >= full slots (checked above); the variants qualify (checked)
+            unsafe { kernel(group, r0, boxes, outs, full) };
+            for ((s, r), o) in group.iter().zip(rays).zip(outs.iter_mut()) {
+                s.batch_ray_from(r, boxes, o, full);
+            }
+            return Some(which);
+        }
+    }
+    let _ = which;
+    None
+}
 
 slab_entry!(
     /// [`Slab::batch`] for bf16 on the fastest kernel available; the same bits.

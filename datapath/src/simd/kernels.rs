@@ -439,7 +439,98 @@ macro_rules! slab_kernel {
             unsafe { slab_redo(model, slab_kernel!(@rays $shape r), boxes, (o_hit, o_near, o_far), $full) };
         }
     }};
+    // several round-to-nearest variants of one format on one ray and the same boxes, their
+    // planes computed once (they compute them alike: the same ray, the same operations and
+    // rounding; the caller checked), then per variant `@loop`'s chains, widening, guard,
+    // deferred-rounding mark, stores and NaN check, with its comparator; each variant's NaN
+    // lanes redone by its own model after the loop — each variant's outputs bit for bit those
+    // of `@loop` with `one r` alone
+    (@mloop $x:ident, $group:expr, $r:ident, $boxes:expr, $outs:expr, $full:expr, $load:expr, $lround:expr, $pending:expr, $store:expr, $upn:expr, $bcast:expr) => {{
+        let (group, boxes, outs) = ($group, $boxes, $outs);
+        let (load, rd, store, upn, bcast) = ($load, $lround, $store, $upn, $bcast);
+        let pending = $pending;
+        let none = $x::lt($x::splat(0.0), $x::splat(0.0));
+        let neg = |v| $x::xor(v, $x::splat(-0.0));
+        let down_n = |v, n| neg(upn(neg(v), n));
+        let bmin = boxes.min.each_ref().map(|c| c.as_ptr());
+        let bmax = boxes.max.each_ref().map(|c| c.as_ptr());
+        let r = $r;
+        let prep = slab_kernel!(@prep $x, one r, bmin, bmax, bcast);
+        let zero = $x::splat(0.0);
+        assert!(group.len() == outs.len() && group.len() <= MAX_SHARED, "slab_kernel: a group of another shape");
+        // per variant: comparator, widening, guard, whether it checks for NaN (as `@loop`),
+        // output columns
+        let cfg: [(bool, i32, bool, bool); MAX_SHARED] = std::array::from_fn(|j| match group.get(j) {
+            Some(s) => {
+                let tof = s.cfg.nan == SlabNan::TakeOnFalse;
+                (tof, s.cfg.widen_ulps, s.cfg.guard, tof || prep.4 || s.cfg.guard || pending.is_some())
+            }
+            None => (false, 0, false, false),
+        });
+        let mut each = outs.iter_mut();
+        let ptrs: [_; MAX_SHARED] = std::array::from_fn(|_| {
+            each.next().map(|o| (o.hit.as_mut_ptr(), o.t_near.as_mut_ptr(), o.t_far.as_mut_ptr()))
+        });
+        let mut nan_seen = [0; MAX_SHARED];
+        let mut i = 0;
+        while i < $full {
+            let planes = [
+                slab_kernel!(@plane $x, one prep, bmin, bmax, load, rd, 0, i),
+                slab_kernel!(@plane $x, one prep, bmin, bmax, load, rd, 1, i),
+                slab_kernel!(@plane $x, one prep, bmin, bmax, load, rd, 2, i),
+            ];
+            // the lanes the deferred rounding may have got wrong, for every variant
+            let marked = pending.map(|c| c.replace(none));
+            for (j, p) in ptrs.iter().enumerate() {
+                let Some((o_hit, o_near, o_far)) = *p else { break };
+                let (tof, widen, guard, check_nan) = cfg[j];
+                let (mut tn, mut tf) = prep.3;
+                for &(near, far) in &planes {
+                    if tof {
+                        tn = $x::blend(near, tn, $x::le(near, tn));
+                        tf = $x::blend(far, tf, $x::le(tf, far));
+                    } else {
+                        tn = $x::max(near, tn);
+                        tf = $x::min(far, tf);
+                    }
+                }
+                let ends = (tn, tf);
+                if widen > 0 {
+                    tn = down_n(tn, widen.unsigned_abs());
+                    tf = upn(tf, widen.unsigned_abs());
+                } else if widen < 0 {
+                    tn = upn(tn, widen.unsigned_abs());
+                    tf = down_n(tf, widen.unsigned_abs());
+                }
+                if guard {
+                    let unbounded = $x::unord($x::mul(ends.0, zero), $x::mul(ends.1, zero));
+                    tn = $x::blend(tn, $x::canonical_nan(), unbounded);
+                }
+                if let Some(m) = marked {
+                    tn = $x::blend(tn, $x::canonical_nan(), m);
+                }
+                // SAFETY: lanes i..i + L are in bounds (the caller checked every column).
+                unsafe { $x::flags(o_hit, i, $x::le(tn, tf)) };
+                store(o_near, i, tn);
+                store(o_far, i, tf);
+                if check_nan {
+                    nan_seen[j] |= $x::bits($x::unord(tn, tf));
+                }
+            }
+            i += $x::LANES;
+        }
+        for (j, p) in ptrs.iter().enumerate() {
+            let Some(p) = *p else { break };
+            if nan_seen[j] != 0 {
+                // SAFETY: lanes 0..full are in bounds (as above).
+                unsafe { slab_redo(group[j], SlabRays::One(r), boxes, p, $full) };
+            }
+        }
+    }};
 }
+
+/// Variants at most in one shared slab batch (`slab_kernel!`'s `@mloop`).
+pub(super) const MAX_SHARED: usize = 8;
 
 /// [`slab_kernel!`] with the format's subnormal rule: as it is under IEEE subnormals; under
 /// FTZ every operand read (columns and broadcast ray values) and every rounded result
@@ -744,6 +835,39 @@ macro_rules! narrow_for {
                     |v: u64| n.lay.is_subnormal(v),
                     defer | x | $x::split_noting(x, n, &pending),
                     Some(&pending)
+                );
+            }
+
+            /// [`slab_soft`] of several round-to-nearest variants on one ray and the same
+            /// boxes, their planes computed once (`slab_kernel!`'s `@mloop`; IEEE subnormals:
+            /// the caller checked that every variant qualifies and that they share the format
+            /// and the prepared ray): each `outs[j]` bit for bit `slab_soft` of `group[j]`.
+            #[target_feature(enable = $feat)]
+            pub fn slab_soft_shared(
+                group: &[&Slab<Ieee<Soft>>],
+                r: &crate::slab::SlabRay<u64>,
+                boxes: &BoxesSoa<u64>,
+                outs: &mut [SlabOutSoa<u64>],
+                full: usize,
+            ) {
+                let n: &Narrow = &super::super::select::narrow_of(&group[0].fmt).expect("the dispatch checked the format");
+                let f = group[0].fmt;
+                let pending = std::cell::Cell::new($x::lt($x::splat(0.0), $x::splat(0.0)));
+                // SAFETY (loads and stores): the caller checked that every column holds
+                // `full` lanes.
+                slab_kernel!(
+                    @mloop $x,
+                    group,
+                    r,
+                    boxes,
+                    outs,
+                    full,
+                    |c: *const u64, i: usize| unsafe { $x::load_soft(c, i, n) },
+                    |x| $x::split_noting(x, n, &pending),
+                    Some(&pending),
+                    |c: *mut u64, i: usize, x| unsafe { $x::store_soft(c, i, x, n) },
+                    |v, k: u32| $x::next_up_soft_n(v, k, n),
+                    |v: u64| $x::splat(f.to_f64(v))
                 );
             }
 
