@@ -381,42 +381,18 @@ macro_rules! slab_kernel {
         // non-finite chain end (before widening) are marked NaN and redone by the model
         // (the reciprocal's guard is applied when the ray is prepared)
         let guard = s.cfg.guard;
-        let zero = $x::splat(0.0);
         let check_nan = $tof || prep.4 || guard || pending.is_some();
         let (r, model) = ($r, s);
         let mut nan_seen = 0;
         let mut i = 0;
         while i < $full {
-            let (mut tn, mut tf) = slab_kernel!(@limits $shape prep, load, i);
-            let p = [
+            let planes = [
                 slab_kernel!(@plane $x, $shape prep, bmin, bmax, load, rd, 0, i),
                 slab_kernel!(@plane $x, $shape prep, bmin, bmax, load, rd, 1, i),
                 slab_kernel!(@plane $x, $shape prep, bmin, bmax, load, rd, 2, i),
             ];
-            for (near, far) in p {
-                if $tof {
-                    // t = (x <= t) ? t : x (near), (t <= x) ? t : x (far)
-                    tn = $x::blend(near, tn, $x::le(near, tn));
-                    tf = $x::blend(far, tf, $x::le(tf, far));
-                } else {
-                    // t = (x > t) ? x : t (near), (x < t) ? x : t (far): exactly vmaxps(x, t)
-                    // and vminps(x, t), which return the second operand on NaN or equality
-                    tn = $x::max(near, tn);
-                    tf = $x::min(far, tf);
-                }
-            }
-            let ends = (tn, tf);
-            if widen > 0 {
-                tn = down_n(tn, widen.unsigned_abs());
-                tf = upn(tf, widen.unsigned_abs());
-            } else if widen < 0 {
-                tn = upn(tn, widen.unsigned_abs());
-                tf = down_n(tf, widen.unsigned_abs());
-            }
-            if guard {
-                let unbounded = $x::unord($x::mul(ends.0, zero), $x::mul(ends.1, zero));
-                tn = $x::blend(tn, $x::canonical_nan(), unbounded);
-            }
+            let lim = slab_kernel!(@limits $shape prep, load, i);
+            let (mut tn, tf) = slab_kernel!(@ends $x, lim, planes, $tof, widen, guard, upn, down_n);
             if let Some(p) = pending {
                 // the lanes the deferred rounding may have got wrong: redone by the model
                 tn = $x::blend(tn, $x::canonical_nan(), p.replace(none));
@@ -439,6 +415,37 @@ macro_rules! slab_kernel {
             unsafe { slab_redo(model, slab_kernel!(@rays $shape r), boxes, (o_hit, o_near, o_far), $full) };
         }
     }};
+    // the comparator chains over the three planes from the t interval `$lim`, then the
+    // widening by `$widen` grid steps and the conservative guard: (t_near, t_far)
+    (@ends $x:ident, $lim:expr, $planes:expr, $tof:expr, $widen:expr, $guard:expr, $upn:ident, $down_n:ident) => {{
+        let (mut tn, mut tf) = $lim;
+        for &(near, far) in &$planes {
+            if $tof {
+                // t = (x <= t) ? t : x (near), (t <= x) ? t : x (far)
+                tn = $x::blend(near, tn, $x::le(near, tn));
+                tf = $x::blend(far, tf, $x::le(tf, far));
+            } else {
+                // t = (x > t) ? x : t (near), (x < t) ? x : t (far): exactly vmaxps(x, t)
+                // and vminps(x, t), which return the second operand on NaN or equality
+                tn = $x::max(near, tn);
+                tf = $x::min(far, tf);
+            }
+        }
+        let (ends, widen): (_, i32) = ((tn, tf), $widen);
+        if widen > 0 {
+            tn = $down_n(tn, widen.unsigned_abs());
+            tf = $upn(tf, widen.unsigned_abs());
+        } else if widen < 0 {
+            tn = $upn(tn, widen.unsigned_abs());
+            tf = $down_n(tf, widen.unsigned_abs());
+        }
+        if $guard {
+            let zero = $x::splat(0.0);
+            let unbounded = $x::unord($x::mul(ends.0, zero), $x::mul(ends.1, zero));
+            tn = $x::blend(tn, $x::canonical_nan(), unbounded);
+        }
+        (tn, tf)
+    }};
     // several round-to-nearest variants of one format on one ray and the same boxes, their
     // planes computed once (they compute them alike: the same ray, the same operations and
     // rounding; the caller checked), then per variant `@loop`'s chains, widening, guard,
@@ -456,7 +463,6 @@ macro_rules! slab_kernel {
         let bmax = boxes.max.each_ref().map(|c| c.as_ptr());
         let r = $r;
         let prep = slab_kernel!(@prep $x, one r, bmin, bmax, bcast);
-        let zero = $x::splat(0.0);
         assert!(group.len() == outs.len() && group.len() <= MAX_SHARED, "slab_kernel: a group of another shape");
         // per variant: comparator, widening, guard, whether it checks for NaN (as `@loop`),
         // output columns
@@ -484,28 +490,7 @@ macro_rules! slab_kernel {
             for (j, p) in ptrs.iter().enumerate() {
                 let Some((o_hit, o_near, o_far)) = *p else { break };
                 let (tof, widen, guard, check_nan) = cfg[j];
-                let (mut tn, mut tf) = prep.3;
-                for &(near, far) in &planes {
-                    if tof {
-                        tn = $x::blend(near, tn, $x::le(near, tn));
-                        tf = $x::blend(far, tf, $x::le(tf, far));
-                    } else {
-                        tn = $x::max(near, tn);
-                        tf = $x::min(far, tf);
-                    }
-                }
-                let ends = (tn, tf);
-                if widen > 0 {
-                    tn = down_n(tn, widen.unsigned_abs());
-                    tf = upn(tf, widen.unsigned_abs());
-                } else if widen < 0 {
-                    tn = upn(tn, widen.unsigned_abs());
-                    tf = down_n(tf, widen.unsigned_abs());
-                }
-                if guard {
-                    let unbounded = $x::unord($x::mul(ends.0, zero), $x::mul(ends.1, zero));
-                    tn = $x::blend(tn, $x::canonical_nan(), unbounded);
-                }
+                let (mut tn, tf) = slab_kernel!(@ends $x, prep.3, planes, tof, widen, guard, upn, down_n);
                 if let Some(m) = marked {
                     tn = $x::blend(tn, $x::canonical_nan(), m);
                 }
