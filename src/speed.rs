@@ -425,8 +425,9 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     }
     // the traversals on the built-in scene's BVH, f32 slab unit as box tester, first 4 leaves,
     // 4096 rays (M rays/s): the 2-bit history traversal with each box test of a ray remembered
-    // and its result's buffers reused (as `traverse` and `render` run it) against the ordered stack traversal (the speed
-    // issue's ratio, history >= 0.8 of stack, is these two rows of one run)
+    // and its result's buffers reused (as `traverse` and `render` run it) against the ordered
+    // stack traversal (the speed issue's ratio, history >= 0.8 of stack, is these two rows of
+    // one run)
     {
         let scene = crate::scene::Scene::builtin();
         let b = crate::bvh::build(&scene, 4);

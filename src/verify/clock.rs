@@ -1,9 +1,10 @@
 //! The clock of verify's model timings, read around every batch call of the timed rays (a dozen
 //! short intervals per block; every 8th ray, `chunk::TIME_EVERY`). On x86-64 with an invariant
-//! time-stamp counter (CPUID leaf 0x8000_0007, EDX bit 8) a reading is the counter (a few cycles, where the OS clock costs tens of
-//! nanoseconds), and ticks become nanoseconds at the rate measured against the OS's monotonic
-//! clock over the same pass; elsewhere a reading is the OS clock in nanoseconds. Timings only:
-//! no count, verdict or report field other than a rate depends on it.
+//! time-stamp counter (CPUID leaf 0x8000_0007, EDX bit 8) a reading is the counter (a few
+//! cycles, where the OS clock costs tens of nanoseconds), and ticks become nanoseconds at the
+//! rate measured against the OS's monotonic clock over the same pass; elsewhere a reading is
+//! the OS clock in nanoseconds. Timings only: no count, verdict or report field other than a
+//! rate depends on it.
 
 use std::time::Instant;
 

@@ -183,14 +183,11 @@ fn narrow_avx2(src: &[i64], scale: f64, dst: &mut [f64]) -> bool {
 #[repr(transparent)]
 struct Narrow(i64);
 
-/// Any column on the binary64 lanes [`f64_lanes`] picks (with AVX-512DQ too where the machine
-/// has it); `p` the type's parameter.
+/// Any column on the binary64 lanes [`f64_lanes`] picks; `p` the type's parameter. (Only a
+/// fixed-point column needs AVX-512DQ: [`fixed_to_f64`] dispatches its own.)
 fn widen_column<T: Widen>(cap: Kernel, src: &[T], p: T::P, dst: &mut [f64]) {
     assert_eq!(src.len(), dst.len(), "widen: columns of different lengths");
     match f64_lanes(cap) {
-        // SAFETY: AVX-512F is present (f64_lanes detected it), AVX-512DQ too (detected)
-        #[cfg(target_arch = "x86_64")]
-        F64Lanes::Avx512 if std::arch::is_x86_feature_detected!("avx512dq") => unsafe { avx512dq(src, p, dst) },
         // SAFETY: AVX-512F is present (f64_lanes detected it)
         #[cfg(target_arch = "x86_64")]
         F64Lanes::Avx512 => unsafe { avx512(src, p, dst) },
