@@ -690,77 +690,155 @@ mod slab {
         }
     }
 
-    proptest! {
-        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
-
-        /// The shared one-ray `eEmM` slab batch (`slab_ray_shared`: the round-to-nearest
-        /// variants' planes computed once) gives every variant of the group `slab_ray_soft`'s
-        /// bits — any subset of the four, in either order, rays from the same origin, direction
-        /// and t interval (specials, zero and tiny direction components, NaN limits with
-        /// payloads) — and declines (`None`) exactly when their prepared rays differ or the
-        /// machine (cap) has no kernel.
-        #[test]
-        fn shared_soft_slab_batches_equal_each_variant_alone(seed in any::<u64>(), n in 0usize..300, fmt in 0usize..6, pick in 1u32..16) {
-            use datapath::simd::{slab_ray_shared, slab_ray_soft};
-            let names = ["e8m16", "e5m4", "e10m24:divide", "e8m7", "e6m9:divide", "e8m23:divide"];
-            let datapath::AnyFormat::Soft(f) = names[fmt].parse().unwrap() else { unreachable!() };
-            let all: Vec<Slab<_>> = VARIANTS[..4].iter().map(|v| Slab::new(f, SlabConfig::named(v).unwrap())).collect();
-            let mut idx: Vec<usize> = (0..4).filter(|&j| pick >> j & 1 == 1).collect();
-            if seed % 2 == 1 {
-                idx.reverse();
-            }
-            let group: Vec<&Slab<_>> = idx.iter().map(|&j| &all[j]).collect();
-            let (_, mut boxes) = batch(&all[0], seed, n);
-            let mut r = SplitMix64::new(seed ^ 0x5ead);
-            let e = datapath::format::edges(&f);
-            let o: [f64; 3] = std::array::from_fn(|_| if r.below(8) == 0 { f64_value(&mut r) } else { r.range(-1.0, 1.0) });
-            // (a zero component: 1/d = ±inf, shared by all but embree; a tiny one: embree's
-            // and the conservative guard's rays differ)
-            let d: [f64; 3] = std::array::from_fn(|_| match r.below(10) {
-                0 => 0.0,
-                1 => r.range(-1.0, 1.0) * e.least,
-                2 => f64_value(&mut r),
-                _ => r.range(-2.0, 2.0),
-            });
-            let limit = |r: &mut SplitMix64, usual: f64| if r.below(8) == 0 { f64_value(r) } else { usual };
-            let (tmin, tmax) = (limit(&mut r, 0.0), limit(&mut r, f64::INFINITY));
-            let payload = r.below(4) == 0;
-            let prepared: Vec<_> = group
-                .iter()
-                .map(|s| {
-                    let mut ray = s.prepare(o, d, tmin, tmax);
-                    if payload {
-                        // a NaN t limit with a payload and a sign, as a column could hold
-                        ray.tmax = f.from_bits(f.to_bits(f.from_f64(f64::INFINITY)) | 3 | f.to_bits(f.from_f64(-0.0)));
-                    }
-                    ray
-                })
-                .collect();
-            let refs: Vec<_> = prepared.iter().collect();
-            // planes on the origin every third box (0 · inf is NaN where 1/d is infinite)
-            for i in (0..n).step_by(3) {
-                boxes.min[i % 3][i] = refs[0].o[i % 3];
-                boxes.max[(i + 1) % 3][i] = refs[0].o[(i + 1) % 3];
-            }
-            let same = refs.iter().all(|x| x.o == refs[0].o && x.inv_d == refs[0].inv_d && x.tmin == refs[0].tmin && x.tmax == refs[0].tmax);
-            for k in kernels_here() {
-                let mut outs: Vec<SlabOutSoa<u64>> = (0..group.len()).map(|_| SlabOutSoa::with_len(n)).collect();
-                let got = with_kernel_cap(k, || slab_ray_shared(&group, &refs, &boxes, &mut outs));
-                prop_assert_eq!(got.is_some(), same && k != Kernel::Scalar, "{:?} {:?}", k, idx);
-                if got.is_some() {
-                    for (j, out) in outs.iter().enumerate() {
-                        let mut want = SlabOutSoa::with_len(n);
-                        with_kernel_cap(k, || slab_ray_soft(group[j], refs[j], &boxes, &mut want));
-                        for i in 0..n {
-                            prop_assert_eq!(
-                                (out.hit[i], out.t_near[i], out.t_far[i]),
-                                (want.hit[i], want.t_near[i], want.t_far[i]),
-                                "{} {} lane {} of {} on {:?}", names[fmt], VARIANTS[idx[j]], i, n, k
-                            );
-                        }
+    /// One case of the shared one-ray slab batch (`slab_ray_shared`: the round-to-nearest
+    /// variants' planes computed once): the subset `pick` of the four variants of `f` (in
+    /// reverse order when `seed` is odd), each prepared from the ray `(o, d, tmin, tmax)` (its
+    /// t limit replaced by a NaN with a payload and a sign when `payload`), against `boxes`
+    /// with a plane on the origin every third box, on every kernel here: every output is
+    /// `alone`'s bits for that variant, and the batch declines (`None`) exactly when the
+    /// prepared rays differ (origin, 1/d or t interval, bit for bit) or the cap leaves no
+    /// kernel.
+    #[allow(clippy::too_many_arguments)]
+    fn shared_case<F: Format + 'static>(
+        f: F,
+        seed: u64,
+        pick: u32,
+        ray: ([f64; 3], [f64; 3], f64, f64),
+        payload: bool,
+        mut boxes: BoxesSoa<F::V>,
+        alone: RayFn<F>,
+    ) -> Result<(), TestCaseError> {
+        use datapath::simd::slab_ray_shared;
+        let all: Vec<Slab<F>> = VARIANTS[..4].iter().map(|v| Slab::new(f, SlabConfig::named(v).unwrap())).collect();
+        let mut idx: Vec<usize> = (0..4).filter(|&j| pick >> j & 1 == 1).collect();
+        if seed % 2 == 1 {
+            idx.reverse();
+        }
+        let group: Vec<&Slab<F>> = idx.iter().map(|&j| &all[j]).collect();
+        let (o, d, tmin, tmax) = ray;
+        let prepared: Vec<_> = group
+            .iter()
+            .map(|s| {
+                let mut ray = s.prepare(o, d, tmin, tmax);
+                if payload {
+                    // a NaN t limit with a payload and a sign, as a column could hold
+                    ray.tmax = f.from_bits(f.to_bits(f.from_f64(f64::INFINITY)) | 3 | f.to_bits(f.from_f64(-0.0)));
+                }
+                ray
+            })
+            .collect();
+        let refs: Vec<_> = prepared.iter().collect();
+        let n = boxes.min[0].len();
+        // planes on the origin every third box (0 · inf is NaN where 1/d is infinite)
+        for i in (0..n).step_by(3) {
+            boxes.min[i % 3][i] = refs[0].o[i % 3];
+            boxes.max[(i + 1) % 3][i] = refs[0].o[(i + 1) % 3];
+        }
+        let bits = |v: &[F::V]| v.iter().map(|&x| f.to_bits(x)).collect::<Vec<_>>();
+        let key = |r: &&SlabRay<F::V>| (bits(&r.o), bits(&r.inv_d), bits(&[r.tmin, r.tmax]));
+        let same = refs.iter().all(|r| key(r) == key(&refs[0]));
+        for k in kernels_here() {
+            let mut outs: Vec<SlabOutSoa<F::V>> = (0..group.len()).map(|_| SlabOutSoa::with_len(n)).collect();
+            let got = with_kernel_cap(k, || slab_ray_shared(&group, &refs, &boxes, &mut outs));
+            prop_assert_eq!(got.is_some(), same && k != Kernel::Scalar, "{:?} {:?}", k, idx);
+            if got.is_some() {
+                for (j, out) in outs.iter().enumerate() {
+                    let mut want = SlabOutSoa::with_len(n);
+                    with_kernel_cap(k, || alone(group[j], refs[j], &boxes, &mut want));
+                    for i in 0..n {
+                        prop_assert_eq!(
+                            (out.hit[i], f.to_bits(out.t_near[i]), f.to_bits(out.t_far[i])),
+                            (want.hit[i], f.to_bits(want.t_near[i]), f.to_bits(want.t_far[i])),
+                            "{} {} lane {} of {} on {:?}", f.name(), VARIANTS[idx[j]], i, n, k
+                        );
                     }
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// A ray for [`shared_case`] on a float format: origin and direction components mostly
+    /// ordinary, sometimes specials; a zero direction component (1/d = ±inf, shared by all but
+    /// embree) or a tiny one (embree's and the conservative guard's rays differ); t limits
+    /// sometimes specials.
+    fn float_shared_ray(e: &datapath::format::Edges, r: &mut SplitMix64) -> ([f64; 3], [f64; 3], f64, f64) {
+        let o: [f64; 3] = std::array::from_fn(|_| if r.below(8) == 0 { f64_value(r) } else { r.range(-1.0, 1.0) });
+        let d: [f64; 3] = std::array::from_fn(|_| match r.below(10) {
+            0 => 0.0,
+            1 => r.range(-1.0, 1.0) * e.least,
+            2 => f64_value(r),
+            _ => r.range(-2.0, 2.0),
+        });
+        let limit = |r: &mut SplitMix64, usual: f64| if r.below(8) == 0 { f64_value(r) } else { usual };
+        let (tmin, tmax) = (limit(r, 0.0), limit(r, f64::INFINITY));
+        (o, d, tmin, tmax)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+        /// The shared one-ray slab batch of the float formats (binary32, binary16, bf16 and
+        /// `eEmM` layouts; IEEE subnormals) gives every variant of the group the one-ray
+        /// batch's bits — any subset of the four, in either order, rays from the same origin,
+        /// direction and t interval (specials, zero and tiny direction components, NaN limits
+        /// with payloads) — and declines exactly when their prepared rays differ or the
+        /// machine (cap) has no kernel.
+        #[test]
+        fn shared_slab_batches_equal_each_variant_alone(seed in any::<u64>(), n in 0usize..300, fmt in 0usize..9, pick in 1u32..16) {
+            use datapath::simd::slab_ray_soft;
+            let mut r = SplitMix64::new(seed ^ 0x5ead);
+            let payload = r.below(4) == 0;
+            let names = ["e8m16", "e5m4", "e10m24:divide", "e8m7", "e6m9:divide", "e8m23:divide"];
+            match fmt {
+                0 => {
+                    let f = Ieee::new(F32Native, subnormals(false));
+                    let ray = float_shared_ray(&datapath::format::edges(&f), &mut r);
+                    let boxes = batch(&Slab::new(f, SlabConfig::default()), seed, n).1;
+                    shared_case(f, seed, pick, ray, payload, boxes, slab_ray_f32)?;
+                }
+                1 => {
+                    let f = Ieee::new(F16Half, subnormals(false));
+                    let ray = float_shared_ray(&datapath::format::edges(&f), &mut r);
+                    let boxes = batch(&Slab::new(f, SlabConfig::default()), seed, n).1;
+                    shared_case(f, seed, pick, ray, payload, boxes, slab_ray_f16)?;
+                }
+                2 => {
+                    let o = FpOpts { div: if seed % 4 < 2 { DivMode::Divide } else { DivMode::RecipMul }, ..subnormals(false) };
+                    let f = Ieee::new(datapath::format::Bf16, o);
+                    let ray = float_shared_ray(&datapath::format::edges(&f), &mut r);
+                    let boxes = batch(&Slab::new(f, SlabConfig::default()), seed, n).1;
+                    shared_case(f, seed, pick, ray, payload, boxes, datapath::simd::slab_ray_bf16)?;
+                }
+                _ => {
+                    let datapath::AnyFormat::Soft(f) = names[fmt - 3].parse().unwrap() else { unreachable!() };
+                    let ray = float_shared_ray(&datapath::format::edges(&f), &mut r);
+                    let boxes = batch(&Slab::new(f, SlabConfig::default()), seed, n).1;
+                    shared_case(f, seed, pick, ray, payload, boxes, slab_ray_soft)?;
+                }
+            }
+        }
+
+        /// The shared one-ray slab batch of the fixed-point formats (every rounding, overflow
+        /// and division mode): each variant of the group `slab_ray_fixed`'s bits, the chains
+        /// computed once (its variants differ only in the widening), rays with parallel axes
+        /// and saturated reciprocals, t intervals mostly [0, max].
+        #[test]
+        fn shared_fixed_slab_batches_equal_each_variant_alone(seed in any::<u64>(), n in 0usize..300, name in 0usize..8, mode in 0usize..16, pick in 1u32..16) {
+            let f = super::fixed(&format!("{}{}", super::FIXED_NAMES[name], super::FIXED_MODES[mode]));
+            let m = f.to_f64(f.max_raw()) / 4.0;
+            let step = f.to_f64(1);
+            let mut r = SplitMix64::new(seed ^ 0x5ead);
+            let o: [f64; 3] = std::array::from_fn(|_| r.range(-m, m));
+            let d: [f64; 3] = std::array::from_fn(|_| match r.below(6) {
+                0 => 0.0,
+                1 => step * (r.below(5) as f64 - 2.0),
+                _ => r.range(-m, m),
+            });
+            let tmin = if r.below(8) == 0 { r.range(-m, m) } else { 0.0 };
+            let tmax = if r.below(8) == 0 { r.range(-m, m) } else { f64::INFINITY };
+            let boxes = fixed_slab_batch(&Slab::new(f, SlabConfig::default()), seed, n).1;
+            shared_case(f, seed, pick, (o, d, tmin, tmax), false, boxes, datapath::simd::slab_ray_fixed)?;
         }
     }
 
@@ -819,7 +897,7 @@ mod slab {
     /// A shared slab batch declines a group with the directed variant, a format that flushes
     /// subnormals, or mismatched lengths (nothing written).
     #[test]
-    fn shared_soft_slab_batches_decline_what_they_do_not_share() {
+    fn shared_slab_batches_decline_what_they_do_not_share() {
         use datapath::simd::slab_ray_shared;
         for (name, v) in [("e8m16", "directed"), ("e8m16:ftz", "plain"), ("e5m10:ftz", "take-on-false")] {
             let datapath::AnyFormat::Soft(f) = name.parse().unwrap() else { unreachable!() };
@@ -837,6 +915,26 @@ mod slab {
         let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
         let mut outs = vec![SlabOutSoa::with_len(40)];
         assert!(slab_ray_shared(&[&a, &a], &[&ray, &ray], &boxes, &mut outs).is_none(), "two variants, one output");
+        // binary32 under FTZ, binary16 and fixed point with the directed variant
+        let f = Ieee::new(F32Native, subnormals(true));
+        let a = Slab::new(f, SlabConfig::named("plain").unwrap());
+        let (_, boxes) = batch(&a, 3, 40);
+        let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
+        let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];
+        assert!(slab_ray_shared(&[&a, &a], &[&ray, &ray], &boxes, &mut outs).is_none(), "f32:ftz");
+        let f = Ieee::new(F16Half, subnormals(false));
+        let (a, b) = (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named("directed").unwrap()));
+        let (_, boxes) = batch(&a, 3, 40);
+        let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
+        let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];
+        assert!(slab_ray_shared(&[&a, &b], &[&ray, &ray], &boxes, &mut outs).is_none(), "fp16 directed");
+        let f = super::fixed("q16.16");
+        let (a, b) = (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named("directed").unwrap()));
+        let (_, boxes) = fixed_slab_batch(&a, 3, 40);
+        let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
+        let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];
+        assert!(slab_ray_shared(&[&a, &b], &[&ray, &ray], &boxes, &mut outs).is_none(), "q16.16 directed");
+        assert!(outs.iter().all(|o| !o.hit.iter().any(|&h| h)), "q16.16: written");
     }
 
     /// One-ray `eEmM` slab batches whose box planes sit on the ray's origin, a few grid steps

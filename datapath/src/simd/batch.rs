@@ -2,7 +2,7 @@
 //! (or the fixed-point lanes, or the scalar model), and the streaming form of the RTI batch.
 
 use super::entries::*;
-use super::fixed::{rti_batch_fixed, slab_batch_fixed, slab_ray_fixed};
+use super::fixed::{rti_batch_fixed, slab_batch_fixed, slab_ray_fixed, slab_ray_shared_fixed};
 use super::select::*;
 use crate::rti::{HitsSoa, RaysSoa, Rti, TrisSoa};
 use crate::slab::{BoxesSoa, Slab, SlabOutSoa, SlabRay, SlabRaysSoa};
@@ -100,16 +100,15 @@ where
 }
 
 /// [`slab_ray`] of each `(group[j], rays[j])` into `outs[j]` — the same bits — with the work
-/// the variants do alike done once where a kernel shares it: the round-to-nearest variants
-/// (plain, conservative, take-on-false, embree) of one `eEmM` format with IEEE subnormals
-/// whose prepared rays have the same origin, 1/d and t interval, bit for bit, compute the
-/// planes `(box − o) ⊗ 1/d` once, then each its comparator chains, widening and guard. Returns
-/// the kernel used, or `None`, nothing written, when the group does not qualify (another
-/// format, a directed variant, rays that differ, a machine without the kernel): the caller
-/// runs [`slab_ray`] per variant.
-///
-/// # Panics
-/// If the column lengths differ.
+/// the variants do alike done once: the round-to-nearest variants (plain, conservative,
+/// take-on-false, embree) of one format with IEEE subnormals (binary32, binary16, bf16, an
+/// `eEmM` layout the kernels take) or of one fixed-point format, whose prepared rays have the
+/// same origin, 1/d and t interval, bit for bit, compute the planes `(box − o) ⊗ 1/d` once,
+/// then each its comparator chains, widening and guard (fixed point: the chains once too; it
+/// has no NaN, so its variants differ only in the widening). Returns the kernel used, or
+/// `None`, nothing written, when the group does not qualify (another format, FTZ, a directed
+/// variant, rays that differ, columns of another length, a machine without the kernel): the
+/// caller runs [`slab_ray`] per variant.
 pub fn slab_ray_shared<F: crate::Format + 'static>(
     group: &[&Slab<F>],
     rays: &[&SlabRay<F::V>],
@@ -119,22 +118,32 @@ pub fn slab_ray_shared<F: crate::Format + 'static>(
 where
     F::V: 'static,
 {
-    use crate::format::{Ieee, Soft};
+    use crate::format::{Bf16, F16Half, F32Native, Fixed, Ieee, Soft};
     use std::any::TypeId;
-    if TypeId::of::<F>() != TypeId::of::<Ieee<Soft>>() {
-        return None;
+    // the typed entry of F's format, if it has one
+    macro_rules! typed {
+        ($fmt:ty, $v:ty, $entry:ident) => {
+            if TypeId::of::<F>() == TypeId::of::<$fmt>() {
+                // SAFETY: F is $fmt (the same type, checked above), so F::V is $v and each
+                // slice has the element type it is cast to
+                let (group, rays, boxes, outs) = unsafe {
+                    (
+                        &*(group as *const [&Slab<F>] as *const [&Slab<$fmt>]),
+                        &*(rays as *const [&SlabRay<F::V>] as *const [&SlabRay<$v>]),
+                        &*(boxes as *const BoxesSoa<F::V>).cast::<BoxesSoa<$v>>(),
+                        &mut *(outs as *mut [SlabOutSoa<F::V>] as *mut [SlabOutSoa<$v>]),
+                    )
+                };
+                return $entry(group, rays, boxes, outs);
+            }
+        };
     }
-    // SAFETY: F is Ieee<Soft> (the same type, checked above), so F::V is u64 and each slice
-    // has the element type it is cast to
-    let (group, rays, boxes, outs) = unsafe {
-        (
-            &*(group as *const [&Slab<F>] as *const [&Slab<Ieee<Soft>>]),
-            &*(rays as *const [&SlabRay<F::V>] as *const [&SlabRay<u64>]),
-            &*(boxes as *const BoxesSoa<F::V>).cast::<BoxesSoa<u64>>(),
-            &mut *(outs as *mut [SlabOutSoa<F::V>] as *mut [SlabOutSoa<u64>]),
-        )
-    };
-    slab_ray_shared_soft(group, rays, boxes, outs)
+    typed!(Ieee<F32Native>, f32, slab_ray_shared_f32);
+    typed!(Ieee<F16Half>, half::f16, slab_ray_shared_f16);
+    typed!(Ieee<Bf16>, u16, slab_ray_shared_bf16);
+    typed!(Ieee<Soft>, u64, slab_ray_shared_soft);
+    typed!(Fixed, i64, slab_ray_shared_fixed);
+    None
 }
 
 /// Pairs per chunk of [`rti_stream`]: 256 pairs × (15 input + 3 output columns) × 4 bytes plus

@@ -284,51 +284,55 @@ slab_entry!(
     slab_ray_soft, Ieee<Soft>, u64, SlabRay<u64>, One, slab_ray_kernel_soft, v4d, v8d, slab_soft, None
 );
 
-/// A shared slab kernel: several variants on one ray and the same boxes (`@mloop`).
-#[cfg(target_arch = "x86_64")]
-type SharedSoftFn = unsafe fn(&[&Slab<Ieee<Soft>>], &SlabRay<u64>, &BoxesSoa<u64>, &mut [SlabOutSoa<u64>], usize);
-
-/// [`slab_ray_soft`] of each `(group[j], rays[j])` into `outs[j]`, their planes computed once
-/// ([`super::slab_ray_shared`]); `None`, nothing written, when the group does not qualify:
-/// its lengths differ or exceed 8, a variant is directed or is not the first's format, the
-/// format flushes subnormals, a prepared ray's origin, 1/d or t interval is not the first's
-/// bit for bit, a column is not the boxes' length, or the machine has no kernel for it.
-pub fn slab_ray_shared_soft(
-    group: &[&Slab<Ieee<Soft>>],
-    rays: &[&SlabRay<u64>],
-    boxes: &BoxesSoa<u64>,
-    outs: &mut [SlabOutSoa<u64>],
-) -> Option<Kernel> {
-    let (s0, r0) = (group.first()?, rays.first()?);
-    let same_ray = |r: &&SlabRay<u64>| r.o == r0.o && r.inv_d == r0.inv_d && r.tmin == r0.tmin && r.tmax == r0.tmax;
-    let ok = group.len() == rays.len()
-        && group.len() == outs.len()
-        && group.len() <= super::kernels::MAX_SHARED
-        && s0.fmt.opts.subnormals != Subnormals::Ftz
-        && group.iter().all(|s| s.fmt == s0.fmt && !s.cfg.directed && soft_slab_ok(s, true))
-        && rays.iter().all(same_ray);
-    let n = boxes.min[0].len();
-    if !ok || !outs.iter().all(|o| slab_columns_ok(boxes, o, n)) {
-        return None;
-    }
-    let which = slab_ray_kernel_soft(s0);
-    #[cfg(target_arch = "x86_64")]
-    {
-        let table: Table<SharedSoftFn> = (kernels::v4d::slab_soft_shared, kernels::v8d::slab_soft_shared, None);
-        if let Some((kernel, lanes)) = pick(which, table) {
-            let full = n / lanes * lanes;
-            // SAFETY: `which` names a kernel only after run-time feature detection; every
-            // column holds n >= full slots (checked above); the variants qualify (checked)
-            unsafe { kernel(group, r0, boxes, outs, full) };
-            for ((s, r), o) in group.iter().zip(rays).zip(outs.iter_mut()) {
-                s.batch_ray_from(r, boxes, o, full);
-            }
-            return Some(which);
+/// A typed shared slab entry point ([`super::slab_ray_shared`]): [`shared_dispatch`] with the
+/// format's one-ray kernel choice and eligibility (IEEE subnormals: the shared loops do not
+/// flush).
+macro_rules! shared_entry {
+    ($(#[$doc:meta])* $name:ident, $fmt:ty, $v:ty, $which:ident, $eligible:expr, $m8:ident, $m16:ident, $kernel:ident, $fp16:expr) => {
+        $(#[$doc])*
+        pub fn $name(
+            group: &[&Slab<$fmt>],
+            rays: &[&SlabRay<$v>],
+            boxes: &BoxesSoa<$v>,
+            outs: &mut [SlabOutSoa<$v>],
+        ) -> Option<Kernel> {
+            let eligible: fn(&Slab<$fmt>) -> bool = $eligible;
+            shared_dispatch(
+                group,
+                rays,
+                boxes,
+                outs,
+                |s| s.fmt.opts.subnormals != Subnormals::Ftz && eligible(s),
+                $which,
+                #[cfg(target_arch = "x86_64")]
+                (kernels::$m8::$kernel, kernels::$m16::$kernel, $fp16),
+            )
         }
-    }
-    let _ = which;
-    None
+    };
 }
+
+shared_entry!(
+    /// [`slab_ray_f32`] of each `(group[j], rays[j])` into `outs[j]`, their planes computed once
+    /// ([`super::slab_ray_shared`]); `None`, nothing written, when the group does not qualify.
+    slab_ray_shared_f32, Ieee<F32Native>, f32, slab_ray_kernel_f32, |_| true, v8, v16, slab_f32_shared, None
+);
+shared_entry!(
+    /// [`slab_ray_f16`] of each `(group[j], rays[j])` into `outs[j]`, their planes computed once
+    /// ([`super::slab_ray_shared`]); `None`, nothing written, when the group does not qualify.
+    slab_ray_shared_f16, Ieee<F16Half>, f16, slab_ray_kernel_f16, |_| true, v8, v16, slab_f16_shared,
+    Some(kernels::v32h::slab_f16_shared)
+);
+shared_entry!(
+    /// [`slab_ray_bf16`] of each `(group[j], rays[j])` into `outs[j]`, their planes computed once
+    /// ([`super::slab_ray_shared`]); `None`, nothing written, when the group does not qualify.
+    slab_ray_shared_bf16, Ieee<Bf16>, u16, slab_ray_kernel_bf16, |_| true, b8, b16, slab_bf16_shared, None
+);
+shared_entry!(
+    /// [`slab_ray_soft`] of each `(group[j], rays[j])` into `outs[j]`, their planes computed once
+    /// ([`super::slab_ray_shared`]); `None`, nothing written, when the group does not qualify
+    /// (also: a layout the `eEmM` kernels do not take).
+    slab_ray_shared_soft, Ieee<Soft>, u64, slab_ray_kernel_soft, |s| soft_slab_ok(s, true), v4d, v8d, slab_soft_shared, None
+);
 
 slab_entry!(
     /// [`Slab::batch`] for bf16 on the fastest kernel available; the same bits.

@@ -514,9 +514,6 @@ macro_rules! slab_kernel {
     }};
 }
 
-/// Variants at most in one shared slab batch (`slab_kernel!`'s `@mloop`).
-pub(super) const MAX_SHARED: usize = 8;
-
 /// [`slab_kernel!`] with the format's subnormal rule: as it is under IEEE subnormals; under
 /// FTZ every operand read (columns and broadcast ray values) and every rounded result
 /// flushed in the lanes (a lane below `$min`, the smallest normal, becomes zero of its
@@ -625,12 +622,12 @@ macro_rules! kernels_for {
         }
     };
     (@f32 $x:ident, $f32feat:literal) => {
-        kernels_for!(@format $x, $f32feat, rti_f32, slab_f32, Ieee<F32Native>, f32, load32, store32,
+        kernels_for!(@format $x, $f32feat, rti_f32, slab_f32, slab_f32_shared, Ieee<F32Native>, f32, load32, store32,
             |x| x, |v| $x::next_up(v), |v, n: u32| $x::next_up_n(v, n), |x: f32| $x::splat(x), |r: &Rti<Ieee<F32Native>>| r.det_thr,
             f32::MIN_POSITIVE, |v: f32| v != 0.0 && v.abs() < f32::MIN_POSITIVE);
     };
     (@f16 $x:ident, $f16feat:literal) => {
-        kernels_for!(@format $x, $f16feat, rti_f16, slab_f16, Ieee<F16Half>, f16, load16, store16,
+        kernels_for!(@format $x, $f16feat, rti_f16, slab_f16, slab_f16_shared, Ieee<F16Half>, f16, load16, store16,
             |v| $x::round16(v), |v| $x::next_up16(v), |v, n: u32| (0..n).fold(v, |v, _| $x::next_up16(v)), |x: f16| $x::splat16(x),
             |r: &Rti<Ieee<F16Half>>| r.det_thr.to_f32(), f16::MIN_POSITIVE.to_f32(), |v: f16| v.to_bits() & 0x7c00 == 0 && v.to_bits() & 0x3ff != 0);
     };
@@ -638,7 +635,7 @@ macro_rules! kernels_for {
     // step, ray broadcast, det threshold (as the lanes hold it), and smallest normal (the RTI
     // kernel under FTZ flushes every operand read and every rounded result in the lanes: a
     // lane below it becomes zero of its sign)
-    (@format $x:ident, $feat:literal, $rti:ident, $slab:ident, $fmt:ty, $v:ty, $load:ident, $store:ident,
+    (@format $x:ident, $feat:literal, $rti:ident, $slab:ident, $shared:ident, $fmt:ty, $v:ty, $load:ident, $store:ident,
      $round:expr, $up:expr, $upn:expr, $bcast:expr, $thr:expr, $min_normal:expr, $raw_sub:expr) => {
         #[target_feature(enable = $feat)]
         pub fn $rti(rti: &Rti<$fmt>, rays: &RaysSoa<$v>, tris: &TrisSoa<$v>, out: &mut HitsSoa<$v>, full: usize) {
@@ -692,6 +689,37 @@ macro_rules! kernels_for {
                 $bcast,
                 $min_normal,
                 $raw_sub
+            );
+        }
+
+        /// The slab kernel above for several round-to-nearest variants on one ray and the same
+        /// boxes, their planes computed once (`slab_kernel!`'s `@mloop`; IEEE subnormals: the caller
+        /// checked that every variant qualifies and that they share the format and the
+        /// prepared ray): each `outs[j]` bit for bit the slab kernel of `group[j]` alone.
+        // (`v8r`'s is unused: the dispatch keeps `v8`'s F16C rounding)
+        #[allow(dead_code)]
+        #[target_feature(enable = $feat)]
+        pub fn $shared(
+            group: &[&Slab<$fmt>],
+            r: &crate::slab::SlabRay<$v>,
+            boxes: &BoxesSoa<$v>,
+            outs: &mut [SlabOutSoa<$v>],
+            full: usize,
+        ) {
+            // SAFETY (loads and stores): as above.
+            slab_kernel!(
+                @mloop $x,
+                group,
+                r,
+                boxes,
+                outs,
+                full,
+                |c: *const $v, i: usize| unsafe { $x::$load(c, i) },
+                $round,
+                None::<&std::cell::Cell<$x::M>>,
+                |c: *mut $v, i: usize, x| unsafe { $x::$store(c, i, x) },
+                $upn,
+                $bcast
             );
         }
     };
@@ -954,6 +982,33 @@ macro_rules! bf16_for {
                     |x: u16| $x::splat(f32::from_bits((x as u32) << 16)),
                     f32::MIN_POSITIVE,
                     |v: u16| v & 0x7f80 == 0 && v & 0x7f != 0
+                );
+            }
+
+            /// [`slab_bf16`] of several round-to-nearest variants on one ray and the same
+            /// boxes, their planes computed once (as the binary32 `slab_f32_shared`).
+            #[target_feature(enable = $feat)]
+            pub fn slab_bf16_shared(
+                group: &[&Slab<Ieee<Bf16>>],
+                r: &crate::slab::SlabRay<u16>,
+                boxes: &BoxesSoa<u16>,
+                outs: &mut [SlabOutSoa<u16>],
+                full: usize,
+            ) {
+                // SAFETY (loads and stores): as above.
+                slab_kernel!(
+                    @mloop $x,
+                    group,
+                    r,
+                    boxes,
+                    outs,
+                    full,
+                    |c: *const u16, i: usize| unsafe { $x::load_bf16(c, i) },
+                    |x| $x::round_bf16(x),
+                    None::<&std::cell::Cell<$x::M>>,
+                    |c: *mut u16, i: usize, x| unsafe { $x::store_bf16(c, i, x) },
+                    |v, n: u32| $x::next_up_bf16_n(v, n),
+                    |x: u16| $x::splat(f32::from_bits((x as u32) << 16))
                 );
             }
         }

@@ -59,6 +59,6 @@ pub mod widen;
 
 pub use batch::*;
 pub use entries::*;
-pub use fixed::{rti_batch_fixed, slab_batch_fixed, slab_ray_fixed};
+pub use fixed::{rti_batch_fixed, slab_batch_fixed, slab_ray_fixed, slab_ray_shared_fixed};
 pub use select::{cap_process, kernels_here, with_kernel_cap, Kernel};
 pub(crate) use select::{f64_lanes, F64Lanes};

@@ -275,3 +275,65 @@ pub(crate) fn slab_dispatch<F: crate::Format>(
     }
     Kernel::Scalar
 }
+
+/// Variants at most in one shared slab batch (`slab_kernel!`'s `@mloop`, the fixed-point
+/// `slab_shared_loop`).
+pub(crate) const MAX_SHARED: usize = 8;
+
+/// The signature of a shared slab kernel: several round-to-nearest variants of one format on
+/// one ray and the same boxes, lanes `0..full` of every column, `outs[j]` for `group[j]`.
+#[cfg(target_arch = "x86_64")]
+pub(crate) type SharedSlabFn<F> = unsafe fn(
+    &[&Slab<F>],
+    &SlabRay<<F as crate::Format>::V>,
+    &BoxesSoa<<F as crate::Format>::V>,
+    &mut [SlabOutSoa<<F as crate::Format>::V>],
+    usize,
+);
+
+/// Runs the shared slab kernel of `table` that `which(group[0])` names on the full vectors
+/// and each variant's scalar model on the rest, when the group qualifies: one to
+/// [`MAX_SHARED`] variants, as many rays and outputs; every variant of the first's format,
+/// not directed, and `eligible`; every prepared ray's origin, 1/d and t interval the first's
+/// bit for bit (the loops read nothing else of a ray); every column the boxes' length; a
+/// kernel for it on this machine. Returns that kernel, or `None`, nothing written, otherwise.
+pub(crate) fn shared_dispatch<F: crate::Format + PartialEq>(
+    group: &[&Slab<F>],
+    rays: &[&SlabRay<F::V>],
+    boxes: &BoxesSoa<F::V>,
+    outs: &mut [SlabOutSoa<F::V>],
+    eligible: impl Fn(&Slab<F>) -> bool,
+    which: impl Fn(&Slab<F>) -> Kernel,
+    #[cfg(target_arch = "x86_64")] table: Table<SharedSlabFn<F>>,
+) -> Option<Kernel> {
+    let (s0, r0) = (group.first()?, rays.first()?);
+    let f = &s0.fmt;
+    let same = |a: &[F::V], b: &[F::V]| a.iter().zip(b).all(|(&x, &y)| f.to_bits(x) == f.to_bits(y));
+    let same_ray = |r: &&SlabRay<F::V>| {
+        same(&r.o, &r0.o) && same(&r.inv_d, &r0.inv_d) && same(&[r.tmin, r.tmax], &[r0.tmin, r0.tmax])
+    };
+    let n = boxes.min[0].len();
+    let ok = group.len() == rays.len()
+        && group.len() == outs.len()
+        && group.len() <= MAX_SHARED
+        && group.iter().all(|s| s.fmt == s0.fmt && !s.cfg.directed && eligible(s))
+        && rays.iter().all(same_ray)
+        && outs.iter().all(|o| slab_columns_ok(boxes, o, n));
+    if !ok {
+        return None;
+    }
+    let which = which(s0);
+    #[cfg(target_arch = "x86_64")]
+    if let Some((kernel, lanes)) = pick(which, table) {
+        let full = n / lanes * lanes;
+        // SAFETY: `which` names a kernel only after run-time feature detection; every column
+        // holds n >= full slots (checked above); the variants qualify (checked)
+        unsafe { kernel(group, r0, boxes, outs, full) };
+        for ((s, r), o) in group.iter().zip(rays).zip(outs.iter_mut()) {
+            s.batch_ray_from(r, boxes, o, full);
+        }
+        return Some(which);
+    }
+    let _ = which;
+    None
+}

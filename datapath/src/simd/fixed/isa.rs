@@ -7,7 +7,7 @@ use super::{ymm, zmm};
 use crate::format::{DivMode, Fixed, FxOverflow};
 use crate::rti::{Cull, HitsSoa, RaysSoa, Rti, TrisSoa};
 use crate::simd::select::SlabRays;
-use crate::slab::{BoxesSoa, Slab, SlabOutSoa};
+use crate::slab::{BoxesSoa, Slab, SlabOutSoa, SlabRay};
 use crate::stage::Op;
 
 /// The constants of a format the dispatch accepted (`kernel_fixed` names a kernel only
@@ -105,6 +105,52 @@ pub(super) fn slab_avx512(
     // SAFETY: this function's features
     let z = unsafe { zmm::Z::new(lanes(&s.fmt)) };
     slab_any(&z, s, rays, boxes, out, full)
+}
+
+/// The shared slab loop (several round-to-nearest variants, one ray) on lanes `x` for the
+/// format's modes.
+#[inline(always)]
+fn slab_shared_any<X: Ops>(
+    x: &X,
+    group: &[&Slab<Fixed>],
+    r: &SlabRay<i64>,
+    boxes: &BoxesSoa<i64>,
+    outs: &mut [SlabOutSoa<i64>],
+    full: usize,
+) {
+    by_modes!(&group[0].fmt, slab_shared_loop, X, x, group, r, boxes, outs, full)
+}
+
+/// AVX2 (4 lanes).
+#[target_feature(enable = "avx2")]
+pub(super) fn slab_shared_avx2(
+    group: &[&Slab<Fixed>],
+    r: &SlabRay<i64>,
+    boxes: &BoxesSoa<i64>,
+    outs: &mut [SlabOutSoa<i64>],
+    full: usize,
+) {
+    let c = lanes(&group[0].fmt);
+    if ymm::Y::fits(&c, group[0].fmt.overflow == FxOverflow::Wrap) {
+        // SAFETY: this function's features
+        slab_shared_any(&unsafe { ymm::Y::new(c) }, group, r, boxes, outs, full)
+    } else {
+        slab_shared_any(&Port::<4>(c), group, r, boxes, outs, full)
+    }
+}
+
+/// AVX-512F + DQ (8 lanes).
+#[target_feature(enable = "avx512f,avx512dq")]
+pub(super) fn slab_shared_avx512(
+    group: &[&Slab<Fixed>],
+    r: &SlabRay<i64>,
+    boxes: &BoxesSoa<i64>,
+    outs: &mut [SlabOutSoa<i64>],
+    full: usize,
+) {
+    // SAFETY: this function's features
+    let z = unsafe { zmm::Z::new(lanes(&group[0].fmt)) };
+    slab_shared_any(&z, group, r, boxes, outs, full)
 }
 
 /// AVX2 (4 lanes).

@@ -479,20 +479,43 @@ pub(super) fn slab_vec<X: Ops, const R: u8, const WRAP: bool>(
         }
         return (!outside & x.le(near, far), near, far);
     }
+    let (near, far) = slab_chains::<X, R, WRAP>(x, r, bmin, bmax);
+    slab_widen(x, s.widen_ulps, near, far)
+}
+
+/// The round-to-nearest variants' planes and comparator chains (stages 1-4; the same for
+/// every such variant of a format, fixed point having no NaN): (t_near, t_far) before the
+/// widening. Reads the ray's origin, 1/d and t interval only.
+#[inline(always)]
+fn slab_chains<X: Ops, const R: u8, const WRAP: bool>(
+    x: &X,
+    r: &SlabRayV<X::V>,
+    bmin: [X::V; 3],
+    bmax: [X::V; 3],
+) -> (X::V, X::V) {
+    let zero = x.splat(0);
     let (mut near, mut far) = (r.tmin, r.tmax);
     for a in 0..3 {
         let (lo, hi) = (x.sub::<WRAP>(bmin[a], r.o[a]), x.sub::<WRAP>(bmax[a], r.o[a]));
         let (tlo, thi) = (x.mul::<R, WRAP>(lo, r.inv_d[a]), x.mul::<R, WRAP>(hi, r.inv_d[a]));
-        let ng = neg(r.inv_d[a]);
+        let ng = x.lt(r.inv_d[a], zero);
         near = x.max(near, x.sel(ng, thi, tlo));
         far = x.min(far, x.sel(ng, tlo, thi));
     }
-    // stage 5: widening by |widen_ulps| steps (saturating)
-    let w = s.widen_ulps.unsigned_abs() as i64;
-    if s.widen_ulps > 0 {
+    (near, far)
+}
+
+/// Stage 5, the widening by `widen` steps (saturating; outward when positive), and the hit
+/// compare: (hit, t_near, t_far).
+#[inline(always)]
+fn slab_widen<X: Ops>(x: &X, widen: i32, mut near: X::V, mut far: X::V) -> (u8, X::V, X::V) {
+    let c = x.c();
+    let (top, bottom) = (x.splat(c.max), x.splat(c.min));
+    let w = widen.unsigned_abs() as i64;
+    if widen > 0 {
         near = x.max(x.step(near, -w), bottom);
         far = x.min(x.step(far, w), top);
-    } else if s.widen_ulps < 0 {
+    } else if widen < 0 {
         near = x.min(x.step(near, w), top);
         far = x.max(x.step(far, -w), bottom);
     }
@@ -544,6 +567,43 @@ pub(super) fn slab_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, 
                 };
                 slab_step::<X, R, WRAP>(x, s, &ray, boxes, out, i);
             }
+        }
+    }
+}
+
+/// Several round-to-nearest variants of one format (`group`, none directed) on one ray and
+/// the same boxes over slots `0..full` (a multiple of `L`), `outs[j]` for `group[j]`: the
+/// planes and chains ([`slab_chains`]) computed once per vector, then each variant's widening
+/// and stores — each output bit for bit [`slab_loop`]'s for that variant alone (the variants
+/// differ only in the widening: fixed point has no NaN, so neither comparator nor guard
+/// applies).
+#[inline(always)]
+pub(super) fn slab_shared_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, const RECIP: bool>(
+    x: &X,
+    group: &[&crate::slab::Slab<Fixed>],
+    r: &crate::slab::SlabRay<i64>,
+    boxes: &BoxesSoa<i64>,
+    outs: &mut [SlabOutSoa<i64>],
+    full: usize,
+) {
+    assert!(group.len() == outs.len(), "slab_shared_loop: a group of another shape");
+    let ray = SlabRayV {
+        o: r.o.map(|v| x.splat(v)),
+        inv_d: r.inv_d.map(|v| x.splat(v)),
+        inv_lo: r.inv_lo.map(|v| x.splat(v)),
+        inv_hi: r.inv_hi.map(|v| x.splat(v)),
+        parallel: r.parallel.map(|p| if p { u8::MAX } else { 0 }),
+        tmin: x.splat(r.tmin),
+        tmax: x.splat(r.tmax),
+    };
+    for i in (0..full).step_by(X::L) {
+        let (bmin, bmax) = (load3(x, &boxes.min, i), load3(x, &boxes.max, i));
+        let (near, far) = slab_chains::<X, R, WRAP>(x, &ray, bmin, bmax);
+        for (s, out) in group.iter().zip(outs.iter_mut()) {
+            let (hit, near, far) = slab_widen(x, s.cfg.widen_ulps, near, far);
+            store_flags(&mut out.hit, i, X::L, hit);
+            x.store(&mut out.t_near, i, near);
+            x.store(&mut out.t_far, i, far);
         }
     }
 }

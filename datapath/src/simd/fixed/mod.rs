@@ -161,3 +161,26 @@ pub fn slab_batch_fixed(
 pub fn slab_ray_fixed(s: &Slab<Fixed>, ray: &SlabRay<i64>, boxes: &BoxesSoa<i64>, out: &mut SlabOutSoa<i64>) -> Kernel {
     slab_fixed(s, SlabRays::One(ray), boxes, out)
 }
+
+/// [`slab_ray_fixed`] of each `(group[j], rays[j])` into `outs[j]` — the same bits — with
+/// the planes and comparator chains computed once: the round-to-nearest variants of one format
+/// (fixed point has no NaN, so they differ only in the widening) whose prepared rays have the
+/// same origin, 1/d and t interval. `None`, nothing written, when the group does not qualify
+/// (see `datapath::simd::slab_ray_shared`).
+pub fn slab_ray_shared_fixed(
+    group: &[&Slab<Fixed>],
+    rays: &[&SlabRay<i64>],
+    boxes: &BoxesSoa<i64>,
+    outs: &mut [SlabOutSoa<i64>],
+) -> Option<Kernel> {
+    crate::simd::select::shared_dispatch(
+        group,
+        rays,
+        boxes,
+        outs,
+        |_| true,
+        slab_kernel_fixed,
+        #[cfg(target_arch = "x86_64")]
+        (isa::slab_shared_avx2, isa::slab_shared_avx512, None),
+    )
+}
