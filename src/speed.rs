@@ -194,16 +194,45 @@ fn rate(n: usize, reps: usize, mut f: impl FnMut()) -> f64 {
 /// sampled across the run's clock changes. Returns the row with its best rate (its fraction of
 /// peak is set by [`speed`] against the run's best peak of its precision) and the best peak
 /// bursts seen.
-fn row(name: &str, n: usize, ops: f64, reps: usize, mut f: impl FnMut()) -> (SpeedRow, [f64; 2]) {
+fn row(name: &str, n: usize, ops: f64, reps: usize, f: impl FnMut()) -> (SpeedRow, [f64; 2]) {
+    let mut one = in_turns(vec![Turn { name: name.into(), n, ops, f: Box::new(f) }], reps);
+    one.pop().expect("one row in, one row out")
+}
+
+/// A row to measure [`in_turns`] with others: its name, tests per call, operations per test
+/// and the call.
+struct Turn<'a> {
+    name: String,
+    n: usize,
+    ops: f64,
+    f: Box<dyn FnMut() + 'a>,
+}
+
+/// Rows measured in turns, as [`row`] measures one: `reps` rounds, each a 20 ms timing of
+/// every row's call in list order, each followed by a 5 ms peak burst — so that the rows whose
+/// ratio the report states (each format's RTI batch path against the binary32 kernel) are
+/// timed across the same stretch of the run, not one after the other (on a shared machine a
+/// slow stretch then slows both, instead of one). Each row its best rate; every row the best
+/// peak bursts seen.
+fn in_turns(mut list: Vec<Turn<'_>>, reps: usize) -> Vec<(SpeedRow, [f64; 2])> {
     let burst = || [peak(0.005), peak16(0.005).unwrap_or(0.0)];
-    let (mut m, mut p) = (0.0f64, burst());
+    let mut p = burst();
+    let mut best = vec![0.0f64; list.len()];
     for _ in 0..reps {
-        m = m.max(timed(0.02, n as u64, &mut f));
-        let q = burst();
-        p = [p[0].max(q[0]), p[1].max(q[1])];
+        for (m, t) in best.iter_mut().zip(list.iter_mut()) {
+            *m = m.max(timed(0.02, t.n as u64, &mut t.f));
+            let q = burst();
+            p = [p[0].max(q[0]), p[1].max(q[1])];
+        }
     }
-    let peak = if name.contains("fp16") && p[1] > 0.0 { "binary16" } else { "binary32" };
-    (SpeedRow { name: name.into(), mtests_per_s: m / 1e6, ops, peak: peak.into(), fraction_of_peak: 0.0 }, p)
+    list.iter()
+        .zip(best)
+        .map(|(t, m)| {
+            let peak = if t.name.contains("fp16") && p[1] > 0.0 { "binary16" } else { "binary32" };
+            let row = SpeedRow { name: t.name.clone(), mtests_per_s: m / 1e6, ops: t.ops, peak: peak.into(), fraction_of_peak: 0.0 };
+            (row, p)
+        })
+        .collect()
 }
 
 /// The RTI input columns of `cases` in the unit's format.
@@ -276,26 +305,57 @@ pub fn speed(pairs: usize, seed: u64) -> SpeedReport {
     let mut o32 = HitsSoa::with_len(pairs);
     let mut o16 = HitsSoa::with_len(pairs);
     let mut k = [Kernel::Scalar; 2];
-    push(row("rti f32 kernel (dispatch)", pairs, RTI_OPS, 7, || {
-        k[0] = rti_batch_f32(&r32, &rays32, &tris32, &mut o32)
-    }));
+    // the RTI batch paths in turns (the ratios the report states are of these rows): binary32,
+    // binary16, and those of bf16 (binary32 lanes), e8m16 (binary64 lanes, see
+    // datapath::format::narrow) and q16.16 (i64 lanes, datapath::simd::fixed); BATCH_PATHS says
+    // what runs where
+    let narrow = ["bf16", "e8m16", "q16.16"];
+    let mut kernels = {
+        let (k32, k16) = k.split_at_mut(1);
+        let mut turns = vec![
+            Turn {
+                name: "rti f32 kernel (dispatch)".into(),
+                n: pairs,
+                ops: RTI_OPS,
+                f: Box::new(|| k32[0] = rti_batch_f32(&r32, &rays32, &tris32, &mut o32)),
+            },
+            Turn {
+                name: "rti fp16 kernel (dispatch)".into(),
+                n: pairs,
+                ops: RTI_OPS,
+                f: Box::new(|| k16[0] = rti_batch_f16(&r16, &rays16, &tris16, &mut o16)),
+            },
+        ];
+        for name in narrow {
+            let any: datapath::AnyFormat = name.parse().expect("a built-in format name");
+            datapath::with_format!(any, |f| {
+                let rti = Rti::new(f, RtiConfig::default());
+                let (rays, tris) = columns(&rti, &cases);
+                let mut out = HitsSoa::with_len(pairs);
+                turns.push(Turn {
+                    name: format!("rti {name} kernel (dispatch)"),
+                    n: pairs,
+                    ops: RTI_OPS,
+                    f: Box::new(move || {
+                        datapath::simd::rti_batch(&rti, &rays, &tris, &mut out);
+                    }),
+                });
+            });
+        }
+        in_turns(turns, 7).into_iter()
+    };
+    let mut next_kernel = || kernels.next().expect("a row per turn");
+    push(next_kernel());
     push(row("rti f32 scalar model", pairs, RTI_OPS, 3, || r32.batch(&rays32, &tris32, &mut o32)));
-    push(row("rti fp16 kernel (dispatch)", pairs, RTI_OPS, 7, || {
-        k[1] = rti_batch_f16(&r16, &rays16, &tris16, &mut o16)
-    }));
+    push(next_kernel());
     push(row("rti fp16 scalar model", pairs, RTI_OPS, 3, || r16.batch(&rays16, &tris16, &mut o16)));
-    // the batch paths of bf16 (binary32 lanes), e8m16 (binary64 lanes, see
-    // datapath::format::narrow) and q16.16 (i64 lanes, datapath::simd::fixed) beside their
-    // scalar models (BATCH_PATHS says what runs where)
-    for name in ["bf16", "e8m16", "q16.16"] {
+    for name in narrow {
         let any: datapath::AnyFormat = name.parse().expect("a built-in format name");
+        push(next_kernel());
         datapath::with_format!(any, |f| {
             let rti = Rti::new(f, RtiConfig::default());
             let (rays, tris) = columns(&rti, &cases);
             let mut out = HitsSoa::with_len(pairs);
-            push(row(&format!("rti {name} kernel (dispatch)"), pairs, RTI_OPS, 7, || {
-                datapath::simd::rti_batch(&rti, &rays, &tris, &mut out);
-            }));
             push(row(&format!("rti {name} scalar model"), pairs, RTI_OPS, 3, || rti.batch(&rays, &tris, &mut out)));
         });
     }
