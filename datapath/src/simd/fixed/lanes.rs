@@ -534,6 +534,7 @@ pub(super) fn slab_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, 
     full: usize,
 ) {
     match rays {
+        SlabRays::One(r) if s.directed => slab_directed_one::<X, R, WRAP>(x, r, boxes, out, full),
         SlabRays::One(r) => {
             // the ray broadcast once, read by reference (a copy of its 14 vectors per step
             // was a memory copy per vector)
@@ -568,6 +569,72 @@ pub(super) fn slab_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, 
                 slab_step::<X, R, WRAP>(x, s, &ray, boxes, out, i);
             }
         }
+    }
+}
+
+/// The directed variant of [`slab_vec`] on one ray against every box over slots `0..full` (a
+/// multiple of `L`), the outputs stored — the same bits, with what the ray decides alike for
+/// every lane decided once per axis instead of selected per lane: whether the axis is parallel
+/// (then only the origin's inside test), the direction's sign (which plane is the entry, which
+/// bracket end each difference takes: two grid steps per axis instead of four), and whether the
+/// 1/d ends stand for ±∞ (usually neither: no per-lane test).
+#[inline(always)]
+fn slab_directed_one<X: Ops, const R: u8, const WRAP: bool>(
+    x: &X,
+    r: &crate::slab::SlabRay<i64>,
+    boxes: &BoxesSoa<i64>,
+    out: &mut SlabOutSoa<i64>,
+    full: usize,
+) {
+    let c = *x.c();
+    let (top, bottom) = (x.splat(c.max), x.splat(c.min));
+    let up = |v| x.min(x.step(v, 1), top);
+    let down = |v| x.max(x.step(v, -1), bottom);
+    let zero = x.splat(0);
+    let all = |b: bool| if b { u8::MAX } else { 0 };
+    // per axis, uniform: the origin, 1/d's ends and whether each stands for ±∞, the sign of 1/d
+    let o = r.o.map(|v| x.splat(v));
+    let (inv_lo, inv_hi) = (r.inv_lo.map(|v| x.splat(v)), r.inv_hi.map(|v| x.splat(v)));
+    let lo_inf = r.inv_lo.map(|v| v == c.min);
+    let hi_inf = r.inv_hi.map(|v| v == c.max);
+    let ng = r.inv_d.map(|v| v < 0);
+    let (tmin, tmax) = (x.splat(r.tmin), x.splat(r.tmax));
+    for i in (0..full).step_by(X::L) {
+        let (bmin, bmax) = (load3(x, &boxes.min, i), load3(x, &boxes.max, i));
+        let (mut near, mut far, mut outside) = (tmin, tmax, 0u8);
+        for a in 0..3 {
+            if r.parallel[a] {
+                // a parallel axis adds no constraint but the origin's inside test
+                outside |= !(x.le(bmin[a], o[a]) & x.le(o[a], bmax[a]));
+                continue;
+            }
+            // the entry difference's bracket end and the exit's (by the direction's sign), and
+            // whether each is the range's end (standing for ±∞)
+            let (x_e, x_e_inf, x_x, x_x_inf) = if ng[a] {
+                let (e, xx) = (up(x.sub::<WRAP>(bmax[a], o[a])), down(x.sub::<WRAP>(bmin[a], o[a])));
+                (e, x.eq(e, top), xx, x.eq(xx, bottom))
+            } else {
+                let (e, xx) = (down(x.sub::<WRAP>(bmin[a], o[a])), up(x.sub::<WRAP>(bmax[a], o[a])));
+                (e, x.eq(e, bottom), xx, x.eq(xx, top))
+            };
+            // the 1/d end by the bracket end's sign: negative → inv_hi (entry) / inv_lo (exit)
+            let (se, sx) = (x.lt(x_e, zero), x.lt(x_x, zero));
+            let inv_e = x.sel(se, inv_hi[a], inv_lo[a]);
+            let inv_x = x.sel(sx, inv_lo[a], inv_hi[a]);
+            let (hi, lo) = (all(hi_inf[a]), all(lo_inf[a]));
+            let (inv_e_inf, inv_x_inf) = if hi_inf[a] || lo_inf[a] {
+                ((se & hi) | (!se & lo), (sx & lo) | (!sx & hi))
+            } else {
+                (0, 0)
+            };
+            let entry = x.sel(x_e_inf | inv_e_inf, bottom, down(x.mul::<R, WRAP>(x_e, inv_e)));
+            let exit = x.sel(x_x_inf | inv_x_inf, top, up(x.mul::<R, WRAP>(x_x, inv_x)));
+            near = x.max(near, entry);
+            far = x.min(far, exit);
+        }
+        store_flags(&mut out.hit, i, X::L, !outside & x.le(near, far));
+        x.store(&mut out.t_near, i, near);
+        x.store(&mut out.t_far, i, far);
     }
 }
 
