@@ -229,7 +229,13 @@ fn in_turns(mut list: Vec<Turn<'_>>, reps: usize) -> Vec<(SpeedRow, [f64; 2])> {
         .zip(best)
         .map(|(t, m)| {
             let peak = if t.name.contains("fp16") && p[1] > 0.0 { "binary16" } else { "binary32" };
-            let row = SpeedRow { name: t.name.clone(), mtests_per_s: m / 1e6, ops: t.ops, peak: peak.into(), fraction_of_peak: 0.0 };
+            let row = SpeedRow {
+                name: t.name.clone(),
+                mtests_per_s: m / 1e6,
+                ops: t.ops,
+                peak: peak.into(),
+                fraction_of_peak: 0.0,
+            };
             (row, p)
         })
         .collect()

@@ -749,7 +749,12 @@ mod slab {
                         prop_assert_eq!(
                             (out.hit[i], f.to_bits(out.t_near[i]), f.to_bits(out.t_far[i])),
                             (want.hit[i], f.to_bits(want.t_near[i]), f.to_bits(want.t_far[i])),
-                            "{} {} lane {} of {} on {:?}", f.name(), VARIANTS[idx[j]], i, n, k
+                            "{} {} lane {} of {} on {:?}",
+                            f.name(),
+                            VARIANTS[idx[j]],
+                            i,
+                            n,
+                            k
                         );
                     }
                 }
@@ -923,13 +928,15 @@ mod slab {
         let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];
         assert!(slab_ray_shared(&[&a, &a], &[&ray, &ray], &boxes, &mut outs).is_none(), "f32:ftz");
         let f = Ieee::new(F16Half, subnormals(false));
-        let (a, b) = (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named("directed").unwrap()));
+        let (a, b) =
+            (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named("directed").unwrap()));
         let (_, boxes) = batch(&a, 3, 40);
         let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
         let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];
         assert!(slab_ray_shared(&[&a, &b], &[&ray, &ray], &boxes, &mut outs).is_none(), "fp16 directed");
         let f = super::fixed("q16.16");
-        let (a, b) = (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named("directed").unwrap()));
+        let (a, b) =
+            (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named("directed").unwrap()));
         let (_, boxes) = fixed_slab_batch(&a, 3, 40);
         let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
         let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];

@@ -622,11 +622,8 @@ fn slab_directed_one<X: Ops, const R: u8, const WRAP: bool>(
             let inv_e = x.sel(se, inv_hi[a], inv_lo[a]);
             let inv_x = x.sel(sx, inv_lo[a], inv_hi[a]);
             let (hi, lo) = (all(hi_inf[a]), all(lo_inf[a]));
-            let (inv_e_inf, inv_x_inf) = if hi_inf[a] || lo_inf[a] {
-                ((se & hi) | (!se & lo), (sx & lo) | (!sx & hi))
-            } else {
-                (0, 0)
-            };
+            let (inv_e_inf, inv_x_inf) =
+                if hi_inf[a] || lo_inf[a] { ((se & hi) | (!se & lo), (sx & lo) | (!sx & hi)) } else { (0, 0) };
             let entry = x.sel(x_e_inf | inv_e_inf, bottom, down(x.mul::<R, WRAP>(x_e, inv_e)));
             let exit = x.sel(x_x_inf | inv_x_inf, top, up(x.mul::<R, WRAP>(x_x, inv_x)));
             near = x.max(near, entry);
