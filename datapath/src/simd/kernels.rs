@@ -692,35 +692,36 @@ macro_rules! kernels_for {
             );
         }
 
-        /// The slab kernel above for several round-to-nearest variants on one ray and the same
-        /// boxes, their planes computed once (`slab_kernel!`'s `@mloop`; IEEE subnormals: the caller
-        /// checked that every variant qualifies and that they share the format and the
-        /// prepared ray): each `outs[j]` bit for bit the slab kernel of `group[j]` alone.
         // (`v8r`'s is unused: the dispatch keeps `v8`'s F16C rounding)
+        shared_slab_fn!($x, $feat, $shared, $fmt, $v,
+            |c: *const $v, i: usize| unsafe { $x::$load(c, i) },
+            $round,
+            |c: *mut $v, i: usize, x| unsafe { $x::$store(c, i, x) },
+            $upn, $bcast);
+    };
+}
+
+/// A slab kernel for several round-to-nearest variants of one format on one ray and the same
+/// boxes, their planes computed once (`slab_kernel!`'s `@mloop`, no deferred rounding; IEEE
+/// subnormals: the caller checked that every variant qualifies and that they share the format
+/// and the prepared ray): each `outs[j]` bit for bit the format's slab kernel of `group[j]`
+/// alone. `$load`, `$round`, `$store`, `$upn`, `$bcast` as that kernel's.
+macro_rules! shared_slab_fn {
+    ($x:ident, $feat:literal, $name:ident, $fmt:ty, $v:ty, $load:expr, $round:expr, $store:expr, $upn:expr, $bcast:expr) => {
+        /// The format's slab kernel for several round-to-nearest variants on one ray and the
+        /// same boxes, their planes computed once (`shared_slab_fn!`).
         #[allow(dead_code)]
         #[target_feature(enable = $feat)]
-        pub fn $shared(
+        pub fn $name(
             group: &[&Slab<$fmt>],
             r: &crate::slab::SlabRay<$v>,
             boxes: &BoxesSoa<$v>,
             outs: &mut [SlabOutSoa<$v>],
             full: usize,
         ) {
-            // SAFETY (loads and stores): as above.
-            slab_kernel!(
-                @mloop $x,
-                group,
-                r,
-                boxes,
-                outs,
-                full,
-                |c: *const $v, i: usize| unsafe { $x::$load(c, i) },
-                $round,
-                None::<&std::cell::Cell<$x::M>>,
-                |c: *mut $v, i: usize, x| unsafe { $x::$store(c, i, x) },
-                $upn,
-                $bcast
-            );
+            // SAFETY (loads and stores): the caller checked that every column holds `full`
+            // lanes; the column types are plain values.
+            slab_kernel!(@mloop $x, group, r, boxes, outs, full, $load, $round, None::<&std::cell::Cell<$x::M>>, $store, $upn, $bcast);
         }
     };
 }
@@ -985,32 +986,18 @@ macro_rules! bf16_for {
                 );
             }
 
-            /// [`slab_bf16`] of several round-to-nearest variants on one ray and the same
-            /// boxes, their planes computed once (as the binary32 `slab_f32_shared`).
-            #[target_feature(enable = $feat)]
-            pub fn slab_bf16_shared(
-                group: &[&Slab<Ieee<Bf16>>],
-                r: &crate::slab::SlabRay<u16>,
-                boxes: &BoxesSoa<u16>,
-                outs: &mut [SlabOutSoa<u16>],
-                full: usize,
-            ) {
-                // SAFETY (loads and stores): as above.
-                slab_kernel!(
-                    @mloop $x,
-                    group,
-                    r,
-                    boxes,
-                    outs,
-                    full,
-                    |c: *const u16, i: usize| unsafe { $x::load_bf16(c, i) },
-                    |x| $x::round_bf16(x),
-                    None::<&std::cell::Cell<$x::M>>,
-                    |c: *mut u16, i: usize, x| unsafe { $x::store_bf16(c, i, x) },
-                    |v, n: u32| $x::next_up_bf16_n(v, n),
-                    |x: u16| $x::splat(f32::from_bits((x as u32) << 16))
-                );
-            }
+            shared_slab_fn!(
+                $x,
+                $feat,
+                slab_bf16_shared,
+                Ieee<Bf16>,
+                u16,
+                |c: *const u16, i: usize| unsafe { $x::load_bf16(c, i) },
+                |x| $x::round_bf16(x),
+                |c: *mut u16, i: usize, x| unsafe { $x::store_bf16(c, i, x) },
+                |v, n: u32| $x::next_up_bf16_n(v, n),
+                |x: u16| $x::splat(f32::from_bits((x as u32) << 16))
+            );
         }
     };
 }

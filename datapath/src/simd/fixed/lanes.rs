@@ -538,15 +538,7 @@ pub(super) fn slab_loop<X: Ops, const R: u8, const WRAP: bool, const TWO: bool, 
         SlabRays::One(r) => {
             // the ray broadcast once, read by reference (a copy of its 14 vectors per step
             // was a memory copy per vector)
-            let ray = SlabRayV {
-                o: r.o.map(|v| x.splat(v)),
-                inv_d: r.inv_d.map(|v| x.splat(v)),
-                inv_lo: r.inv_lo.map(|v| x.splat(v)),
-                inv_hi: r.inv_hi.map(|v| x.splat(v)),
-                parallel: r.parallel.map(|p| if p { u8::MAX } else { 0 }),
-                tmin: x.splat(r.tmin),
-                tmax: x.splat(r.tmax),
-            };
+            let ray = broadcast(x, r);
             for i in (0..full).step_by(X::L) {
                 slab_step::<X, R, WRAP>(x, s, &ray, boxes, out, i);
             }
@@ -635,6 +627,20 @@ fn slab_directed_one<X: Ops, const R: u8, const WRAP: bool>(
     }
 }
 
+/// One ray's values in every lane (a one-ray batch's [`SlabRayV`]).
+#[inline(always)]
+fn broadcast<X: Ops>(x: &X, r: &crate::slab::SlabRay<i64>) -> SlabRayV<X::V> {
+    SlabRayV {
+        o: r.o.map(|v| x.splat(v)),
+        inv_d: r.inv_d.map(|v| x.splat(v)),
+        inv_lo: r.inv_lo.map(|v| x.splat(v)),
+        inv_hi: r.inv_hi.map(|v| x.splat(v)),
+        parallel: r.parallel.map(|p| if p { u8::MAX } else { 0 }),
+        tmin: x.splat(r.tmin),
+        tmax: x.splat(r.tmax),
+    }
+}
+
 /// Several round-to-nearest variants of one format (`group`, none directed) on one ray and
 /// the same boxes over slots `0..full` (a multiple of `L`), `outs[j]` for `group[j]`: the
 /// planes and chains ([`slab_chains`]) computed once per vector, then each variant's widening
@@ -651,15 +657,7 @@ pub(super) fn slab_shared_loop<X: Ops, const R: u8, const WRAP: bool, const TWO:
     full: usize,
 ) {
     assert!(group.len() == outs.len(), "slab_shared_loop: a group of another shape");
-    let ray = SlabRayV {
-        o: r.o.map(|v| x.splat(v)),
-        inv_d: r.inv_d.map(|v| x.splat(v)),
-        inv_lo: r.inv_lo.map(|v| x.splat(v)),
-        inv_hi: r.inv_hi.map(|v| x.splat(v)),
-        parallel: r.parallel.map(|p| if p { u8::MAX } else { 0 }),
-        tmin: x.splat(r.tmin),
-        tmax: x.splat(r.tmax),
-    };
+    let ray = broadcast(x, r);
     for i in (0..full).step_by(X::L) {
         let (bmin, bmax) = (load3(x, &boxes.min, i), load3(x, &boxes.max, i));
         let (near, far) = slab_chains::<X, R, WRAP>(x, &ray, bmin, bmax);
