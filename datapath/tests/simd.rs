@@ -899,49 +899,41 @@ mod slab {
         }
     }
 
+    /// Whether the shared slab batch declines plain with `second` of format `f` on `boxes`
+    /// (`None`, and nothing written).
+    fn declines<F: Format + 'static>(f: F, second: &str, boxes: &BoxesSoa<F::V>) -> bool {
+        let (a, b) =
+            (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named(second).unwrap()));
+        let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
+        let n = boxes.min[0].len();
+        let mut outs = vec![SlabOutSoa::with_len(n), SlabOutSoa::with_len(n)];
+        datapath::simd::slab_ray_shared(&[&a, &b], &[&ray, &ray], boxes, &mut outs).is_none()
+            && outs.iter().all(|o| !o.hit.iter().any(|&h| h))
+    }
+
     /// A shared slab batch declines a group with the directed variant, a format that flushes
-    /// subnormals, or mismatched lengths (nothing written).
+    /// subnormals, or mismatched lengths (nothing written): `eEmM`, binary32 under FTZ,
+    /// binary16 and fixed point with the directed variant.
     #[test]
     fn shared_slab_batches_decline_what_they_do_not_share() {
         use datapath::simd::slab_ray_shared;
+        let plain = SlabConfig::named("plain").unwrap();
         for (name, v) in [("e8m16", "directed"), ("e8m16:ftz", "plain"), ("e5m10:ftz", "take-on-false")] {
             let datapath::AnyFormat::Soft(f) = name.parse().unwrap() else { unreachable!() };
-            let (a, b) =
-                (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named(v).unwrap()));
-            let (_, boxes) = batch(&a, 3, 40);
-            let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
-            let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];
-            assert!(slab_ray_shared(&[&a, &b], &[&ray, &ray], &boxes, &mut outs).is_none(), "{name} {v}");
-            assert!(outs.iter().all(|o| !o.hit.iter().any(|&h| h)), "{name} {v}: written");
+            assert!(declines(f, v, &batch(&Slab::new(f, plain), 3, 40).1), "{name} {v}");
         }
+        let f = Ieee::new(F32Native, subnormals(true));
+        assert!(declines(f, "plain", &batch(&Slab::new(f, plain), 3, 40).1), "f32:ftz");
+        let f = Ieee::new(F16Half, subnormals(false));
+        assert!(declines(f, "directed", &batch(&Slab::new(f, plain), 3, 40).1), "fp16 directed");
+        let f = super::fixed("q16.16");
+        assert!(declines(f, "directed", &fixed_slab_batch(&Slab::new(f, plain), 3, 40).1), "q16.16 directed");
         let datapath::AnyFormat::Soft(f) = "e8m16".parse().unwrap() else { unreachable!() };
-        let a = Slab::new(f, SlabConfig::named("plain").unwrap());
+        let a = Slab::new(f, plain);
         let (_, boxes) = batch(&a, 3, 40);
         let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
         let mut outs = vec![SlabOutSoa::with_len(40)];
         assert!(slab_ray_shared(&[&a, &a], &[&ray, &ray], &boxes, &mut outs).is_none(), "two variants, one output");
-        // binary32 under FTZ, binary16 and fixed point with the directed variant
-        let f = Ieee::new(F32Native, subnormals(true));
-        let a = Slab::new(f, SlabConfig::named("plain").unwrap());
-        let (_, boxes) = batch(&a, 3, 40);
-        let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
-        let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];
-        assert!(slab_ray_shared(&[&a, &a], &[&ray, &ray], &boxes, &mut outs).is_none(), "f32:ftz");
-        let f = Ieee::new(F16Half, subnormals(false));
-        let (a, b) =
-            (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named("directed").unwrap()));
-        let (_, boxes) = batch(&a, 3, 40);
-        let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
-        let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];
-        assert!(slab_ray_shared(&[&a, &b], &[&ray, &ray], &boxes, &mut outs).is_none(), "fp16 directed");
-        let f = super::fixed("q16.16");
-        let (a, b) =
-            (Slab::new(f, SlabConfig::named("plain").unwrap()), Slab::new(f, SlabConfig::named("directed").unwrap()));
-        let (_, boxes) = fixed_slab_batch(&a, 3, 40);
-        let ray = a.prepare([0.1, 0.2, 0.3], [1.0, 0.5, 0.25], 0.0, f64::INFINITY);
-        let mut outs = vec![SlabOutSoa::with_len(40), SlabOutSoa::with_len(40)];
-        assert!(slab_ray_shared(&[&a, &b], &[&ray, &ray], &boxes, &mut outs).is_none(), "q16.16 directed");
-        assert!(outs.iter().all(|o| !o.hit.iter().any(|&h| h)), "q16.16: written");
     }
 
     /// One-ray `eEmM` slab batches whose box planes sit on the ray's origin, a few grid steps
