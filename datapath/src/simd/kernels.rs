@@ -181,13 +181,19 @@ macro_rules! slab_kernel {
     // `defer $lround, $pending`: the non-directed loops round with `$lround`, which may leave
     // lanes wrong as long as it notes them in `$pending` (`Some(&Cell<mask>)`): those lanes'
     // outputs are made NaN, and the scalar model redoes them after the loop (`slab_redo`)
-    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, defer $lround:expr, $pending:expr) => {{
+    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, defer $lround:expr, $pending:expr) => {
+        slab_kernel!($x, $s, $rays, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, defer $lround, $pending, rup |v| ($up)(($round)(v)))
+    };
+    // `rup $rup`: `$rup(x)` is `$up($round(x))` — the directed variant's rounding then grid
+    // step — for any x, in whatever fewer operations the format has (binary16 on F16C: one
+    // round trip, the step taken on the encoding between the two conversions)
+    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, defer $lround:expr, $pending:expr, rup $rup:expr) => {{
         // one loop per comparator and batch shape, so that neither is decided per vector
         let tof = $s.cfg.nan == SlabNan::TakeOnFalse;
         if $s.cfg.directed {
             match $rays {
-                SlabRays::One(r) if tof => slab_kernel!(@dloop $x, $s, r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, true),
-                SlabRays::One(r) => slab_kernel!(@dloop $x, $s, r, $boxes, $out, $full, $load, $round, $store, $up, $bcast, false),
+                SlabRays::One(r) if tof => slab_kernel!(@dloop $x, $s, r, $boxes, $out, $full, $load, $round, $store, $rup, $bcast, true),
+                SlabRays::One(r) => slab_kernel!(@dloop $x, $s, r, $boxes, $out, $full, $load, $round, $store, $rup, $bcast, false),
                 // pairs of the directed variant are not eligible (see `slab_kernel_ray_*`)
                 SlabRays::Pairs(r) => {
                     for k in 0..$full {
@@ -263,11 +269,14 @@ macro_rules! slab_kernel {
     // bound, the product stepped outward once. A parallel axis (uniform) tests the origin
     // against the slab. Lanes whose plane difference is NaN (its sign would pick an end) are
     // marked NaN and redone by the model, as are NaN outputs.
-    (@dloop $x:ident, $s:expr, $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $bcast:expr, $tof:expr) => {{
+    (@dloop $x:ident, $s:expr, $r:ident, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $rup:expr, $bcast:expr, $tof:expr) => {{
         let (s, boxes, out) = ($s, $boxes, $out);
-        let (load, rd, store, up, bcast) = ($load, $round, $store, $up, $bcast);
+        // `rup(x)` rounds x to the format, then steps up; `rdown` rounds, then steps down
+        // (rounding to nearest commutes with negation)
+        // (`$round` only through `rup`)
+        let (load, store, rup, bcast) = ($load, $store, $rup, $bcast);
         let neg = |v| $x::xor(v, $x::splat(-0.0));
-        let down = |v| neg(up(neg(v)));
+        let rdown = |v| neg(rup(neg(v)));
         let bmin = boxes.min.each_ref().map(|c| c.as_ptr());
         let bmax = boxes.max.each_ref().map(|c| c.as_ptr());
         let r = $r;
@@ -301,24 +310,26 @@ macro_rules! slab_kernel {
                     outside = $x::or_m(outside, $x::not_m(inside));
                     continue;
                 }
-                let de = rd($x::sub(load(prep.0[a], i), o));
-                let dx = rd($x::sub(load(prep.1[a], i), o));
-                bad = $x::or_m(bad, $x::unord(de, dx));
+                // the plane differences, rounded and stepped to their bracket ends at once
+                let de = $x::sub(load(prep.0[a], i), o);
+                let dx = $x::sub(load(prep.1[a], i), o);
                 // bracket end of the entry difference: d < 0 → its upper end, else its lower
                 let (x_e, x_e_inf) = if dneg[a] {
-                    let v = up(de);
+                    let v = rup(de);
                     (v, $x::le(vtop, v))
                 } else {
-                    let v = down(de);
+                    let v = rdown(de);
                     (v, $x::le(v, vbottom))
                 };
                 let (x_x, x_x_inf) = if dneg[a] {
-                    let v = down(dx);
+                    let v = rdown(dx);
                     (v, $x::le(v, vbottom))
                 } else {
-                    let v = up(dx);
+                    let v = rup(dx);
                     (v, $x::le(vtop, v))
                 };
+                // a NaN difference (its bracket end is NaN too: a step keeps NaN)
+                bad = $x::or_m(bad, $x::unord(x_e, x_x));
                 // the 1/d end by the bracket end's sign: negative → inv_hi (entry) / inv_lo (exit)
                 let inv_e = $x::blend_sign(inv_lo[a], inv_hi[a], x_e);
                 let inv_x = $x::blend_sign(inv_hi[a], inv_lo[a], x_x);
@@ -332,8 +343,8 @@ macro_rules! slab_kernel {
                 } else {
                     (none, none)
                 };
-                let t_entry = $x::blend(down(rd($x::mul(x_e, inv_e))), vbottom, $x::or_m(x_e_inf, inv_e_inf));
-                let t_exit = $x::blend(up(rd($x::mul(x_x, inv_x))), vtop, $x::or_m(x_x_inf, inv_x_inf));
+                let t_entry = $x::blend(rdown($x::mul(x_e, inv_e)), vbottom, $x::or_m(x_e_inf, inv_e_inf));
+                let t_exit = $x::blend(rup($x::mul(x_x, inv_x)), vtop, $x::or_m(x_x_inf, inv_x_inf));
                 if $tof {
                     tn = $x::blend(t_entry, tn, $x::le(t_entry, tn));
                     tf = $x::blend(t_exit, tf, $x::le(tf, t_exit));
@@ -525,11 +536,16 @@ macro_rules! slab_ftz {
     ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, $min:expr, $raw_sub:expr) => {
         slab_ftz!($x, $s, $rays, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, $min, $raw_sub, defer $round, None::<&std::cell::Cell<$x::M>>)
     };
-    // `defer`: as `slab_kernel!`'s, with IEEE subnormals only (under FTZ, `$round`)
-    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, $min:expr, $raw_sub:expr, defer $lround:expr, $pending:expr) => {{
+    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, $min:expr, $raw_sub:expr, defer $lround:expr, $pending:expr) => {
+        slab_ftz!($x, $s, $rays, $boxes, $out, $full, $load, $round, $store, $up, $upn, $bcast, $min, $raw_sub, defer $lround, $pending, rup |v| ($up)(($round)(v)))
+    };
+    // `defer`: as `slab_kernel!`'s, with IEEE subnormals only (under FTZ, `$round`); `rup`:
+    // as `slab_kernel!`'s, with IEEE subnormals only (under FTZ, the flushing step of the
+    // flushed rounding)
+    ($x:ident, $s:expr, $rays:expr, $boxes:expr, $out:expr, $full:expr, $load:expr, $round:expr, $store:expr, $up:expr, $upn:expr, $bcast:expr, $min:expr, $raw_sub:expr, defer $lround:expr, $pending:expr, rup $rup:expr) => {{
         let (s, rays, boxes, out, full) = ($s, $rays, $boxes, $out, $full);
         if s.fmt.opts.subnormals != Subnormals::Ftz {
-            slab_kernel!($x, s, rays, boxes, out, full, $load, $round, $store, $up, $upn, $bcast, defer $lround, $pending);
+            slab_kernel!($x, s, rays, boxes, out, full, $load, $round, $store, $up, $upn, $bcast, defer $lround, $pending, rup $rup);
         } else {
             let raw_sub = $raw_sub;
             if let SlabRays::One(r) = rays {
@@ -688,7 +704,12 @@ macro_rules! kernels_for {
                 $upn,
                 $bcast,
                 $min_normal,
-                $raw_sub
+                $raw_sub,
+                defer $round,
+                None::<&std::cell::Cell<$x::M>>,
+                // binary32: rounding is the identity; binary16: `next_up16` rounds to nearest
+                // in its conversion to the encoding, so it is the step of the rounding
+                rup $up
             );
         }
 
