@@ -345,13 +345,7 @@ macro_rules! slab_kernel {
                 };
                 let t_entry = $x::blend(rdown($x::mul(x_e, inv_e)), vbottom, $x::or_m(x_e_inf, inv_e_inf));
                 let t_exit = $x::blend(rup($x::mul(x_x, inv_x)), vtop, $x::or_m(x_x_inf, inv_x_inf));
-                if $tof {
-                    tn = $x::blend(t_entry, tn, $x::le(t_entry, tn));
-                    tf = $x::blend(t_exit, tf, $x::le(tf, t_exit));
-                } else {
-                    tn = $x::max(t_entry, tn);
-                    tf = $x::min(t_exit, tf);
-                }
+                (tn, tf) = slab_kernel!(@compare $x, $tof, (tn, tf), t_entry, t_exit);
             }
             tn = $x::blend(tn, $x::canonical_nan(), bad);
             let hit = $x::and_m($x::not_m(outside), $x::le(tn, tf));
@@ -426,21 +420,25 @@ macro_rules! slab_kernel {
             unsafe { slab_redo(model, slab_kernel!(@rays $shape r), boxes, (o_hit, o_near, o_far), $full) };
         }
     }};
+    // one step of the compare unit's chains: the running (t_near, t_far) `$t` against a plane's
+    // near and far t, by the variant's comparator
+    (@compare $x:ident, $tof:expr, $t:expr, $near:expr, $far:expr) => {{
+        let ((tn, tf), near, far) = ($t, $near, $far);
+        if $tof {
+            // t = (x <= t) ? t : x (near), (t <= x) ? t : x (far)
+            ($x::blend(near, tn, $x::le(near, tn)), $x::blend(far, tf, $x::le(tf, far)))
+        } else {
+            // t = (x > t) ? x : t (near), (x < t) ? x : t (far): exactly vmaxps(x, t)
+            // and vminps(x, t), which return the second operand on NaN or equality
+            ($x::max(near, tn), $x::min(far, tf))
+        }
+    }};
     // the comparator chains over the three planes from the t interval `$lim`, then the
     // widening by `$widen` grid steps and the conservative guard: (t_near, t_far)
     (@ends $x:ident, $lim:expr, $planes:expr, $tof:expr, $widen:expr, $guard:expr, $upn:ident, $down_n:ident) => {{
         let (mut tn, mut tf) = $lim;
         for &(near, far) in &$planes {
-            if $tof {
-                // t = (x <= t) ? t : x (near), (t <= x) ? t : x (far)
-                tn = $x::blend(near, tn, $x::le(near, tn));
-                tf = $x::blend(far, tf, $x::le(tf, far));
-            } else {
-                // t = (x > t) ? x : t (near), (x < t) ? x : t (far): exactly vmaxps(x, t)
-                // and vminps(x, t), which return the second operand on NaN or equality
-                tn = $x::max(near, tn);
-                tf = $x::min(far, tf);
-            }
+            (tn, tf) = slab_kernel!(@compare $x, $tof, (tn, tf), near, far);
         }
         let (ends, widen): (_, i32) = ((tn, tf), $widen);
         if widen > 0 {
