@@ -15,6 +15,9 @@
 // M <= 24 (binary32, binary16, bfloat16 and eEmM customs within that); products and
 // quotients of such values stay normal and finite in binary64.
 // Works in Icarus Verilog 11 (-g2012), Verilator 5.006 and commercial simulators.
+// The larger functions carry /*verilator no_inline_task*/: Verilator inlines every call
+// otherwise, and the reference DUTs' ~100 call sites became 70 MB of C++ (a 47 s build; 5 s
+// with the functions kept as functions). Other tools read it as a comment.
 package raypipe_fp;
 
   // A format: exponent and fraction widths, flush-to-zero, NaN propagation.
@@ -93,7 +96,7 @@ package raypipe_fp;
   endfunction
 
   // Finite encoding to binary64 (exact).
-  function automatic real to_real(fmt_t f, word_t a);
+  function automatic real to_real(fmt_t f, word_t a); /*verilator no_inline_task*/
     word_t e = exp_field(f, a);
     word_t fr = frac_field(f, a);
     word_t out = sign_of(f, a) ? 64'h8000_0000_0000_0000 : 64'h0;
@@ -117,7 +120,7 @@ package raypipe_fp;
 
   // A finite binary64 value rounded to the format: nearest, ties to even; overflow to
   // infinity; gradual underflow, then the FTZ result flush.
-  function automatic word_t from_real(fmt_t f, real r);
+  function automatic word_t from_real(fmt_t f, real r); /*verilator no_inline_task*/
     word_t b = $realtobits(r);
     logic s = b[63];
     int e64 = int'(b[62:52]);
@@ -151,7 +154,7 @@ package raypipe_fp;
   endfunction
 
   // a + b, or a - b when neg is set.
-  function automatic word_t addsub(fmt_t f, word_t a, word_t b, logic neg);
+  function automatic word_t addsub(fmt_t f, word_t a, word_t b, logic neg); /*verilator no_inline_task*/
     word_t x = rd(f, a);
     word_t y = rd(f, b);
     if (is_nan(f, x) || is_nan(f, y)) return nan_result(f, a, b);
@@ -170,7 +173,7 @@ package raypipe_fp;
     return addsub(f, a, b, 1'b1);
   endfunction
 
-  function automatic word_t fmul(fmt_t f, word_t a, word_t b);
+  function automatic word_t fmul(fmt_t f, word_t a, word_t b); /*verilator no_inline_task*/
     word_t x = rd(f, a);
     word_t y = rd(f, b);
     logic s = sign_of(f, x) ^ sign_of(f, y);
@@ -183,7 +186,7 @@ package raypipe_fp;
 
   // A deliberately wrong multiplier for the kit's negative check: rounds toward zero where
   // a x b rounded to nearest went away from zero (wrong in about half the inexact products).
-  function automatic word_t fmul_faulty(fmt_t f, word_t a, word_t b);
+  function automatic word_t fmul_faulty(fmt_t f, word_t a, word_t b); /*verilator no_inline_task*/
     word_t r = fmul(f, a, b);
     real exact, got;
     if (is_nan(f, r) || is_inf(f, r) || is_zero(f, r) || is_inf(f, a) || is_inf(f, b)) return r;
@@ -194,7 +197,7 @@ package raypipe_fp;
   endfunction
 
   // a / b correctly rounded.
-  function automatic word_t fdiv(fmt_t f, word_t a, word_t b);
+  function automatic word_t fdiv(fmt_t f, word_t a, word_t b); /*verilator no_inline_task*/
     word_t x = rd(f, a);
     word_t y = rd(f, b);
     logic s = sign_of(f, x) ^ sign_of(f, y);
@@ -211,7 +214,7 @@ package raypipe_fp;
     return fdiv(f, a, b);
   endfunction
 
-  function automatic logic flt(fmt_t f, word_t a, word_t b);
+  function automatic logic flt(fmt_t f, word_t a, word_t b); /*verilator no_inline_task*/
     word_t x = rd(f, a);
     word_t y = rd(f, b);
     word_t mx = x & ~sign_mask(f);
@@ -223,7 +226,7 @@ package raypipe_fp;
     return mx < my;
   endfunction
 
-  function automatic logic fle(fmt_t f, word_t a, word_t b);
+  function automatic logic fle(fmt_t f, word_t a, word_t b); /*verilator no_inline_task*/
     word_t x = rd(f, a);
     word_t y = rd(f, b);
     if (is_nan(f, x) || is_nan(f, y)) return 1'b0;
@@ -237,7 +240,7 @@ package raypipe_fp;
   endfunction
 
   // The next encoding above a (NaN and +inf unchanged); under FTZ it skips the subnormals.
-  function automatic word_t next_up(fmt_t f, word_t a);
+  function automatic word_t next_up(fmt_t f, word_t a); /*verilator no_inline_task*/
     word_t r;
     if (is_nan(f, a) || a == inf_of(f, 1'b0)) return a;
     if (is_zero(f, a)) r = f.ftz ? (word_t'(1) << f.m) : 1;
@@ -248,7 +251,7 @@ package raypipe_fp;
   endfunction
 
   // The next encoding below a: next_up mirrored through the sign.
-  function automatic word_t next_down(fmt_t f, word_t a);
+  function automatic word_t next_down(fmt_t f, word_t a); /*verilator no_inline_task*/
     if (is_nan(f, a)) return a;
     return next_up(f, a ^ sign_mask(f)) ^ sign_mask(f);
   endfunction

@@ -3,7 +3,7 @@
 // RAYPIPE_WAVES_TOP <module name>; `define RAYPIPE_FAILURES <expression> when the failure count
 // is not the module's `failed`).
 // +wavefile=F dumps to F (FST with Icarus' -fst and Verilator's --trace-fst, as hdl/run builds
-// them); with +waves_from=T0 [+waves_to=T1] only that window of simulation time. hdl/run passes
+// them when it dumps: a Verilator build without --trace-fst writes nothing); with +waves_from=T0 [+waves_to=T1] only that window of simulation time. hdl/run passes
 // them (+waves: the whole run; after a failure, a re-run dumps the window around the first
 // failure, whose time the testbench prints as "first failure at simulation time T").
   string wavefile;
