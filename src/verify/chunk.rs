@@ -209,21 +209,92 @@ struct Setup<'a, F: Format> {
     name: String,
     /// The model timings' clock (started with the pass).
     clock: Clock,
+    /// Every ray tests every triangle in order, in at most [`KEPT_BLOCKS`] blocks: each block's
+    /// lane set keeps its gathered inputs.
+    kept: bool,
+}
+
+/// Blocks of a ray, at most, whose lanes a worker keeps one set each for when every ray tests
+/// every triangle in order (a scene of at most `sample` triangles, in at most this many blocks):
+/// each block's gathered triangles and boxes are then the same for every ray and stay in its set
+/// (a speed choice: gathered again, they would be the same values).
+pub const KEPT_BLOCKS: usize = 4;
+
+/// The columns the model kernels, the bound and the golden read and write for one block of
+/// a ray, at one block size (its inputs gathered from the records, its outputs).
+struct Lanes<V> {
+    rays: RaysSoa<V>,
+    tris: TrisSoa<V>,
+    out: HitsSoa<V>,
+    cols: [Vec<f64>; 9],
+    bcols: [Vec<f64>; 6],
+    boxes: BoxesSoa<V>,
+    sout: SlabOutSoa<V>,
+    /// The outputs of a shared batch, one per variant of [`Setup::shared`].
+    souts: Vec<SlabOutSoa<V>>,
+    /// The ray whose values `rays` holds in every lane.
+    ray: Option<u64>,
+    /// The inputs (tris, cols, bcols, boxes) hold the gathered block for good (a kept block of
+    /// an every-triangle list, [`KEPT_BLOCKS`]).
+    kept: bool,
+}
+
+impl<V: Copy + Default> Lanes<V> {
+    /// No lanes (nothing allocated): the placeholder while a block borrows its set.
+    fn empty() -> Self {
+        Lanes {
+            rays: RaysSoa::default(),
+            tris: TrisSoa::default(),
+            out: HitsSoa::default(),
+            cols: Default::default(),
+            bcols: Default::default(),
+            boxes: BoxesSoa::default(),
+            sout: SlabOutSoa::default(),
+            souts: Vec::new(),
+            ray: None,
+            kept: false,
+        }
+    }
+    /// A set of `n` lanes.
+    fn new(n: usize) -> Self {
+        let z = V::default();
+        let mut l = Lanes {
+            rays: RaysSoa::default(),
+            tris: TrisSoa::default(),
+            out: HitsSoa::default(),
+            cols: std::array::from_fn(|_| vec![0.0; n]),
+            bcols: std::array::from_fn(|_| vec![0.0; n]),
+            boxes: BoxesSoa::default(),
+            sout: SlabOutSoa::default(),
+            souts: (0..datapath::slab::SLAB_VARIANTS.len()).map(|_| SlabOutSoa::default()).collect(),
+            ray: None,
+            kept: false,
+        };
+        l.rays.resize(n, z);
+        l.tris.resize(n, z);
+        l.out.resize(n);
+        l.boxes.min.iter_mut().chain(l.boxes.max.iter_mut()).for_each(|c| c.resize(n, z));
+        for o in std::iter::once(&mut l.sout).chain(&mut l.souts) {
+            o.hit.resize(n, false);
+            o.t_near.resize(n, z);
+            o.t_far.resize(n, z);
+        }
+        l
+    }
 }
 
 /// A worker's reusable buffers (no allocation per chunk after the first).
 struct Scratch<V> {
     list: Vec<u32>,
-    rays: RaysSoa<V>,
-    tris: TrisSoa<V>,
-    out: HitsSoa<V>,
-    cols: [Vec<f64>; 9],
+    /// The block lane sets: per block of the ray where the ray's blocks are kept
+    /// ([`KEPT_BLOCKS`]), else one for full blocks and one for a ray's last, shorter block
+    /// (every ray's list has the same length, so no set changes size).
+    sets: Vec<Lanes<V>>,
     ghit: Vec<bool>,
     gt: Vec<f64>,
     dec: Vec<bool>,
     ehit: Vec<bool>,
     terr: Vec<f64>,
-    bcols: [Vec<f64>; 6],
     shit: Vec<bool>,
     /// Lanes whose golden f64 interval is within [`CLOSE_REL`] of empty: exact decides.
     sclose: Vec<bool>,
@@ -238,28 +309,20 @@ struct Scratch<V> {
     fterr: Vec<f64>,
     exact: Vec<u8>,
     prepared: Vec<datapath::slab::SlabRay<V>>,
-    boxes: BoxesSoa<V>,
-    sout: SlabOutSoa<V>,
-    /// The outputs of a shared batch, one per variant of [`Setup::shared`].
-    souts: Vec<SlabOutSoa<V>>,
 }
 
 impl<V: Copy + Default> Scratch<V> {
     fn new() -> Self {
         let f = || vec![0.0; BLOCK];
         let b = || vec![false; BLOCK];
-        let mut s = Scratch {
+        Scratch {
             list: Vec::new(),
-            rays: RaysSoa::default(),
-            tris: TrisSoa::default(),
-            out: HitsSoa::default(),
-            cols: std::array::from_fn(|_| f()),
+            sets: Vec::new(),
             ghit: b(),
             gt: f(),
             dec: b(),
             ehit: b(),
             terr: f(),
-            bcols: std::array::from_fn(|_| f()),
             shit: b(),
             sclose: b(),
             cert: b(),
@@ -269,28 +332,21 @@ impl<V: Copy + Default> Scratch<V> {
             fterr: f(),
             exact: vec![0; BLOCK],
             prepared: Vec::new(),
-            boxes: BoxesSoa::default(),
-            sout: SlabOutSoa::default(),
-            souts: (0..datapath::slab::SLAB_VARIANTS.len()).map(|_| SlabOutSoa::default()).collect(),
-        };
-        s.size(BLOCK);
-        s
+        }
     }
 
-    /// The kernels' columns at `n` lanes (only when a block's size changes: a ray's last block).
-    fn size(&mut self, n: usize) {
-        if self.tris.len() != n {
-            let z = V::default();
-            self.rays.resize(n, z);
-            self.tris.resize(n, z);
-            self.out.resize(n);
-            self.boxes.min.iter_mut().chain(self.boxes.max.iter_mut()).for_each(|c| c.resize(n, z));
-            for o in std::iter::once(&mut self.sout).chain(&mut self.souts) {
-                o.hit.resize(n, false);
-                o.t_near.resize(n, z);
-                o.t_far.resize(n, z);
-            }
+    /// The lane set of block `b` (`n` lanes) of a ray, made the first time (`kept`: the
+    /// ray's blocks are kept, one set each).
+    fn set(&mut self, b: usize, n: usize, kept: bool) -> usize {
+        let j = if kept { b } else { usize::from(n != BLOCK) };
+        while self.sets.len() <= j {
+            self.sets.push(Lanes::new(n));
         }
+        if self.sets[j].tris.len() != n {
+            // (a list of another length: not in one run, whose lists all have one length)
+            self.sets[j] = Lanes::new(n);
+        }
+        j
     }
 }
 
@@ -332,13 +388,19 @@ where
             let list = std::mem::take(&mut s.list);
             for (b, blk) in list.chunks(BLOCK).enumerate() {
                 let base = b * BLOCK;
-                s.size(blk.len());
+                let j = s.set(b, blk.len(), self.kept);
+                let mut l = std::mem::replace(&mut s.sets[j], Lanes::empty());
                 if self.with_rti {
-                    self.rti_block(s, &mut acc, &ray, &rq, &mray, &pre, blk, base, i, timed, &mut cap, &mut gbest);
+                    self.rti_block(
+                        s, &mut l, &mut acc, &ray, &rq, &mray, &pre, blk, base, i, timed, &mut cap, &mut gbest,
+                    );
                 }
                 if !self.variants.is_empty() {
-                    self.slab_block(s, &mut sacc, &rq, &prepared, blk, timed);
+                    self.slab_block(s, &mut l, &mut sacc, &rq, &prepared, blk, timed);
                 }
+                // a kept block's inputs stay (the next ray's block b is the same triangles)
+                l.kept = self.kept;
+                s.sets[j] = l;
             }
             if self.with_rti {
                 let same = match (gbest, cap.hit) {
@@ -371,6 +433,7 @@ where
     fn rti_block(
         &self,
         s: &mut Scratch<F::V>,
+        l: &mut Lanes<F::V>,
         acc: &mut RtiAcc,
         ray: &Ray64,
         rq: &Ray64,
@@ -384,14 +447,16 @@ where
         gbest: &mut Option<(usize, f64)>,
     ) {
         let n = blk.len();
-        // every lane holds the ray: written in the ray's first block (the largest), kept after
-        if base == 0 {
+        // every lane holds the ray: written in the first block of the ray that uses the set
+        if l.ray != Some(ray_index) {
             for k in 0..n {
-                s.rays.set(k, mray);
+                l.rays.set(k, mray);
             }
+            l.ray = Some(ray_index);
         }
-        {
-            let [[a, b, c], [d, e, f], [g, h, i]] = &mut s.tris.v;
+        // a kept block holds its gathered triangles from an earlier ray (the same values)
+        if !l.kept {
+            let [[a, b, c], [d, e, f], [g, h, i]] = &mut l.tris.v;
             gather(
                 Kernel::Avx512Fp16,
                 &self.recs,
@@ -404,17 +469,18 @@ where
         // the quantised triangles: the model's values in f64 (Rti::tri stores from_f64 of each
         // coordinate, so to_f64 of the model's column is the quantised column), converted where
         // the format converts a column at vector speed, else gathered from the records
-        if self.q_from_m {
-            for (c, col) in s.cols.iter_mut().enumerate() {
-                self.rti.fmt.to_f64_column(&s.tris.v[c / 3][c % 3][..n], &mut col[..n]);
+        if l.kept {
+        } else if self.q_from_m {
+            for (c, col) in l.cols.iter_mut().enumerate() {
+                self.rti.fmt.to_f64_column(&l.tris.v[c / 3][c % 3][..n], &mut col[..n]);
             }
         } else {
-            gather(Kernel::Avx512Fp16, &self.qs, blk, true, |r| r, s.cols.each_mut().map(|x| &mut x[..]));
+            gather(Kernel::Avx512Fp16, &self.qs, blk, true, |r| r, l.cols.each_mut().map(|x| &mut x[..]));
         }
         let t0 = timed.then(|| self.clock.now());
         match self.cfg.inject {
             None => {
-                simd::rti_batch(&self.rti, &s.rays, &s.tris, &mut s.out);
+                simd::rti_batch(&self.rti, &l.rays, &l.tris, &mut l.out);
             }
             Some(spec) => {
                 // a deliberately wrong model: the bank fault's stage model, lane by lane
@@ -424,7 +490,7 @@ where
                     let m = &self.recs[ti as usize].m;
                     let tri = Tri { v: std::array::from_fn(|p| std::array::from_fn(|a| m[3 * p + a])) };
                     let o = self.rti.trace_faulty(mray, &tri, &mut datapath::probe::NoProbe, &x);
-                    (s.out.valid[k], s.out.hit[k], s.out.t[k], s.out.u[k], s.out.v[k]) =
+                    (l.out.valid[k], l.out.hit[k], l.out.t[k], l.out.u[k], l.out.v[k]) =
                         (o.valid, o.hit, o.t, o.u, o.v);
                 }
             }
@@ -445,7 +511,7 @@ where
                 Kernel::Avx512Fp16,
                 self.opts,
                 bray,
-                cols(&s.cols, n),
+                cols(&l.cols, n),
                 &mut s.dec[..n],
                 &mut s.ehit[..n],
                 &mut s.terr[..n],
@@ -455,7 +521,7 @@ where
                 Kernel::Avx512Fp16,
                 self.opts,
                 bray,
-                cols(&s.cols, n),
+                cols(&l.cols, n),
                 pre.bound.as_ref(),
                 &mut s.dec[..n],
                 &mut s.ehit[..n],
@@ -478,7 +544,7 @@ where
             Kernel::Avx512Fp16,
             self.fopts,
             bray,
-            cols(&s.cols, n),
+            cols(&l.cols, n),
             fpre,
             &s.dec[..n],
             &mut s.fdec[..n],
@@ -492,7 +558,7 @@ where
         for (x, (w, len)) in words(n).enumerate() {
             let r = w..w + len;
             let (dec, mhit, ehit, valid) =
-                (bits(&s.dec[r.clone()]), bits(&s.out.hit[r.clone()]), bits(&s.ehit[r.clone()]), bits(&s.out.valid[r]));
+                (bits(&s.dec[r.clone()]), bits(&l.out.hit[r.clone()]), bits(&s.ehit[r.clone()]), bits(&l.out.valid[r]));
             let all = u64::MAX >> (64 - len);
             let c = &mut acc.counts;
             c.tests += len as u64;
@@ -505,19 +571,19 @@ where
         // reference is the bound's decisive miss, its t is never compared); the whole block
         // in lanes when many are judged, else lane by lane (the same function on one lane)
         if k > n / 8 {
-            intersect_block(self.level, rq, self.faces, cols(&s.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
+            intersect_block(self.level, rq, self.faces, cols(&l.cols, n), &mut s.ghit[..n], &mut s.gt[..n]);
         } else {
             for (x, (w, _)) in words(n).enumerate() {
                 for j in ones(judged[x]) {
                     let i = w + j;
-                    let c: [&[f64]; 9] = std::array::from_fn(|c| &s.cols[c][i..i + 1]);
+                    let c: [&[f64]; 9] = std::array::from_fn(|c| &l.cols[c][i..i + 1]);
                     intersect_block(self.level, rq, self.faces, c, &mut s.ghit[i..i + 1], &mut s.gt[i..i + 1]);
                 }
             }
         }
         for (x, (w, _)) in words(n).enumerate() {
             for j in ones(judged[x]) {
-                self.rti_lane(s, acc, ray, rq, blk, base, w + j, ray_index, cap, gbest);
+                self.rti_lane(s, l, acc, ray, rq, blk, base, w + j, ray_index, cap, gbest);
             }
         }
     }
@@ -530,6 +596,7 @@ where
     fn rti_lane(
         &self,
         s: &Scratch<F::V>,
+        l: &Lanes<F::V>,
         acc: &mut RtiAcc,
         ray: &Ray64,
         rq: &Ray64,
@@ -542,14 +609,14 @@ where
     ) {
         let f = &self.rti.fmt;
         let c = &mut acc.counts;
-        let (mhit, dec) = (s.out.hit[k], s.dec[k]);
-        let (gt, mt) = (s.gt[k], f.to_f64(s.out.t[k]));
+        let (mhit, dec) = (l.out.hit[k], s.dec[k]);
+        let (gt, mt) = (s.gt[k], f.to_f64(l.out.t[k]));
         // the reference decision (crate::judge::decide): a decisive case's is the bound's;
         // the rest go through the f64 filter, then exact arithmetic
         let gh = if dec {
             s.ehit[k]
         } else {
-            let tq = Tri64 { v: std::array::from_fn(|p| std::array::from_fn(|a| s.cols[3 * p + a][k])) };
+            let tq = Tri64 { v: std::array::from_fn(|p| std::array::from_fn(|a| l.cols[3 * p + a][k])) };
             let (h, by) = crate::judge::reference_after(&self.rti, rq, &tq, (s.fdec[k], s.fhit[k]), s.ghit[k]);
             c.exact += by.fell_through() as u64;
             h
@@ -579,7 +646,7 @@ where
             acc.ulps.add(e / f.ulp(gt));
             acc.rels.add(e / gt.abs().max(f64::MIN_POSITIVE));
         }
-        let out = RtiOut { valid: s.out.valid[k], hit: mhit, t: s.out.t[k], u: s.out.u[k], v: s.out.v[k] };
+        let out = RtiOut { valid: l.out.valid[k], hit: mhit, t: l.out.t[k], u: l.out.u[k], v: l.out.v[k] };
         self.rti.capture(cap, &out, (base + k) as u32);
         if gh && gbest.is_none_or(|(_, bt)| gt < bt) {
             *gbest = Some((base + k, gt));
@@ -594,6 +661,7 @@ where
     fn slab_block(
         &self,
         s: &mut Scratch<F::V>,
+        l: &mut Lanes<F::V>,
         sacc: &mut [SlabAcc],
         rq: &Ray64,
         prepared: &[datapath::slab::SlabRay<F::V>],
@@ -601,7 +669,19 @@ where
         timed: bool,
     ) {
         let n = blk.len();
-        gather(Kernel::Avx512Fp16, &self.recs, blk, !self.with_rti, |r| &r.b, s.bcols.each_mut().map(|x| &mut x[..]));
+        // a kept block holds its gathered boxes from an earlier ray (the same values)
+        if !l.kept {
+            gather(
+                Kernel::Avx512Fp16,
+                &self.recs,
+                blk,
+                !self.with_rti,
+                |r| &r.b,
+                l.bcols.each_mut().map(|x| &mut x[..]),
+            );
+            let ([a, b, c], [d, e, f]) = (&mut l.boxes.min, &mut l.boxes.max);
+            gather(Kernel::Avx512Fp16, &self.recs, blk, false, |r| &r.s, [a, b, c, d, e, f].map(|x| &mut x[..]));
+        }
         // the golden hit, and whether the golden interval is too close to empty to trust
         // (|far − near| ≤ 1e-9 · max(1, |near|, |far| if finite)), once for all variants
         slab_block_flags(
@@ -610,16 +690,11 @@ where
             rq.d,
             rq.tmin,
             rq.tmax,
-            cols(&s.bcols, n),
+            cols(&l.bcols, n),
             CLOSE_REL,
             &mut s.shit[..n],
             &mut s.sclose[..n],
         );
-        // the stored boxes, gathered once for every variant
-        {
-            let ([a, b, c], [d, e, f]) = (&mut s.boxes.min, &mut s.boxes.max);
-            gather(Kernel::Avx512Fp16, &self.recs, blk, false, |r| &r.s, [a, b, c, d, e, f].map(|x| &mut x[..]));
-        }
         // the exact decision of each lane, computed at most once for all variants (0: not yet)
         s.exact[..n].fill(0);
         // the golden hits and the close lanes as bit masks, word by word, once for all variants
@@ -635,19 +710,19 @@ where
             let pick = |j: usize| self.shared[j.min(k - 1)];
             let group: [&Slab<F>; 8] = std::array::from_fn(|j| &self.variants[pick(j)].slab);
             let rays: [&datapath::slab::SlabRay<F::V>; 8] = std::array::from_fn(|j| &prepared[pick(j)]);
-            simd::slab_ray_shared(&group[..k], &rays[..k], &s.boxes, &mut s.souts[..k]).is_some()
+            simd::slab_ray_shared(&group[..k], &rays[..k], &l.boxes, &mut l.souts[..k]).is_some()
         };
         for (i, ((v, sr), acc)) in self.variants.iter().zip(prepared).zip(sacc.iter_mut()).enumerate() {
             let out = match self.shared.iter().position(|&j| j == i).filter(|_| shared) {
-                Some(j) => &s.souts[j],
+                Some(j) => &l.souts[j],
                 None => {
                     let t0 = timed.then(|| self.clock.now());
-                    simd::slab_ray(&v.slab, sr, &s.boxes, &mut s.sout);
+                    simd::slab_ray(&v.slab, sr, &l.boxes, &mut l.sout);
                     if let Some(t0) = t0 {
                         acc.model_ns += self.clock.since(t0);
                         acc.model_tests += n as u64;
                     }
-                    &s.sout
+                    &l.sout
                 }
             };
             let c = &mut acc.counts;
@@ -945,6 +1020,7 @@ where
         name: f.name(),
         rti: rti.clone(),
         clock: Clock::start(),
+        kept: scene.tris.len() <= cfg.sample && scene.tris.len().div_ceil(BLOCK) <= KEPT_BLOCKS,
     };
     let progress = Progress::new(cfg.engine.shard_items(cfg.rays), "rays", !cfg.progress);
     progress.message(format!("{} ({} tests per ray)", setup.name, tests_per_ray(scene, cfg.sample)));
