@@ -240,21 +240,6 @@ struct Lanes<V> {
 }
 
 impl<V: Copy + Default> Lanes<V> {
-    /// No lanes (nothing allocated): the placeholder while a block borrows its set.
-    fn empty() -> Self {
-        Lanes {
-            rays: RaysSoa::default(),
-            tris: TrisSoa::default(),
-            out: HitsSoa::default(),
-            cols: Default::default(),
-            bcols: Default::default(),
-            boxes: BoxesSoa::default(),
-            sout: SlabOutSoa::default(),
-            souts: Vec::new(),
-            ray: None,
-            kept: false,
-        }
-    }
     /// A set of `n` lanes.
     fn new(n: usize) -> Self {
         let z = V::default();
@@ -334,20 +319,21 @@ impl<V: Copy + Default> Scratch<V> {
             prepared: Vec::new(),
         }
     }
+}
 
-    /// The lane set of block `b` (`n` lanes) of a ray, made the first time (`kept`: the
-    /// ray's blocks are kept, one set each).
-    fn set(&mut self, b: usize, n: usize, kept: bool) -> usize {
-        let j = if kept { b } else { usize::from(n != BLOCK) };
-        while self.sets.len() <= j {
-            self.sets.push(Lanes::new(n));
-        }
-        if self.sets[j].tris.len() != n {
-            // (a list of another length: not in one run, whose lists all have one length)
-            self.sets[j] = Lanes::new(n);
-        }
-        j
+/// The index in `sets` of the lane set of block `b` (`n` lanes) of a ray, made the first time
+/// (`kept`: the ray's blocks are kept, one set each; else one set for full blocks and one for a
+/// ray's last, shorter block).
+fn lane_set<V: Copy + Default>(sets: &mut Vec<Lanes<V>>, b: usize, n: usize, kept: bool) -> usize {
+    let j = if kept { b } else { usize::from(n != BLOCK) };
+    while sets.len() <= j {
+        sets.push(Lanes::new(n));
     }
+    if sets[j].tris.len() != n {
+        // (a list of another length: not in one run, whose lists all have one length)
+        sets[j] = Lanes::new(n);
+    }
+    j
 }
 
 fn cols<const N: usize>(c: &[Vec<f64>; N], n: usize) -> [&[f64]; N] {
@@ -363,6 +349,8 @@ where
         let w = |v: F::V| f.to_f64(v);
         let mut acc = RtiAcc::default();
         let mut sacc: Vec<SlabAcc> = self.variants.iter().map(|_| SlabAcc::default()).collect();
+        // the lane sets, out of the scratch while its other buffers are lent beside one
+        let mut sets = std::mem::take(&mut s.sets);
         for i in rays {
             let (ray, target) = self.gen.ray(self.scene, i);
             test_list(self.scene.tris.len(), self.cfg.sample, self.cfg.seed, i, target, &mut s.list);
@@ -388,19 +376,16 @@ where
             let list = std::mem::take(&mut s.list);
             for (b, blk) in list.chunks(BLOCK).enumerate() {
                 let base = b * BLOCK;
-                let j = s.set(b, blk.len(), self.kept);
-                let mut l = std::mem::replace(&mut s.sets[j], Lanes::empty());
+                let j = lane_set(&mut sets, b, blk.len(), self.kept);
+                let l = &mut sets[j];
                 if self.with_rti {
-                    self.rti_block(
-                        s, &mut l, &mut acc, &ray, &rq, &mray, &pre, blk, base, i, timed, &mut cap, &mut gbest,
-                    );
+                    self.rti_block(s, l, &mut acc, &ray, &rq, &mray, &pre, blk, base, i, timed, &mut cap, &mut gbest);
                 }
                 if !self.variants.is_empty() {
-                    self.slab_block(s, &mut l, &mut sacc, &rq, &prepared, blk, timed);
+                    self.slab_block(s, l, &mut sacc, &rq, &prepared, blk, timed);
                 }
                 // a kept block's inputs stay (the next ray's block b is the same triangles)
                 l.kept = self.kept;
-                s.sets[j] = l;
             }
             if self.with_rti {
                 let same = match (gbest, cap.hit) {
@@ -413,6 +398,7 @@ where
             s.list = list;
             s.prepared = prepared;
         }
+        s.sets = sets;
         (acc, sacc)
     }
 
