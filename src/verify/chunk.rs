@@ -644,6 +644,7 @@ where
     /// whose model agrees with the golden (most lanes) counts as a test and, when it hits, an
     /// exact hit (the golden decides it; no false hit or miss) on bit masks; every other lane
     /// takes the exact rational decision (computed once per lane for all variants).
+    #[allow(clippy::too_many_arguments)]
     fn slab_block(
         &self,
         s: &mut Scratch<F::V>,
