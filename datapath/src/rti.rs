@@ -495,6 +495,16 @@ impl<V: Copy> RaysSoa<V> {
         self.tmin.resize(n, fill);
         self.tmax.resize(n, fill);
     }
+    /// Overwrites every ray with `r` (what [`Self::set`] of each index does, column by column).
+    #[inline]
+    pub fn fill(&mut self, r: &Ray<V>) {
+        for k in 0..3 {
+            self.o[k].fill(r.o[k]);
+            self.d[k].fill(r.d[k]);
+        }
+        self.tmin.fill(r.tmin);
+        self.tmax.fill(r.tmax);
+    }
     /// Overwrites ray i.
     #[inline(always)]
     pub fn set(&mut self, i: usize, r: &Ray<V>) {

@@ -311,7 +311,7 @@ fn nan_in_any_input_never_hits() {
 }
 
 /// The structure-of-arrays columns: resize fills every column, set writes lane i of every
-/// column (get reads it back), len / is_empty follow.
+/// column (get reads it back), fill writes every lane, len / is_empty follow.
 #[test]
 fn soa_columns_resize_set_get() {
     let ray = |k: u32| Ray { o: [k, k + 1, k + 2], d: [k + 3, k + 4, k + 5], tmin: k + 6, tmax: k + 7 };
@@ -326,6 +326,13 @@ fn soa_columns_resize_set_get() {
     let g = rs.get(1);
     assert_eq!((g.o, g.d, g.tmin, g.tmax), ([10, 11, 12], [13, 14, 15], 16, 17));
     assert_eq!(rs.get(0).o, [9, 9, 9]);
+    // fill: every lane as set writes it, the length kept
+    rs.fill(&ray(30));
+    assert_eq!(rs.len(), 3);
+    for i in 0..3 {
+        let g = rs.get(i);
+        assert_eq!((g.o, g.d, g.tmin, g.tmax), ([30, 31, 32], [33, 34, 35], 36, 37), "lane {i}");
+    }
     let tri = |k: u32| Tri { v: [[k, k + 1, k + 2], [k + 3, k + 4, k + 5], [k + 6, k + 7, k + 8]] };
     let mut ts = TrisSoa::<u32>::default();
     assert!(ts.is_empty());

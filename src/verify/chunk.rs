@@ -435,9 +435,7 @@ where
         let n = blk.len();
         // every lane holds the ray: written in the first block of the ray that uses the set
         if l.ray != Some(ray_index) {
-            for k in 0..n {
-                l.rays.set(k, mray);
-            }
+            l.rays.fill(mray);
             l.ray = Some(ray_index);
         }
         // a kept block holds its gathered triangles from an earlier ray (the same values)
@@ -455,13 +453,15 @@ where
         // the quantised triangles: the model's values in f64 (Rti::tri stores from_f64 of each
         // coordinate, so to_f64 of the model's column is the quantised column), converted where
         // the format converts a column at vector speed, else gathered from the records
-        if l.kept {
-        } else if self.q_from_m {
-            for (c, col) in l.cols.iter_mut().enumerate() {
-                self.rti.fmt.to_f64_column(&l.tris.v[c / 3][c % 3][..n], &mut col[..n]);
+        // (a kept block holds them from an earlier ray)
+        if !l.kept {
+            if self.q_from_m {
+                for (c, col) in l.cols.iter_mut().enumerate() {
+                    self.rti.fmt.to_f64_column(&l.tris.v[c / 3][c % 3][..n], &mut col[..n]);
+                }
+            } else {
+                gather(Kernel::Avx512Fp16, &self.qs, blk, true, |r| r, l.cols.each_mut().map(|x| &mut x[..]));
             }
-        } else {
-            gather(Kernel::Avx512Fp16, &self.qs, blk, true, |r| r, l.cols.each_mut().map(|x| &mut x[..]));
         }
         let t0 = timed.then(|| self.clock.now());
         match self.cfg.inject {
