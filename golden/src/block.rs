@@ -326,10 +326,9 @@ fn flags_body(
     let r = d.map(|x| 1.0 / x);
     // a group's box planes and flags as fixed arrays — a whole group's read and written in
     // place, the block's last partial group copied into local arrays (its lanes past the end
-    // hold stale planes and are not written back): the lane loop runs without bounds checks
+    // hold zeros and are not written back): the lane loop runs without bounds checks
     // and vectorises
-    let mut bl = [[0.0f64; FLAG_GROUP]; 6];
-    let (mut hl, mut cl, mut ug) = ([false; FLAG_GROUP], [false; FLAG_GROUP], [false; FLAG_GROUP]);
+    let mut ug = [false; FLAG_GROUP];
     // the usual ray has no zero direction component: then no axis is parallel and the group's
     // lanes run without the parallel-axis test (the same flags: `dead` stays false)
     let parallel = d.contains(&0.0);
@@ -354,6 +353,9 @@ fn flags_body(
             let cg: &mut [bool; FLAG_GROUP] = (&mut close[g..g + FLAG_GROUP]).try_into().expect("a whole group");
             group!(bg, hg, cg);
         } else {
+            // (made here, not per call: a block of whole groups zeroes none of it)
+            let mut bl = [[0.0f64; FLAG_GROUP]; 6];
+            let (mut hl, mut cl) = ([false; FLAG_GROUP], [false; FLAG_GROUP]);
             for (k, col) in bl.iter_mut().enumerate() {
                 col[..m].copy_from_slice(&b[k][g..g + m]);
             }
