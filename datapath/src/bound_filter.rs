@@ -74,6 +74,7 @@
 
 use crate::bound::{BlockOpts, BlockRay, Bnd, Ctx, Steps};
 use crate::format::DivMode;
+use crate::lanes::Lane;
 use crate::rti::Cull;
 use crate::simd::F64Lanes;
 
@@ -90,15 +91,15 @@ enum Static {
 
 /// Where a lane's constants `E` (det, u', v', t', u' + v') come from.
 trait LaneE: Copy {
-    /// The constants of the lane with these inputs.
-    fn of(&self, o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5];
+    /// The constants of the lane (or of each lane of a vector) with these inputs.
+    fn of<L: Lane>(&self, o: [L; 3], d: [L; 3], v: [[L; 3]; 3]) -> [L; 5];
 }
 
 /// The block's: every lane's.
 impl LaneE for [f64; 5] {
     #[inline(always)]
-    fn of(&self, _: [f64; 3], _: [f64; 3], _: [[f64; 3]; 3]) -> [f64; 5] {
-        *self
+    fn of<L: Lane>(&self, _: [L; 3], _: [L; 3], _: [[L; 3]; 3]) -> [L; 5] {
+        self.map(L::splat)
     }
 }
 
@@ -106,9 +107,9 @@ impl LaneE for [f64; 5] {
 /// NaN constants: no compare clears them).
 impl LaneE for LaneConsts {
     #[inline(always)]
-    fn of(&self, o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5] {
+    fn of<L: Lane>(&self, o: [L; 3], d: [L; 3], v: [[L; 3]; 3]) -> [L; 5] {
         let m = lane_magnitudes(o, d, v);
-        std::array::from_fn(|k| self.g[k] * m[k] + self.h[k])
+        std::array::from_fn(|k| L::splat(self.g[k]) * m[k] + L::splat(self.h[k]))
     }
 }
 
@@ -212,20 +213,21 @@ impl Steps for LaneCtx {
 
 /// The lane values' binary64 operations (`values`), or with `MAG` their absolute-value
 /// evaluation (`lane_magnitudes`: a difference adds), the products in the datapath's order.
-struct F64Steps<const MAG: bool>;
+/// On one f64 or on each lane of a vector of them (the same operations per lane).
+struct F64Steps<L, const MAG: bool>(std::marker::PhantomData<L>);
 
-impl<const MAG: bool> Steps for F64Steps<MAG> {
-    type S = f64;
+impl<L: Lane, const MAG: bool> Steps for F64Steps<L, MAG> {
+    type S = L;
     #[inline(always)]
-    fn mul(&mut self, x: f64, y: f64) -> f64 {
+    fn mul(&mut self, x: L, y: L) -> L {
         x * y
     }
     #[inline(always)]
-    fn add(&mut self, x: f64, y: f64) -> f64 {
+    fn add(&mut self, x: L, y: L) -> L {
         x + y
     }
     #[inline(always)]
-    fn sub(&mut self, x: f64, y: f64) -> f64 {
+    fn sub(&mut self, x: L, y: L) -> L {
         if MAG {
             x + y
         } else {
@@ -489,20 +491,31 @@ const QUOT_MARGIN: f64 = 1.0 / (1u64 << 40) as f64;
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn quot_may_overflow(recip: bool, u: f64, eta: f64, max: f64, num: f64, e_num: f64, e_det: f64, d: f64) -> bool {
+    quot_may_overflow_of(recip, u, eta, max, num, e_num, e_det, d)
+}
+
+/// [`quot_may_overflow`] on each lane of `L` (the same operations per lane; `u`, `eta`,
+/// `max` the format's, `recip` the block's).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn quot_may_overflow_of<L: Lane>(recip: bool, u: f64, eta: f64, max: f64, num: L, e_num: L, e_det: L, d: L) -> L::M {
+    let c = L::splat;
     let x = num.abs();
     let d2 = d * d;
     let m = x * d + e_num * d + x * e_det;
-    let lhs_recip = m * (1.0 + (2.0 * u + u * u)) + (eta * (x + e_num) * (1.0 + u) + eta) * d2;
-    let lhs_div = m * (1.0 + u) + eta * d2;
-    let lhs = if recip { lhs_recip } else { lhs_div };
-    let fits = lhs <= max * d2 * (1.0 - QUOT_MARGIN);
-    !(fits & (!recip | recip_fits(max, d)))
+    let lhs = if recip {
+        m * c(1.0 + (2.0 * u + u * u)) + (c(eta) * (x + e_num) * c(1.0 + u) + c(eta)) * d2
+    } else {
+        m * c(1.0 + u) + c(eta) * d2
+    };
+    let fits = lhs.le(c(max) * d2 * c(1.0 - QUOT_MARGIN));
+    !(fits & (L::mask(!recip) | recip_fits(max, d)))
 }
 
 /// [`quot_may_overflow`]'s reciprocal-mode check `max·d·(1 − 2⁻⁴⁰) >= 1` (false on NaN).
 #[inline(always)]
-fn recip_fits(max: f64, d: f64) -> bool {
-    max * d * (1.0 - QUOT_MARGIN) >= 1.0
+fn recip_fits<L: Lane>(max: f64, d: L) -> L::M {
+    (L::splat(max) * d * L::splat(1.0 - QUOT_MARGIN)).ge(L::splat(1.0))
 }
 
 /// As [`crate::bound::verdict_block`] — per lane the verdict's `decisive` and `hit`, and
@@ -825,29 +838,42 @@ fn maxima_avx2(r: BlockRay, c: [&[f64]; 9]) -> Maxima {
     unsafe { maxima_v::<crate::lanes_x86::F64x4>(r, c) }
 }
 
-/// [`certify`] compiled for one instruction set (its loops in that set's vector registers).
+/// [`certify`] on one instruction set's vectors (whole vectors of `$v`, then the rest lane by
+/// lane).
 macro_rules! certify_on {
-    ($name:ident, $feat:literal) => {
+    ($name:ident, $feat:literal, $v:ty) => {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
         fn $name(o: BlockOpts, r: BlockRay, st: Static, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) {
-            certify(o, r, st, c, out, mark)
+            // SAFETY: the feature is enabled on this function (its callers detected it)
+            unsafe {
+                match st {
+                    Static::Block(e) => certify_vectors::<$v, _>(o, r, e, c, out, mark),
+                    Static::Lane(l) => certify_vectors::<$v, _>(o, r, l, c, out, mark),
+                }
+            }
         }
     };
 }
 
-certify_on!(certify_avx512, "avx512f");
-certify_on!(certify_avx2, "avx2");
+certify_on!(certify_avx512, "avx512f", crate::lanes_x86::F64x8);
+certify_on!(certify_avx2, "avx2", crate::lanes_x86::F64x4);
 
 /// The values `RtiBound::new` carries for det, u', v', t' and u' + v' (its `v`): the same
 /// binary64 operations in the same order (no error terms; `tests::values_are_the_bounds`).
 #[inline(always)]
 pub fn values(o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5] {
+    values_of(o, d, v)
+}
+
+/// [`values`] on each lane of `L` (the same operations per lane).
+#[inline(always)]
+fn values_of<L: Lane>(o: [L; 3], d: [L; 3], v: [[L; 3]; 3]) -> [L; 5] {
     let [v0, v1, v2] = v;
     let e1 = [v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]];
     let e2 = [v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]];
     let s = [o[0] - v0[0], o[1] - v0[1], o[2] - v0[2]];
-    let mut f = F64Steps::<false>;
+    let mut f = F64Steps::<L, false>(std::marker::PhantomData);
     let p = f.cross(d, e2);
     let q = f.cross(s, e1);
     let (det, up, vp, tp) = (f.dot(e1, p), f.dot(s, p), f.dot(d, q), f.dot(e2, q));
@@ -859,13 +885,13 @@ pub fn values(o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5] {
 /// than the magnitude of the value [`values`] computes (rounding to nearest is monotone and
 /// odd), and no larger than the block's magnitude of the signal in [`lane_consts`].
 #[inline(always)]
-fn lane_magnitudes(o: [f64; 3], d: [f64; 3], v: [[f64; 3]; 3]) -> [f64; 5] {
+fn lane_magnitudes<L: Lane>(o: [L; 3], d: [L; 3], v: [[L; 3]; 3]) -> [L; 5] {
     let [v0, v1, v2] = v;
     let e1 = [(v1[0] - v0[0]).abs(), (v1[1] - v0[1]).abs(), (v1[2] - v0[2]).abs()];
     let e2 = [(v2[0] - v0[0]).abs(), (v2[1] - v0[1]).abs(), (v2[2] - v0[2]).abs()];
     let s = [(o[0] - v0[0]).abs(), (o[1] - v0[1]).abs(), (o[2] - v0[2]).abs()];
-    let d = d.map(f64::abs);
-    let mut f = F64Steps::<true>;
+    let d = d.map(L::abs);
+    let mut f = F64Steps::<L, true>(std::marker::PhantomData);
     let p = f.cross(d, e2);
     let q = f.cross(s, e1);
     let (det, up, vp, tp) = (f.dot(e1, p), f.dot(s, p), f.dot(d, q), f.dot(e2, q));
@@ -890,59 +916,150 @@ fn certify(o: BlockOpts, r: BlockRay, st: Static, c: [&[f64]; 9], out: &mut [boo
     }
 }
 
-/// [`certify`] with the lanes' constants from `k`.
+/// [`certify`] with the lanes' constants from `k`: whole vectors of `V` where given (called
+/// from a function compiled for `V`'s instruction set), the rest lane by lane — each lane's
+/// verdict is [`lane_verdict`]'s, the same operations on a vector's lanes as on one f64.
 #[inline(always)]
 fn certify_with<K: LaneE>(o: BlockOpts, r: BlockRay, k: K, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) {
-    let (u, eta, max) = (o.em.u, o.em.eta, o.em.max);
-    let recip = o.div == DivMode::RecipMul;
-    assert_eq!(mark.len(), out.len(), "certify: scratch of another length");
-    let mut near = false;
-    for i in 0..out.len() {
-        let (cleared, d, [up, vp, tp], e) = lane_cleared(o, r, k, c, i);
-        let x = tp.abs().max(up.abs()).max(vp.abs());
-        let e_num = e[3].max(e[1]).max(e[2]);
-        let over = quot_may_overflow(recip, u, eta, max, x, e_num, e[0], d);
-        out[i] = cleared & !over;
-        // a lane whose largest quotient surely leaves the range (|num| >= max·|det|, with room)
-        // fails the three checks too, as does one whose reciprocal check fails (the same
-        // `1/denom <= max` test, on the same d, is in each of the three): not marked (leaving
-        // a lane uncertified is always safe)
-        let hopeless = (x >= max * (d + e[0]) * (1.0 + HOPELESS)) | (recip & !recip_fits(max, d));
-        let again = cleared & over & !hopeless;
-        mark[i] = if again { 1.0 } else { 0.0 };
-        near |= again;
-    }
-    if near {
-        for i in 0..out.len() {
-            if mark[i] != 0.0 {
-                let (_, d, [up, vp, tp], e) = lane_cleared(o, r, k, c, i);
-                out[i] = !(quot_may_overflow(recip, u, eta, max, tp, e[3], e[0], d)
-                    | quot_may_overflow(recip, u, eta, max, up, e[1], e[0], d)
-                    | quot_may_overflow(recip, u, eta, max, vp, e[2], e[0], d));
-            }
-        }
-    }
+    certify_lanes(o, r, k, c, out, mark, 0)
 }
 
-/// Lane `i`'s conditions (2) and (3) of the module documentation (not valid, every compared
-/// quantity clear of its constant), its `d = |det| − E_det`, its numerators u', v', t' and its
-/// constants E (det, u', v', t', u' + v') from `k`.
+/// [`certify_with`] on whole vectors of `V` first.
+///
+/// # Safety
+/// `V`'s instruction set must be present.
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn lane_cleared<K: LaneE>(
+unsafe fn certify_vectors<V: crate::lanes_x86::Vector, K: LaneE>(
     o: BlockOpts,
     r: BlockRay,
     k: K,
     c: [&[f64]; 9],
-    i: usize,
-) -> (bool, f64, [f64; 3], [f64; 5]) {
-    let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
-    let [det, up, vp, tp, uv] = values(r.o, r.d, v);
-    let e = k.of(r.o, r.d, v);
-    let det_q = if o.cull == Cull::Backface { det - o.det_threshold } else { det.abs() - o.det_threshold };
-    let pos = det > 0.0;
-    let sgn = |x: f64| if pos { x } else { -x };
-    let valid = (det_q > 0.0) & (sgn(up) >= 0.0) & (sgn(vp) >= 0.0) & (sgn(det - uv) >= 0.0) & (sgn(tp) >= 0.0);
-    let clear = |x: f64, e: f64| x.abs() > e;
+    out: &mut [bool],
+    mark: &mut [f64],
+) {
+    let n = out.len();
+    assert!(mark.len() == n && c.iter().all(|col| col.len() == n), "certify: columns of another length");
+    let whole = n - n % V::N;
+    let (ro, rd) = (r.o.map(V::splat), r.d.map(V::splat));
+    let (one, zero) = (V::splat(1.0), V::splat(0.0));
+    let mut near = false;
+    let mut i = 0;
+    while i < whole {
+        // SAFETY: i + N <= n for every column (checked above); the caller's contract
+        let v: [[V; 3]; 3] =
+            std::array::from_fn(|p| std::array::from_fn(|a| unsafe { V::load(c[3 * p + a].as_ptr().add(i)) }));
+        let (ok, again) = lane_verdict(o, k, ro, rd, v);
+        let bits = V::bits(ok);
+        for (j, x) in out[i..i + V::N].iter_mut().enumerate() {
+            *x = bits >> j & 1 != 0;
+        }
+        // SAFETY: as the loads
+        unsafe { V::select(again, one, zero).store(mark.as_mut_ptr().add(i)) };
+        near |= V::bits(again) != 0;
+        i += V::N;
+    }
+    certify_lanes(o, r, k, c, out, mark, whole);
+    if near {
+        certify_near(o, r, k, c, out, mark, 0..whole);
+    }
+}
+
+/// [`certify_with`] lane by lane from lane `from` on (the lanes before are the caller's).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn certify_lanes<K: LaneE>(
+    o: BlockOpts,
+    r: BlockRay,
+    k: K,
+    c: [&[f64]; 9],
+    out: &mut [bool],
+    mark: &mut [f64],
+    from: usize,
+) {
+    assert_eq!(mark.len(), out.len(), "certify: scratch of another length");
+    let mut near = false;
+    for i in from..out.len() {
+        let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
+        let (ok, again) = lane_verdict(o, k, r.o, r.d, v);
+        out[i] = ok;
+        mark[i] = if again { 1.0 } else { 0.0 };
+        near |= again;
+    }
+    if near {
+        certify_near(o, r, k, c, out, mark, from..out.len());
+    }
+}
+
+/// The lanes of `range` marked in `mark` (they met conditions (2) and (3) but not the one
+/// quotient check): the three quotient checks one by one.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn certify_near<K: LaneE>(
+    o: BlockOpts,
+    r: BlockRay,
+    k: K,
+    c: [&[f64]; 9],
+    out: &mut [bool],
+    mark: &[f64],
+    range: std::ops::Range<usize>,
+) {
+    let (u, eta, max) = (o.em.u, o.em.eta, o.em.max);
+    let recip = o.div == DivMode::RecipMul;
+    for i in range {
+        if mark[i] != 0.0 {
+            let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
+            let (_, d, [up, vp, tp], e) = lane_cleared(o, k, r.o, r.d, v);
+            out[i] = !(quot_may_overflow(recip, u, eta, max, tp, e[3], e[0], d)
+                | quot_may_overflow(recip, u, eta, max, up, e[1], e[0], d)
+                | quot_may_overflow(recip, u, eta, max, vp, e[2], e[0], d));
+        }
+    }
+}
+
+/// One lane's (or each lane of a vector's) certificate and whether it takes the three quotient
+/// checks one by one ([`certify`]): certified when conditions (2) and (3) hold and the one
+/// quotient check on the largest numerator magnitude max(|t'|, |u'|, |v'|) with the largest of
+/// its three constants passes; taken again when (2) and (3) hold, that check fails and the
+/// lane is not hopeless — its largest quotient surely leaves the range (|num| >= max·|det|,
+/// with room), or its reciprocal check fails (the same `1/denom <= max` test, on the same d,
+/// is in each of the three): such a lane fails the three checks too (leaving a lane
+/// uncertified is always safe). Where (2) and (3) hold no value is NaN, so the maximum's
+/// treatment of NaN (f64's or `maxpd`'s) does not reach the verdict.
+#[inline(always)]
+fn lane_verdict<L: Lane, K: LaneE>(o: BlockOpts, k: K, ro: [L; 3], rd: [L; 3], v: [[L; 3]; 3]) -> (L::M, L::M) {
+    let (u, eta, max) = (o.em.u, o.em.eta, o.em.max);
+    let recip = o.div == DivMode::RecipMul;
+    let (cleared, d, [up, vp, tp], e) = lane_cleared(o, k, ro, rd, v);
+    let larger = |a: L, b: L| L::select(a.gt(b), a, b);
+    let x = larger(larger(tp.abs(), up.abs()), vp.abs());
+    let e_num = larger(larger(e[3], e[1]), e[2]);
+    let over = quot_may_overflow_of(recip, u, eta, max, x, e_num, e[0], d);
+    let c = L::splat;
+    let hopeless = x.ge(c(max) * (d + e[0]) * c(1.0 + HOPELESS)) | (L::mask(recip) & !recip_fits(max, d));
+    (cleared & !over, cleared & over & !hopeless)
+}
+
+/// Lane `i`'s (or each lane of a vector's) conditions (2) and (3) of the module documentation
+/// (not valid, every compared quantity clear of its constant), its `d = |det| − E_det`, its
+/// numerators u', v', t' and its constants E (det, u', v', t', u' + v') from `k`.
+#[inline(always)]
+fn lane_cleared<L: Lane, K: LaneE>(
+    o: BlockOpts,
+    k: K,
+    ro: [L; 3],
+    rd: [L; 3],
+    v: [[L; 3]; 3],
+) -> (L::M, L, [L; 3], [L; 5]) {
+    let [det, up, vp, tp, uv] = values_of(ro, rd, v);
+    let e = k.of(ro, rd, v);
+    let thr = L::splat(o.det_threshold);
+    let zero = L::splat(0.0);
+    let det_q = if o.cull == Cull::Backface { det - thr } else { det.abs() - thr };
+    let pos = det.gt(zero);
+    let sgn = |x: L| L::select(pos, x, -x);
+    let valid = det_q.gt(zero) & sgn(up).ge(zero) & sgn(vp).ge(zero) & sgn(det - uv).ge(zero) & sgn(tp).ge(zero);
+    let clear = |x: L, e: L| x.abs().gt(e);
     let cleared = clear(det_q, e[0])
         & clear(det, e[0])
         & clear(up, e[1])

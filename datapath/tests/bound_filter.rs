@@ -53,7 +53,8 @@ fn set_constants(opts: BlockOpts, ray: BlockRay, cols: &[Vec<f64>; 9]) -> Option
 }
 
 /// Runs the per-test bound and the filter (the block's own constants, and the set's of
-/// [`set_constants`]) on one block and compares lane by lane; returns the lanes certified by
+/// [`set_constants`]) on one block, on every kernel here, and compares lane by lane (every
+/// kernel certifies the same lanes); returns the lanes certified by
 /// the block's constants, the lanes the per-test bound finds decisive misses, and the lanes
 /// certified by the set's constants.
 fn same(opts: BlockOpts, ray: BlockRay, cols: &[Vec<f64>; 9]) -> Result<(usize, usize, usize), TestCaseError> {
@@ -61,6 +62,9 @@ fn same(opts: BlockOpts, ray: BlockRay, cols: &[Vec<f64>; 9]) -> Result<(usize, 
     let c = || std::array::from_fn(|k| &cols[k][..]);
     let set = set_constants(opts, ray, cols);
     let (mut certified, mut misses, mut by_set) = (0, 0, 0);
+    // the lanes each kernel's filter certifies, which must be the first kernel's (every
+    // instruction set runs the same lane operations)
+    let mut first: [Option<Vec<bool>>; 2] = [None, None];
     for k in kernels_here() {
         let (mut dec, mut hit, mut te) = (vec![false; n], vec![false; n], vec![0.0; n]);
         verdict_block(k, opts, ray, c(), &mut dec, &mut hit, &mut te);
@@ -97,6 +101,10 @@ fn same(opts: BlockOpts, ray: BlockRay, cols: &[Vec<f64>; 9]) -> Result<(usize, 
                 }
             }
             prop_assert_eq!(got, cert.iter().filter(|&&c| c).count());
+            match &first[which] {
+                None => first[which] = Some(cert.clone()),
+                Some(f) => prop_assert_eq!(f, &cert, "{:?} constants {}: other lanes certified", k, which),
+            }
             if which == 0 {
                 certified = got;
             } else {
