@@ -1322,8 +1322,10 @@ mod bound_block {
 
 /// The static filter in front of the bound (`bound_filter::verdict_block_filtered`) certifies
 /// the same lanes and gives the same verdicts on every instruction level the machine has (its
-/// block maxima run in AVX2 or AVX-512F vector registers; under `emu/avx512`: AVX-512F too), on
-/// blocks of ordinary triangles (most lanes certified) with edge values mixed in; and the block
+/// block maxima and its certificate run in AVX2 or AVX-512F vector registers; under
+/// `emu/avx512`: AVX-512F too), on blocks of ordinary triangles (most lanes certified) with
+/// edge values mixed in, with the block's constants (binary32) and each lane's (binary16, e8m7,
+/// e5m10 under FTZ), both division modes and cull rules; and the block
 /// maxima it starts from are the same bits on every level, on lengths around the vector widths
 /// and inputs with zeros of both signs, subnormals, huge values, infinities and NaNs.
 mod bound_filter_block {
@@ -1378,7 +1380,7 @@ mod bound_filter_block {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
         #[test]
-        fn the_filter_is_the_same_on_every_kernel(seed in any::<u64>(), n in 0usize..300, wild in 0u64..4) {
+        fn the_filter_is_the_same_on_every_kernel(seed in any::<u64>(), n in 0usize..300, wild in 0u64..4, fmt in 0usize..4) {
             let mut r = SplitMix64::new(seed);
             let x = |r: &mut SplitMix64, c: f64| {
                 if wild > 0 && r.below(64) < wild {
@@ -1394,11 +1396,16 @@ mod bound_filter_block {
                     c + r.range(-0.05, 0.05)
                 }
             };
+            // binary32 (the block's constants for every lane) and coarse formats (each lane's
+            // own constants: binary16, e8m7, e5m10 under FTZ), both division modes and cull
+            // rules, a zero and a nonzero det threshold
+            let name = ["f32", "fp16", "e8m7", "e5m10:ftz"][fmt];
+            let f: datapath::AnyFormat = name.parse().unwrap();
             let opts = BlockOpts {
-                em: Ieee::new(F32Native, FpOpts::default()).error_model(),
-                div: DivMode::RecipMul,
-                cull: Cull::TwoSided,
-                det_threshold: 0.0,
+                em: datapath::with_format!(f, |f| datapath::Format::error_model(&f)),
+                div: if r.below(2) == 0 { DivMode::RecipMul } else { DivMode::Divide },
+                cull: if r.below(2) == 0 { Cull::TwoSided } else { Cull::Backface },
+                det_threshold: if r.below(3) == 0 { 1e-3 } else { 0.0 },
             };
             let ray = BlockRay { o: [0.0, 0.0, -2.0], d: [r.range(-0.3, 0.3), r.range(-0.3, 0.3), 1.0], tmin: 0.0, tmax: f64::INFINITY };
             let centres: Vec<[f64; 3]> = (0..n).map(|_| [r.range(-1.0, 1.0), r.range(-1.0, 1.0), r.range(-0.5, 0.5)]).collect();
@@ -1409,7 +1416,7 @@ mod bound_filter_block {
                 (got, dec, hit, te.iter().map(|t| if t.is_nan() { u64::MAX } else { t.to_bits() }).collect::<Vec<_>>(), cert)
             };
             let want = run(Kernel::Scalar);
-            if wild == 0 && n > 0 {
+            if wild == 0 && n > 0 && fmt == 0 {
                 prop_assert!(want.0 > 0, "an ordinary block certifies lanes");
             }
             for k in kernels_here() {
