@@ -980,7 +980,7 @@ fn certify_lanes<K: LaneE>(
     assert_eq!(mark.len(), out.len(), "certify: scratch of another length");
     let mut near = false;
     for i in from..out.len() {
-        let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
+        let v = tri_at(c, i);
         let (ok, again) = lane_verdict(o, k, r.o, r.d, v);
         out[i] = ok;
         mark[i] = if again { 1.0 } else { 0.0 };
@@ -989,6 +989,12 @@ fn certify_lanes<K: LaneE>(
     if near {
         certify_near(o, r, k, c, out, mark, from..out.len());
     }
+}
+
+/// Lane `i`'s triangle from the nine coordinate columns.
+#[inline(always)]
+fn tri_at(c: [&[f64]; 9], i: usize) -> [[f64; 3]; 3] {
+    std::array::from_fn(|p| std::array::from_fn(|a| c[3 * p + a][i]))
 }
 
 /// The lanes of `range` marked in `mark` (they met conditions (2) and (3) but not the one
@@ -1008,7 +1014,7 @@ fn certify_near<K: LaneE>(
     let recip = o.div == DivMode::RecipMul;
     for i in range {
         if mark[i] != 0.0 {
-            let v = [[c[0][i], c[1][i], c[2][i]], [c[3][i], c[4][i], c[5][i]], [c[6][i], c[7][i], c[8][i]]];
+            let v = tri_at(c, i);
             let (_, d, [up, vp, tp], e) = lane_cleared(o, k, r.o, r.d, v);
             out[i] = !(quot_may_overflow(recip, u, eta, max, tp, e[3], e[0], d)
                 | quot_may_overflow(recip, u, eta, max, up, e[1], e[0], d)
