@@ -490,15 +490,9 @@ const QUOT_MARGIN: f64 = 1.0 / (1u64 << 40) as f64;
 /// bounds X, d and the constants by the format's largest value); a NaN fails the check.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn quot_may_overflow(recip: bool, u: f64, eta: f64, max: f64, num: f64, e_num: f64, e_det: f64, d: f64) -> bool {
-    quot_may_overflow_of(recip, u, eta, max, num, e_num, e_det, d)
-}
-
-/// [`quot_may_overflow`] on each lane of `L` (the same operations per lane; `u`, `eta`,
+/// On one f64 or on each lane of a vector of them (the same operations per lane; `u`, `eta`,
 /// `max` the format's, `recip` the block's).
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn quot_may_overflow_of<L: Lane>(recip: bool, u: f64, eta: f64, max: f64, num: L, e_num: L, e_det: L, d: L) -> L::M {
+fn quot_may_overflow<L: Lane>(recip: bool, u: f64, eta: f64, max: f64, num: L, e_num: L, e_det: L, d: L) -> L::M {
     let c = L::splat;
     let x = num.abs();
     let d2 = d * d;
@@ -911,20 +905,14 @@ fn lane_magnitudes<L: Lane>(o: [L; 3], d: [L; 3], v: [[L; 3]; 3]) -> [L; 5] {
 #[inline(always)]
 fn certify(o: BlockOpts, r: BlockRay, st: Static, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) {
     match st {
-        Static::Block(e) => certify_with(o, r, e, c, out, mark),
-        Static::Lane(l) => certify_with(o, r, l, c, out, mark),
+        Static::Block(e) => certify_lanes(o, r, e, c, out, mark, 0),
+        Static::Lane(l) => certify_lanes(o, r, l, c, out, mark, 0),
     }
 }
 
-/// [`certify`] with the lanes' constants from `k`: whole vectors of `V` where given (called
-/// from a function compiled for `V`'s instruction set), the rest lane by lane — each lane's
-/// verdict is [`lane_verdict`]'s, the same operations on a vector's lanes as on one f64.
-#[inline(always)]
-fn certify_with<K: LaneE>(o: BlockOpts, r: BlockRay, k: K, c: [&[f64]; 9], out: &mut [bool], mark: &mut [f64]) {
-    certify_lanes(o, r, k, c, out, mark, 0)
-}
-
-/// [`certify_with`] on whole vectors of `V` first.
+/// [`certify`] with the lanes' constants from `k` on whole vectors of `V` first (called from a
+/// function compiled for `V`'s instruction set), then lane by lane: each lane's verdict is
+/// [`lane_verdict`]'s, the same operations on a vector's lanes as on one f64.
 ///
 /// # Safety
 /// `V`'s instruction set must be present.
@@ -965,7 +953,8 @@ unsafe fn certify_vectors<V: crate::lanes_x86::Vector, K: LaneE>(
     }
 }
 
-/// [`certify_with`] lane by lane from lane `from` on (the lanes before are the caller's).
+/// [`certify`] with the lanes' constants from `k`, lane by lane from lane `from` on (the lanes
+/// before are the caller's).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn certify_lanes<K: LaneE>(
@@ -1040,7 +1029,7 @@ fn lane_verdict<L: Lane, K: LaneE>(o: BlockOpts, k: K, ro: [L; 3], rd: [L; 3], v
     let larger = |a: L, b: L| L::select(a.gt(b), a, b);
     let x = larger(larger(tp.abs(), up.abs()), vp.abs());
     let e_num = larger(larger(e[3], e[1]), e[2]);
-    let over = quot_may_overflow_of(recip, u, eta, max, x, e_num, e[0], d);
+    let over = quot_may_overflow(recip, u, eta, max, x, e_num, e[0], d);
     let c = L::splat;
     let hopeless = x.ge(c(max) * (d + e[0]) * c(1.0 + HOPELESS)) | (L::mask(recip) & !recip_fits(max, d));
     (cleared & !over, cleared & over & !hopeless)

@@ -438,7 +438,10 @@ where
             l.rays.fill(mray);
             l.ray = Some(ray_index);
         }
-        // a kept block holds its gathered triangles from an earlier ray (the same values)
+        // the model's triangles, and the quantised triangles: the model's values in f64
+        // (Rti::tri stores from_f64 of each coordinate, so to_f64 of the model's column is the
+        // quantised column), converted where the format converts a column at vector speed, else
+        // gathered from the records. A kept block holds both from an earlier ray (the same values)
         if !l.kept {
             let [[a, b, c], [d, e, f], [g, h, i]] = &mut l.tris.v;
             gather(
@@ -449,12 +452,6 @@ where
                 |r| &r.m,
                 [a, b, c, d, e, f, g, h, i].map(|x| &mut x[..]),
             );
-        }
-        // the quantised triangles: the model's values in f64 (Rti::tri stores from_f64 of each
-        // coordinate, so to_f64 of the model's column is the quantised column), converted where
-        // the format converts a column at vector speed, else gathered from the records
-        // (a kept block holds them from an earlier ray)
-        if !l.kept {
             if self.q_from_m {
                 for (c, col) in l.cols.iter_mut().enumerate() {
                     self.rti.fmt.to_f64_column(&l.tris.v[c / 3][c % 3][..n], &mut col[..n]);
